@@ -1,0 +1,94 @@
+"""Batched rotations: rotation vectors, matrices and the geodesic angle.
+
+All functions accept leading batch axes: rotation vectors ``(..., 3)``, matrices ``(..., 3, 3)``.
+"""
+
+import numpy as np
+
+_SMALL_ANGLE = 1e-8
+
+
+def rotvec_to_matrix(rotvec):
+    """Rodrigues' formula.
+
+    Parameters
+    ----------
+    rotvec : array_like of shape (..., 3)
+        Axis times angle (radians).
+
+    Returns
+    -------
+    R : ndarray of shape (..., 3, 3)
+    """
+    rotvec = np.asarray(rotvec, dtype=float)
+    theta = np.linalg.norm(rotvec, axis=-1)[..., None, None]
+    k = np.zeros(rotvec.shape[:-1] + (3, 3))
+    x, y, z = rotvec[..., 0], rotvec[..., 1], rotvec[..., 2]
+    k[..., 0, 1], k[..., 0, 2] = -z, y
+    k[..., 1, 0], k[..., 1, 2] = z, -x
+    k[..., 2, 0], k[..., 2, 1] = -y, x
+    small = theta < _SMALL_ANGLE
+    safe = np.where(small, 1.0, theta)
+    a = np.where(small, 1.0 - theta**2 / 6.0, np.sin(safe) / safe)
+    b = np.where(small, 0.5 - theta**2 / 24.0, (1.0 - np.cos(safe)) / safe**2)
+    eye = np.broadcast_to(np.eye(3), k.shape)
+    return eye + a * k + b * (k @ k)
+
+
+def matrix_to_rotvec(R):
+    """Inverse of :func:`rotvec_to_matrix` (angle in [0, pi]).
+
+    Parameters
+    ----------
+    R : array_like of shape (..., 3, 3)
+
+    Returns
+    -------
+    rotvec : ndarray of shape (..., 3)
+    """
+    from scipy.spatial.transform import Rotation
+
+    R = np.asarray(R, dtype=float)
+    flat = R.reshape(-1, 3, 3)
+    return Rotation.from_matrix(flat).as_rotvec().reshape(R.shape[:-2] + (3,))
+
+
+def geodesic_angle_deg(R_a, R_b):
+    """Angle (degrees) of the rotation taking ``R_b`` to ``R_a``: ``angle(R_a @ R_b.T)``.
+
+    Parameters
+    ----------
+    R_a, R_b : array_like of shape (..., 3, 3)
+
+    Returns
+    -------
+    angle_deg : ndarray of shape (...)
+        In [0, 180].
+    """
+    R_a = np.asarray(R_a, dtype=float)
+    R_b = np.asarray(R_b, dtype=float)
+    # trace(R_a R_b^T) = sum of element-wise products.
+    trace = np.sum(R_a * R_b, axis=(-2, -1))
+    cos = np.clip((trace - 1.0) / 2.0, -1.0, 1.0)
+    return np.degrees(np.arccos(cos))
+
+
+def check_rotation(R, name="rotation", tol=1e-6):
+    """Validate a 3x3 rotation matrix and return it as a float array.
+
+    Raises
+    ------
+    ValueError
+        If ``R`` is not a finite, orthonormal, right-handed 3x3 matrix.
+    """
+    R = np.asarray(R, dtype=float)
+    if R.shape != (3, 3):
+        raise ValueError(f"{name} must be a 3x3 matrix, got shape {R.shape}")
+    if not np.all(np.isfinite(R)):
+        raise ValueError(f"{name} contains NaN or infinite values")
+    if np.abs(R @ R.T - np.eye(3)).max() > tol or np.linalg.det(R) < 0:
+        raise ValueError(
+            f"{name} is not a rotation (orthonormal with determinant +1); "
+            "give the 3x3 rotation part of a rigid transform"
+        )
+    return R
