@@ -1,0 +1,1 @@
+"""Pictures: overlays of the projected skull on the photo."""

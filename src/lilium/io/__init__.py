@@ -1,0 +1,1 @@
+"""Case folders, meshes and result files (SPEC section 8): all file formats live here."""

@@ -1,0 +1,1 @@
+"""SFO methods: POSEST-SFO (baseline)."""
