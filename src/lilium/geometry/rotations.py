@@ -67,10 +67,15 @@ def geodesic_angle_deg(R_a, R_b):
     """
     R_a = np.asarray(R_a, dtype=float)
     R_b = np.asarray(R_b, dtype=float)
-    # trace(R_a R_b^T) = sum of element-wise products.
-    trace = np.sum(R_a * R_b, axis=(-2, -1))
-    cos = np.clip((trace - 1.0) / 2.0, -1.0, 1.0)
-    return np.degrees(np.arccos(cos))
+    Q = R_a @ np.swapaxes(R_b, -1, -2)
+    # atan2(sin, cos) keeps full precision near 0 and 180 degrees, unlike arccos(cos).
+    cos = (np.trace(Q, axis1=-2, axis2=-1) - 1.0) / 2.0
+    vee = np.stack(
+        [Q[..., 2, 1] - Q[..., 1, 2], Q[..., 0, 2] - Q[..., 2, 0], Q[..., 1, 0] - Q[..., 0, 1]],
+        axis=-1,
+    )
+    sin = np.linalg.norm(vee, axis=-1) / 2.0
+    return np.degrees(np.arctan2(sin, cos))
 
 
 def check_rotation(R, name="rotation", tol=1e-6):

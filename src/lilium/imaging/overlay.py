@@ -1,0 +1,128 @@
+"""Overlay pictures: the skull projected over the photo, with landmarks.
+
+Pure functions returning ``(H, W, 3)`` uint8 RGB arrays; writing them is :mod:`lilium.io`'s job.
+"""
+
+import cv2
+import numpy as np
+
+#: Colours (RGB).
+SKULL_RGB = np.array([235, 225, 190], dtype=float)
+PHOTO_LANDMARK_RGB = (0, 200, 255)
+ESTIMATE_RGB = (255, 40, 40)
+LIGHT_DIR_CAM = np.array([-0.3, -0.4, -1.0]) / np.linalg.norm([-0.3, -0.4, -1.0])
+
+
+def render_mesh_shaded(vertices_mm, faces, skull2cam, focal_px, principal_point_px, image_size_wh):
+    """Lambert-shaded render of a mesh by the painter's algorithm.
+
+    Parameters
+    ----------
+    vertices_mm : ndarray of shape (V, 3)
+    faces : ndarray of shape (F, 3)
+    skull2cam : ndarray of shape (4, 4)
+    focal_px : float
+    principal_point_px : array_like of shape (2,)
+    image_size_wh : tuple (width, height)
+
+    Returns
+    -------
+    shade : ndarray of shape (H, W), float
+        Shading in [0, 1] where the mesh covers the pixel.
+    covered : ndarray of shape (H, W), bool
+        The union of the projected triangles.
+    """
+    width, height = image_size_wh
+    T = np.asarray(skull2cam, dtype=float)
+    X = vertices_mm @ T[:3, :3].T + T[:3, 3]
+    tri = X[faces]
+    z = tri[..., 2]
+    keep = np.all(z > 1e-6, axis=1)
+    tri, faces = tri[keep], faces[keep]
+    uv = principal_point_px + focal_px * tri[..., :2] / tri[..., 2:3]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
+    # Two-sided lighting: a skull mesh may be wound either way.
+    intensity = 0.25 + 0.75 * np.abs(normal @ LIGHT_DIR_CAM)
+    order = np.argsort(-tri[..., 2].mean(axis=1))  # far to near
+    shade = np.zeros((height, width), dtype=np.float32)
+    covered = np.zeros((height, width), dtype=np.uint8)
+    # Sub-pixel precision: coordinates in 1/16 px, shifted so pixel centres are integers.
+    shift = 4
+    pts_all = np.round(uv * (1 << shift)).astype(np.int64)
+    inside = (
+        (pts_all[..., 0].max(axis=1) >= 0)
+        & (pts_all[..., 1].max(axis=1) >= 0)
+        & (pts_all[..., 0].min(axis=1) < width << shift)
+        & (pts_all[..., 1].min(axis=1) < height << shift)
+    )
+    for k in order:
+        if not inside[k]:
+            continue
+        pts = pts_all[k].astype(np.int32)
+        cv2.fillConvexPoly(shade, pts, float(intensity[k]), lineType=cv2.LINE_8, shift=shift)
+        cv2.fillConvexPoly(covered, pts, 1, lineType=cv2.LINE_8, shift=shift)
+    return shade, covered.astype(bool)
+
+
+def draw_overlay(
+    image,
+    skull_vertices_mm,
+    skull_faces,
+    skull2cam,
+    focal_px,
+    principal_point_px,
+    photo_landmarks_uv=None,
+    estimated_uv=None,
+    opacity=0.55,
+    curves=None,
+):
+    """The photo with the projected skull drawn semi-transparent over it and landmarks marked.
+
+    Parameters
+    ----------
+    image : ndarray of shape (H, W, 3), uint8
+    skull_vertices_mm : ndarray of shape (V, 3)
+    skull_faces : ndarray of shape (F, 3)
+    skull2cam : ndarray of shape (4, 4)
+    focal_px : float
+    principal_point_px : array_like of shape (2,)
+    photo_landmarks_uv : ndarray of shape (N, 2), optional
+        Facial landmarks marked in the photo, drawn as circles.
+    estimated_uv : ndarray of shape (N, 2), optional
+        Projections of the estimated 3D facial landmarks (same order), drawn as dots joined to
+        their circles.
+    opacity : float
+        Skull opacity in [0, 1].
+    curves : list of (ndarray of shape (K, 2), RGB tuple), optional
+        Polylines to draw (e.g. skull and face chin-jaw curves).
+
+    Returns
+    -------
+    ndarray of shape (H, W, 3), uint8
+    """
+    height, width = image.shape[:2]
+    shade, covered = render_mesh_shaded(
+        skull_vertices_mm, skull_faces, skull2cam, focal_px, principal_point_px, (width, height)
+    )
+    out = image.astype(float)
+    skull_rgb = shade[..., None] * SKULL_RGB
+    alpha = opacity * covered[..., None]
+    out = (1 - alpha) * out + alpha * skull_rgb
+    out = np.clip(out, 0, 255).astype(np.uint8)
+    scale = max(1, round(max(width, height) / 800))
+    for curve, colour in curves or []:
+        pts = np.round(np.asarray(curve)).astype(np.int32).reshape(-1, 1, 2)
+        cv2.polylines(out, [pts], False, colour, scale, cv2.LINE_AA)
+    if photo_landmarks_uv is not None:
+        for k, (u, v) in enumerate(np.asarray(photo_landmarks_uv)):
+            centre = (round(u), round(v))
+            if estimated_uv is not None and np.all(np.isfinite(estimated_uv[k])):
+                end = tuple(int(round(x)) for x in estimated_uv[k])
+                cv2.line(out, centre, end, ESTIMATE_RGB, scale, cv2.LINE_AA)
+            cv2.circle(out, centre, 5 * scale, PHOTO_LANDMARK_RGB, scale, cv2.LINE_AA)
+    if estimated_uv is not None:
+        for u, v in np.asarray(estimated_uv):
+            if np.isfinite(u) and np.isfinite(v):
+                cv2.circle(out, (round(u), round(v)), 2 * scale, ESTIMATE_RGB, -1, cv2.LINE_AA)
+    return out

@@ -1,0 +1,272 @@
+"""Case folders of SPEC section 8: subject (skull) folders and photo folders.
+
+Every problem found is a ``ValueError`` whose message names the file, the field and the fix.
+"""
+
+import csv
+import difflib
+from pathlib import Path
+
+import numpy as np
+
+from ..methods.case import VIEWS, Photo, Priors, Skull
+from ..softtissue.depths import DepthStats, check_depth_table
+from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL, FACIAL_NAMES
+from ..softtissue.normals import surface_normals_at
+from .jsonio import read_json
+from .mesh import MESH_SUFFIXES, read_mesh
+
+IMAGE_NAMES = ("image.png", "image.jpg", "image.jpeg")
+
+
+def _find(folder, stems_or_names, what, fix):
+    for name in stems_or_names:
+        if (folder / name).is_file():
+            return folder / name
+    raise ValueError(f"{folder}: no {what} ({' or '.join(stems_or_names)}); {fix}")
+
+
+def _check_folder(folder, kind):
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ValueError(f"{folder}: {kind} folder not found")
+    return folder
+
+
+def _unknown_name(path, field, name, known):
+    close = difflib.get_close_matches(name, known, n=1)
+    hint = f"did you mean {close[0]!r}?" if close else "see SPEC section 2 for the names"
+    return ValueError(f"{path}: {field}: unknown landmark {name!r}; {hint}")
+
+
+def parse_points(path, field, raw, known, dim):
+    """Validate ``{name: [coords]}`` from a file: known names, ``dim`` finite numbers each.
+
+    Returns
+    -------
+    dict of str -> ndarray of shape (dim,)
+    """
+    if not isinstance(raw, dict):
+        raise ValueError(f"{path}: {field} must be an object {{name: [{dim} numbers]}}")
+    out = {}
+    for name, value in raw.items():
+        if name not in known:
+            raise _unknown_name(path, field, name, known)
+        try:
+            point = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            point = np.empty(0)
+        if point.shape != (dim,):
+            raise ValueError(f"{path}: {field}.{name} must be {dim} numbers, got {value!r}")
+        if not np.all(np.isfinite(point)):
+            raise ValueError(
+                f"{path}: {field}.{name} is NaN or infinite; give its coordinates or remove it"
+            )
+        out[name] = point
+    return out
+
+
+def _field(path, data, key):
+    if not isinstance(data, dict) or key not in data:
+        raise ValueError(f"{path}: missing field {key!r}")
+    return data[key]
+
+
+def read_skull(folder, axes_path=None):
+    """Read a subject (skull) folder.
+
+    Parameters
+    ----------
+    folder : str or Path
+        Holds ``skull.ply`` (or ``.obj``/``.stl``), ``cranial_landmarks.json`` and optionally
+        ``soft_tissue_axes.json``.
+    axes_path : str or Path, optional
+        Soft-tissue axes file to use instead of the folder's own (e.g. a perturbed set).
+
+    Returns
+    -------
+    Skull
+        Axes missing from the file default to the outward skull-surface normal.
+    """
+    folder = _check_folder(folder, "subject")
+    mesh_path = _find(
+        folder,
+        [f"skull{s}" for s in MESH_SUFFIXES],
+        "skull mesh",
+        "put the skull mesh (millimetres) there",
+    )
+    vertices, faces = read_mesh(mesh_path)
+    lm_path = folder / "cranial_landmarks.json"
+    landmarks = parse_points(
+        lm_path, "landmarks", _field(lm_path, read_json(lm_path), "landmarks"), CRANIAL_NAMES, 3
+    )
+    extent = np.ptp(vertices, axis=0).max()
+    for name, p in landmarks.items():
+        gap = np.min(np.linalg.norm(vertices - p, axis=1))
+        if gap > 0.1 * extent:
+            raise ValueError(
+                f"{lm_path}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
+                "must be in the mesh's frame and units"
+            )
+    axes = {}
+    axes_path = Path(axes_path) if axes_path else folder / "soft_tissue_axes.json"
+    if axes_path.is_file():
+        raw = _field(axes_path, read_json(axes_path), "axes")
+        for name, a in parse_points(axes_path, "axes", raw, CRANIAL_NAMES, 3).items():
+            norm = np.linalg.norm(a)
+            if norm == 0:
+                raise ValueError(f"{axes_path}: axes.{name} is the zero vector; give a direction")
+            axes[name] = a / norm
+    missing = [n for n in landmarks if n not in axes and n in CRANIAL_TO_FACIAL]
+    if missing:
+        normals = surface_normals_at(vertices, faces, np.array([landmarks[n] for n in missing]))
+        axes.update(zip(missing, normals, strict=True))
+    return Skull(folder.name, vertices, faces, landmarks, axes)
+
+
+def _interval(path, priors, key):
+    value = priors.get(key)
+    if value is None:
+        return None
+    lo_hi = np.asarray(value, dtype=float) if np.ndim(value) == 1 else np.empty(0)
+    if lo_hi.shape != (2,) or not np.all(np.isfinite(lo_hi)) or not 0 < lo_hi[0] <= lo_hi[1]:
+        raise ValueError(f"{path}: priors.{key} must be [lo, hi] with 0 < lo <= hi, got {value!r}")
+    return float(lo_hi[0]), float(lo_hi[1])
+
+
+def parse_priors(path, priors):
+    """Validate the ``priors`` object of ``photo.json``."""
+    from ..geometry.rotations import check_rotation
+
+    if priors is None:
+        return Priors()
+    if not isinstance(priors, dict):
+        raise ValueError(f"{path}: priors must be an object")
+    rotation = priors.get("head_rotation_skull2cam")
+    if rotation is not None:
+        try:
+            rotation = check_rotation(rotation, name="priors.head_rotation_skull2cam")
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
+    tolerance = priors.get("head_tolerance_deg")
+    if tolerance is not None:
+        if not (isinstance(tolerance, (int, float)) and 0 < tolerance <= 180):
+            raise ValueError(f"{path}: priors.head_tolerance_deg must be in (0, 180] degrees")
+        tolerance = float(tolerance)
+    if (rotation is None) != (tolerance is None):
+        raise ValueError(
+            f"{path}: priors.head_rotation_skull2cam and priors.head_tolerance_deg go together; "
+            "give both or neither"
+        )
+    return Priors(
+        _interval(path, priors, "focal_px"), _interval(path, priors, "scd_mm"), rotation, tolerance
+    )
+
+
+def read_image(path):
+    """Read an RGB image as ``(H, W, 3)`` uint8; a corrupt file is a ``ValueError``."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as im:
+            return np.asarray(im.convert("RGB"))
+    except (UnidentifiedImageError, OSError, SyntaxError) as exc:
+        raise ValueError(f"{path}: cannot read the image ({exc}); save it as PNG or JPEG") from exc
+
+
+def read_mask(path, image_size_wh):
+    """Read a face mask (non-zero = face) as ``(H, W)`` bool, checking size and emptiness."""
+    mask = read_image(path).max(axis=2) > 0
+    w, h = image_size_wh
+    if mask.shape != (h, w):
+        raise ValueError(
+            f"{path}: the mask is {mask.shape[1]}x{mask.shape[0]} px but the photo is {w}x{h}; "
+            "make the mask the photo's size"
+        )
+    if not mask.any():
+        raise ValueError(f"{path}: the face mask is empty; paint the face/head pixels non-zero")
+    return mask
+
+
+def read_photo(folder, load_image=True):
+    """Read a photo folder (``image.png``/``.jpg``, ``photo.json``, optional mask and curve).
+
+    Parameters
+    ----------
+    folder : str or Path
+    load_image : bool
+        Keep the pixels (for overlays); the size is always read.
+
+    Returns
+    -------
+    Photo
+    """
+    folder = _check_folder(folder, "photo")
+    image_path = _find(folder, IMAGE_NAMES, "photo image", "put the photograph there")
+    image = read_image(image_path)
+    size_wh = (image.shape[1], image.shape[0])
+    meta_path = folder / "photo.json"
+    meta = read_json(meta_path)
+    view = _field(meta_path, meta, "view")
+    if view not in VIEWS:
+        raise ValueError(f"{meta_path}: view must be one of {', '.join(VIEWS)}, got {view!r}")
+    landmarks = parse_points(
+        meta_path, "landmarks", _field(meta_path, meta, "landmarks"), FACIAL_NAMES, 2
+    )
+    w, h = size_wh
+    for name, (u, v) in landmarks.items():
+        if not (-0.5 <= u <= w - 0.5 and -0.5 <= v <= h - 0.5):
+            raise ValueError(
+                f"{meta_path}: landmarks.{name} = ({u:g}, {v:g}) lies outside the {w}x{h} image "
+                f"{image_path.name}; u is the column and v the row, in pixels"
+            )
+    priors = parse_priors(meta_path, meta.get("priors"))
+    mask_path = folder / "face_mask.png"
+    mask = read_mask(mask_path, size_wh) if mask_path.is_file() else None
+    curve = None
+    curve_path = folder / "face_curve.json"
+    if curve_path.is_file():
+        data = read_json(curve_path)
+        key = "chin_jaw" if view == "frontal" else "forehead"
+        if key in data:
+            curve = np.asarray(data[key], dtype=float)
+            if curve.ndim != 2 or curve.shape[1] != 2 or not np.all(np.isfinite(curve)):
+                raise ValueError(f"{curve_path}: {key} must be a list of finite [u, v] pairs")
+    return Photo(
+        folder.name,
+        size_wh,
+        view,
+        landmarks,
+        mask,
+        curve,
+        priors,
+        image if load_image else None,
+    )
+
+
+def read_depth_table(path):
+    """Read a user's soft-tissue depth table (CSV with ``landmark,mean,sd,min,max``, mm).
+
+    Returns
+    -------
+    dict of str -> DepthStats
+        Keyed by cranial base name; see :func:`lilium.softtissue.check_depth_table`.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{path}: file not found")
+    table = {}
+    with path.open(newline="") as fh:
+        reader = csv.DictReader(fh)
+        need = {"landmark", "mean", "sd", "min", "max"}
+        if not reader.fieldnames or not need <= set(reader.fieldnames):
+            raise ValueError(f"{path}: the header must hold the columns {', '.join(sorted(need))}")
+        for line, row in enumerate(reader, start=2):
+            try:
+                stats = DepthStats(*(float(row[k]) for k in ("mean", "sd", "min", "max")))
+            except ValueError:
+                raise ValueError(
+                    f"{path}: line {line}: mean, sd, min and max must be numbers"
+                ) from None
+            table[row["landmark"].strip()] = stats
+    return check_depth_table(table, source=str(path))

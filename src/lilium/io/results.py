@@ -1,0 +1,32 @@
+"""Writing SFO outputs: ``result.json`` (SPEC section 8) and PNG pictures."""
+
+from pathlib import Path
+
+import numpy as np
+
+from .jsonio import write_json
+
+
+def write_png(path, rgb):
+    """Write an ``(H, W, 3)`` uint8 array as PNG."""
+    from PIL import Image
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    Image.fromarray(np.asarray(rgb, dtype=np.uint8)).save(path)
+
+
+def write_result(out_dir, result, overlay_rgb=None):
+    """Write ``out_dir/result.json`` and, when given, ``out_dir/overlay.png``.
+
+    Returns
+    -------
+    Path
+        The ``result.json`` path.
+    """
+    out_dir = Path(out_dir)
+    path = out_dir / "result.json"
+    write_json(path, result.to_dict())
+    if overlay_rgb is not None:
+        write_png(out_dir / "overlay.png", overlay_rgb)
+    return path

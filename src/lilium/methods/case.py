@@ -1,0 +1,138 @@
+"""In-memory SFO inputs: a skull, a photo and the a-priori camera information.
+
+These are plain validated arrays; reading them from case folders is :mod:`lilium.io.case`'s job.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..constants import MIN_CORRESPONDENCES
+from ..softtissue.landmarks import CRANIAL_TO_FACIAL
+
+VIEWS = ("frontal", "lateral_left", "lateral_right")
+
+
+@dataclass(frozen=True)
+class Priors:
+    """A-priori camera information (SPEC section 1); ``None`` switches a penalty off.
+
+    Attributes
+    ----------
+    focal_px : tuple (lo, hi) or None
+    scd_mm : tuple (lo, hi) or None
+        Subject-to-camera distance interval (camera centre to facial nasion).
+    head_rotation_skull2cam : ndarray of shape (3, 3) or None
+    head_tolerance_deg : float or None
+    """
+
+    focal_px: tuple | None = None
+    scd_mm: tuple | None = None
+    head_rotation_skull2cam: np.ndarray | None = None
+    head_tolerance_deg: float | None = None
+
+
+@dataclass(frozen=True)
+class Skull:
+    """A skull: mesh, cranial landmarks and the soft-tissue axes given for them.
+
+    Attributes
+    ----------
+    id : str
+    vertices_mm : ndarray of shape (V, 3)
+    faces : ndarray of shape (F, 3), int
+    landmarks_mm : dict of str -> ndarray of shape (3,)
+        Cranial landmarks, skull frame.
+    axes : dict of str -> ndarray of shape (3,)
+        Unit soft-tissue directions (cone axes); every correspondence landmark has one (given,
+        or the skull-surface normal by default).
+    """
+
+    id: str
+    vertices_mm: np.ndarray
+    faces: np.ndarray
+    landmarks_mm: dict
+    axes: dict
+
+
+@dataclass(frozen=True)
+class Photo:
+    """A photograph with its 2D facial landmarks and optional mask, curve and priors.
+
+    Attributes
+    ----------
+    id : str
+    image_size_wh : tuple (width, height), pixels
+    view : {"frontal", "lateral_left", "lateral_right"}
+    landmarks_uv : dict of str -> ndarray of shape (2,)
+        Facial landmarks, (u = column, v = row) pixels.
+    face_mask : ndarray of shape (H, W), bool, or None
+    face_curve_uv : ndarray of shape (K, 2) or None
+        Chin-jaw (frontal) or forehead (lateral) curve.
+    priors : Priors
+    image : ndarray of shape (H, W, 3), uint8, or None
+        The picture itself, for overlays.
+    """
+
+    id: str
+    image_size_wh: tuple
+    view: str
+    landmarks_uv: dict
+    face_mask: np.ndarray | None = None
+    face_curve_uv: np.ndarray | None = None
+    priors: Priors = field(default_factory=Priors)
+    image: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Correspondences:
+    """Landmarks usable for one SFO: present on the skull and visible in the photo.
+
+    Attributes
+    ----------
+    cranial_names, facial_names : tuple of str, length N
+    cranial_mm : ndarray of shape (N, 3)
+    axes : ndarray of shape (N, 3)
+    uv_px : ndarray of shape (N, 2)
+    """
+
+    cranial_names: tuple
+    facial_names: tuple
+    cranial_mm: np.ndarray
+    axes: np.ndarray
+    uv_px: np.ndarray
+
+
+def correspondences(skull, photo, min_count=MIN_CORRESPONDENCES):
+    """Pair the skull's cranial landmarks with the photo's facial landmarks.
+
+    Raises
+    ------
+    ValueError
+        Fewer than ``min_count`` landmarks present on both, with the names of what is missing.
+    """
+    pairs = [
+        (c, f)
+        for c, f in CRANIAL_TO_FACIAL.items()
+        if c in skull.landmarks_mm and f in photo.landmarks_uv
+    ]
+    if len(pairs) < min_count:
+        only_photo = sorted(
+            f
+            for c, f in CRANIAL_TO_FACIAL.items()
+            if f in photo.landmarks_uv and c not in skull.landmarks_mm
+        )
+        raise ValueError(
+            f"only {len(pairs)} usable landmark pairs between skull {skull.id!r} and photo "
+            f"{photo.id!r}, at least {min_count} are needed; add cranial landmarks "
+            f"(missing on the skull: {', '.join(only_photo) or 'none'}) or mark more facial "
+            "landmarks in the photo"
+        )
+    cranial, facial = zip(*pairs, strict=True)
+    return Correspondences(
+        cranial,
+        facial,
+        np.array([skull.landmarks_mm[c] for c in cranial], dtype=float),
+        np.array([skull.axes[c] for c in cranial], dtype=float),
+        np.array([photo.landmarks_uv[f] for f in facial], dtype=float),
+    )

@@ -1,0 +1,86 @@
+"""The result of one SFO and its SPEC section 8 dictionary."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SfoResult:
+    """Outcome of one skull-face overlay; falsy when no camera was found.
+
+    Attributes
+    ----------
+    method : str
+    variant : str or None
+    seed : int or None
+    skull_id, photo_id : str
+    skull2cam : ndarray of shape (4, 4) or None
+    focal_px : float
+    principal_point_px : ndarray of shape (2,)
+    fitness : float
+        The method's score (lower is better): mean pixel error for POSEST-SFO, the fitness for
+        Lilium.
+    terms : dict of str -> float
+        ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (``None`` when switched off).
+    facial_landmarks_mm : dict of str -> ndarray of shape (3,)
+        Estimated 3D facial landmarks, keyed by facial name, skull frame.
+    seconds : float
+    error : str
+        Why it failed ("" on success).
+    extra : dict
+        Method-specific additions (e.g. the fitness history).
+    """
+
+    method: str
+    variant: str | None
+    seed: int | None
+    skull_id: str
+    photo_id: str
+    skull2cam: np.ndarray | None
+    focal_px: float
+    principal_point_px: np.ndarray
+    fitness: float
+    terms: dict
+    facial_landmarks_mm: dict
+    seconds: float
+    error: str = ""
+    extra: dict = field(default_factory=dict)
+
+    def __bool__(self):
+        return self.skull2cam is not None
+
+    def to_dict(self):
+        """The ``result.json`` dictionary of SPEC section 8."""
+        camera = None
+        if self:
+            camera = {
+                "focal_px": float(self.focal_px),
+                "principal_point_px": [float(x) for x in self.principal_point_px],
+                "skull2cam": np.asarray(self.skull2cam).tolist(),
+            }
+        out = {
+            "method": self.method,
+            "variant": self.variant,
+            "seed": self.seed,
+            "subject": self.skull_id,
+            "photo": self.photo_id,
+            "camera": camera,
+            "fitness": _finite_or_none(self.fitness),
+            "terms": {k: _finite_or_none(v) for k, v in self.terms.items()},
+            "facial_landmarks_3d": {
+                k: [float(x) for x in v] for k, v in self.facial_landmarks_mm.items()
+            },
+            "seconds": float(self.seconds),
+        }
+        if self.error:
+            out["error"] = self.error
+        out.update(self.extra)
+        return out
+
+
+def _finite_or_none(value):
+    if value is None:
+        return None
+    value = float(value)
+    return value if np.isfinite(value) else None
