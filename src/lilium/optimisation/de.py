@@ -1,0 +1,254 @@
+"""DE/rand/1/exp on the unit cube, vectorised over the population.
+
+Shape of scipy's ``differential_evolution``: a solver object that is also an iterator (one
+generation per ``next``), a thin function over it, and a frozen result. The objective evaluates a
+whole population at once: ``(S, D) -> (S,)``.
+
+Decisions the paper leaves open (SPEC section 6), fixed here:
+
+- Population initialised uniformly at random in ``[0, 1]^D``.
+- Mutant ``x_r1 + F (x_r2 - x_r3)``, with ``r1, r2, r3`` distinct and different from the target.
+- Exponential crossover: a random start gene, then a run of ``L`` consecutive genes (cyclic) with
+  ``P(L >= k) = CR^(k-1)``, taken from the mutant.
+- Out-of-range genes: periodic genes (azimuths) wrap modulo 1; the others are reflected at the
+  violated bound (``-x`` or ``2 - x``), and redrawn uniformly if still outside.
+- Greedy one-to-one selection (a trial replaces its target when not worse).
+- Termination: a generation count, a wall-clock limit, or a stagnation count (generations without
+  improvement of the best fitness), whichever comes first; each can be switched off.
+"""
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class DEOptions:
+    """Options of the DE solver (defaults chosen by measurement, see ``docs/method.md``).
+
+    Attributes
+    ----------
+    population_size : int
+    F : float
+        Differential weight.
+    CR : float
+        Crossover rate of the exponential crossover.
+    max_generations : int
+    max_seconds : float or None
+        Wall-clock limit (checked between generations).
+    stagnation_generations : int or None
+        Stop after this many generations without improving the best fitness by more than
+        ``stagnation_tol`` (relative); ``None`` switches it off.
+    stagnation_tol : float
+    """
+
+    population_size: int = 50
+    F: float = 0.5
+    CR: float = 0.9
+    max_generations: int = 750
+    max_seconds: float | None = 500.0
+    stagnation_generations: int | None = None
+    stagnation_tol: float = 1e-9
+
+
+@dataclass(frozen=True)
+class DEResult:
+    """Outcome of a DE run.
+
+    Attributes
+    ----------
+    x : ndarray of shape (D,)
+        Best genotype.
+    fun : float
+    nit : int
+        Generations run.
+    nfev : int
+        Objective evaluations (individuals).
+    message : str
+        Why it stopped.
+    population : ndarray of shape (S, D)
+    population_fitness : ndarray of shape (S,)
+    history : ndarray of shape (nit + 1,)
+        Best fitness after initialisation and after every generation.
+    seconds : float
+    """
+
+    x: np.ndarray
+    fun: float
+    nit: int
+    nfev: int
+    message: str
+    population: np.ndarray
+    population_fitness: np.ndarray
+    history: np.ndarray
+    seconds: float
+
+
+def exponential_crossover_mask(n_members, n_genes, CR, rng):
+    """Genes taken from the mutant under exponential crossover.
+
+    Returns
+    -------
+    mask : ndarray of shape (S, D), bool
+        At least one gene per row.
+    """
+    start = rng.integers(n_genes, size=n_members)
+    length = (
+        np.minimum(rng.geometric(1.0 - CR, size=n_members), n_genes)
+        if CR < 1
+        else np.full(n_members, n_genes)
+    )
+    offset = (np.arange(n_genes)[None, :] - start[:, None]) % n_genes
+    return offset < length[:, None]
+
+
+def distinct_others(n_members, k, rng):
+    """For each member i, k distinct indices of other members.
+
+    Returns
+    -------
+    ndarray of shape (S, k), int
+    """
+    picks = np.argsort(rng.random((n_members, n_members - 1)), axis=1)[:, :k]
+    return picks + (picks >= np.arange(n_members)[:, None])
+
+
+def fold_into_cube(x, periodic, rng):
+    """Bring genes back into [0, 1]: wrap periodic ones, reflect (then redraw) the rest."""
+    x = np.where(periodic, np.mod(x, 1.0), x)
+    x = np.where(x < 0, -x, x)
+    x = np.where(x > 1, 2.0 - x, x)
+    bad = (x < 0) | (x > 1)
+    if bad.any():
+        x[bad] = rng.random(int(bad.sum()))
+    return x
+
+
+class DifferentialEvolution:
+    """DE/rand/1/exp solver; iterate it to run one generation per step.
+
+    Parameters
+    ----------
+    objective : callable
+        ``objective(population (S, D), parents (S,) int or None) -> (S,)`` fitness, lower is
+        better. ``parents[i]`` is the population index the trial ``i`` replaces (for warm starts);
+        ``None`` at initialisation.
+    n_genes : int
+    periodic : array_like of shape (D,), bool, optional
+        Genes that wrap (azimuths).
+    options : DEOptions
+    rng : seed or numpy Generator
+    callback : callable, optional
+        ``callback(solver)`` after each generation; return True to stop.
+    """
+
+    def __init__(
+        self, objective, n_genes, periodic=None, options=DEOptions(), rng=None, callback=None
+    ):
+        if options.population_size < 4:
+            raise ValueError("population_size must be at least 4 for DE/rand/1")
+        self.objective = objective
+        self.options = options
+        self.rng = np.random.default_rng(rng)
+        self.periodic = np.zeros(n_genes, bool) if periodic is None else np.asarray(periodic, bool)
+        self.callback = callback
+        self._start = time.perf_counter()
+        self.population = self.rng.random((options.population_size, n_genes))
+        self.fitness = np.asarray(objective(self.population, None), dtype=float)
+        self.nfev = options.population_size
+        self.nit = 0
+        self.history = [float(self.fitness.min())]
+        self._since_improvement = 0
+        self.message = ""
+
+    @property
+    def best_index(self):
+        return int(np.argmin(self.fitness))
+
+    @property
+    def elapsed(self):
+        return time.perf_counter() - self._start
+
+    def _stop_reason(self):
+        o = self.options
+        if self.nit >= o.max_generations:
+            return f"reached {o.max_generations} generations"
+        if o.max_seconds is not None and self.elapsed >= o.max_seconds:
+            return f"reached the {o.max_seconds:g} s wall-clock limit"
+        if o.stagnation_generations and self._since_improvement >= o.stagnation_generations:
+            return f"no improvement in {o.stagnation_generations} generations"
+        return ""
+
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        self.message = self._stop_reason()
+        if self.message:
+            raise StopIteration
+        self.step()
+        if self.callback is not None and self.callback(self):
+            self.message = "stopped by the callback"
+            raise StopIteration
+        return self.population[self.best_index], float(self.fitness.min())
+
+    def step(self):
+        """Run one generation: mutation, crossover, fold into the cube, evaluation, selection."""
+        S, D = self.population.shape
+        o = self.options
+        r = distinct_others(S, 3, self.rng)
+        pop = self.population
+        mutant = pop[r[:, 0]] + o.F * (pop[r[:, 1]] - pop[r[:, 2]])
+        take = exponential_crossover_mask(S, D, o.CR, self.rng)
+        trial = fold_into_cube(np.where(take, mutant, pop), self.periodic, self.rng)
+        trial_fitness = np.asarray(self.objective(trial, np.arange(S)), dtype=float)
+        self.nfev += S
+        better = trial_fitness <= self.fitness
+        before = self.fitness.min()
+        self.population[better] = trial[better]
+        self.fitness[better] = trial_fitness[better]
+        self.on_selection(better)
+        self.nit += 1
+        best = self.fitness.min()
+        improved = best < before - o.stagnation_tol * max(abs(before), 1e-300)
+        self._since_improvement = 0 if improved else self._since_improvement + 1
+        self.history.append(float(best))
+
+    def on_selection(self, accepted):
+        """Hook for problems that keep per-member state (e.g. warm-start cameras)."""
+        if hasattr(self.objective, "on_selection"):
+            self.objective.on_selection(accepted)
+
+    def solve(self):
+        """Run to termination and return a :class:`DEResult`."""
+        for _ in self:
+            pass
+        i = self.best_index
+        return DEResult(
+            x=self.population[i].copy(),
+            fun=float(self.fitness[i]),
+            nit=self.nit,
+            nfev=self.nfev,
+            message=self.message,
+            population=self.population.copy(),
+            population_fitness=self.fitness.copy(),
+            history=np.asarray(self.history),
+            seconds=self.elapsed,
+        )
+
+
+def differential_evolution(
+    objective, n_genes, periodic=None, options=DEOptions(), rng=None, callback=None
+):
+    """Minimise ``objective`` over ``[0, 1]^n_genes`` by DE/rand/1/exp (see the module notes).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sphere = lambda pop, parents: np.sum((pop - 0.3) ** 2, axis=1)
+    >>> res = differential_evolution(sphere, 3, options=DEOptions(20, max_generations=200), rng=1)
+    >>> bool(res.fun < 1e-10)
+    True
+    """
+    return DifferentialEvolution(objective, n_genes, periodic, options, rng, callback).solve()
