@@ -1,0 +1,331 @@
+"""Lilium: differential evolution over soft-tissue cones with a composite fitness.
+
+Each DE individual is a genotype of three genes per usable cranial landmark (SPEC section 3).
+Its fitness (SPEC section 5) is ``MSE_pix + P_cam [+ P_skof] [+ P_pll]``:
+
+1. decode the genes into soft-tissue vectors, facial 3D landmarks ``F = C + ST``;
+2. fit the camera to ``(F, f)`` by Levenberg-Marquardt, warm-started from the camera of the
+   member the trial competes with (the first population gets full POSEST); when the warm-started
+   refinement fails (a point behind the camera, focal out of range) the individual falls back to
+   full POSEST (RANSAC + LM);
+3. score the camera: mean squared reprojection error over all used landmarks, camera priors,
+   skull pixels outside the face mask, chin-jaw/forehead curve parallelism.
+
+The whole population is evaluated at once (batched LM, batched projections).
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..constants import C_INF, FOCAL_MAX_PX
+from ..geometry.camera import principal_point_of
+from ..geometry.rotations import geodesic_angle_deg
+from ..optimisation.de import DEOptions, DifferentialEvolution
+from ..pose.posest import PosestOptions, posest
+from ..pose.refine import RefineOptions, refine_batch
+from ..pose.residuals import reprojection_sq_errors
+from ..softtissue.cones import decode, make_cones, midsagittal_plane
+from ..softtissue.depths import depth_stats
+from .case import correspondences
+from .result import SfoResult
+
+#: Variants: which optional penalties are on, (P_skof, P_pll).
+VARIANTS = {
+    "base": (False, False),
+    "pll": (False, True),
+    "skof": (True, False),
+    "skof+pll": (True, True),
+}
+
+
+@dataclass(frozen=True)
+class LiliumOptions:
+    """Options of :func:`lilium_sfo`.
+
+    Attributes
+    ----------
+    variant : {"base", "pll", "skof", "skof+pll"}
+    de : DEOptions
+    refine : RefineOptions
+        The warm-started inner Levenberg-Marquardt (few iterations: it starts near the optimum).
+    posest : PosestOptions
+        Initial population and fallback.
+    """
+
+    variant: str = "skof+pll"
+    de: DEOptions = field(default_factory=DEOptions)
+    refine: RefineOptions = field(
+        default_factory=lambda: RefineOptions(max_iterations=20, cost_tol=1e-10)
+    )
+    posest: PosestOptions = field(default_factory=PosestOptions)
+
+
+def camera_penalty(success, focal_px, scd_mm, dbeta_deg, priors):
+    """P_cam of SPEC section 5 for a population.
+
+    Parameters
+    ----------
+    success : ndarray of shape (S,), bool
+    focal_px, scd_mm, dbeta_deg : ndarray of shape (S,)
+    priors : Priors
+
+    Returns
+    -------
+    ndarray of shape (S,)
+    """
+    bad = ~success | ~(focal_px > 0) | (focal_px > FOCAL_MAX_PX)
+    p = np.zeros(len(success))
+    if priors.focal_px is not None:
+        lo, hi = priors.focal_px
+        p += np.maximum(0, lo - focal_px) ** 2 + np.maximum(0, focal_px - hi) ** 2
+    if priors.scd_mm is not None:
+        lo, hi = priors.scd_mm
+        p += np.maximum(0, lo - scd_mm) ** 2 + np.maximum(0, scd_mm - hi) ** 2
+    if priors.head_rotation_skull2cam is not None:
+        p += np.maximum(0, dbeta_deg - priors.head_tolerance_deg) ** 2
+    return np.where(bad, C_INF, np.nan_to_num(p, nan=C_INF))
+
+
+def build_cones(skull, corr, depth_table=None):
+    """Cones of the usable landmarks, twins with mirror-consistent bases."""
+    stats = [depth_stats(c, depth_table) for c in corr.cranial_names]
+    _, normal = midsagittal_plane(skull.landmarks_mm)
+    return make_cones(
+        corr.cranial_names,
+        corr.axes,
+        [s.min_mm for s in stats],
+        [s.max_mm for s in stats],
+        mirror_normal=normal,
+    )
+
+
+class LiliumProblem:
+    """Fitness of a population of genotypes for one skull and one photo.
+
+    Keeps the camera of every population member for warm starts; the DE solver tells it which
+    trials were accepted (:meth:`on_selection`).
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    options : LiliumOptions
+    depth_table : dict, optional
+    rng : seed or numpy Generator
+        For the RANSAC of initial and fallback POSEST runs.
+    """
+
+    def __init__(self, skull, photo, options=LiliumOptions(), depth_table=None, rng=0):
+        if options.variant not in VARIANTS:
+            raise ValueError(
+                f"unknown Lilium variant {options.variant!r}; use one of {', '.join(VARIANTS)}"
+            )
+        self.skull, self.photo, self.options = skull, photo, options
+        self.use_skof, self.use_pll = VARIANTS[options.variant]
+        self.corr = correspondences(skull, photo)
+        self.cones = build_cones(skull, self.corr, depth_table)
+        self.centre = principal_point_of(photo.image_size_wh)
+        self.uv_c = self.corr.uv_px - self.centre
+        names = self.corr.facial_names
+        self.scd_index = [names.index("nasion")] if "nasion" in names else list(range(len(names)))
+        self.rng = np.random.default_rng(rng)
+        self.periodic = np.tile([False, False, True], len(self.corr.cranial_names))
+        self.skof = self.pll = None
+        if self.use_skof:
+            self.skof = self._prepare_skof()
+        if self.use_pll:
+            self.pll = self._prepare_pll()
+        self.R = self.t = self.focal = None  # cameras of the population members
+        self._trial = None
+        self.n_fallbacks = 0
+
+    # -- optional penalties ---------------------------------------------------------------
+    def _prepare_skof(self):
+        from .lilium_terms import SkofTerm
+
+        if self.photo.face_mask is None:
+            raise ValueError(
+                f"photo {self.photo.id!r} has no face_mask.png; the skof variants need the face "
+                "mask (or use --variant base or pll)"
+            )
+        return SkofTerm(self.skull, self.photo)
+
+    def _prepare_pll(self):
+        from .lilium_terms import PllTerm
+
+        return PllTerm(self.skull, self.photo)
+
+    # -- evaluation -------------------------------------------------------------------------
+    def facial_landmarks(self, genes):
+        """Facial 3D landmarks ``(S, N, 3)`` of a population ``(S, 3N)``."""
+        return self.corr.cranial_mm + decode(np.atleast_2d(genes), self.cones)
+
+    def _posest_each(self, facial_mm, indices):
+        S = len(facial_mm)
+        R, t, f = np.tile(np.eye(3), (S, 1, 1)), np.zeros((S, 3)), np.full(S, np.nan)
+        ok = np.zeros(S, bool)
+        for i in indices:
+            pose = posest(
+                self.corr.uv_px, facial_mm[i], self.centre, self.options.posest, rng=self.rng
+            )
+            if pose:
+                R[i], t[i], f[i], ok[i] = (
+                    pose.skull2cam[:3, :3],
+                    pose.skull2cam[:3, 3],
+                    pose.focal_px,
+                    True,
+                )
+        return R, t, f, ok
+
+    def cameras(self, facial_mm, parents):
+        """Cameras of a population: warm-started LM, POSEST where that fails.
+
+        Returns
+        -------
+        R (S, 3, 3), t (S, 3), focal_px (S,), success (S,) bool, sq_err_px2 (S, N)
+        """
+        S = len(facial_mm)
+        if parents is None:
+            R0, t0, f0, ok = self._posest_each(facial_mm, range(S))
+            # Failed starts borrow a successful member's camera for the refinement below.
+            if ok.any():
+                j = np.flatnonzero(ok)[0]
+                R0[~ok], t0[~ok], f0[~ok] = R0[j], t0[j], f0[j]
+            else:
+                f0[:] = 1.0
+        else:
+            R0, t0, f0 = self.R[parents], self.t[parents], self.focal[parents]
+        ref = refine_batch(self.uv_c, facial_mm, R0, t0, f0, options=self.options.refine)
+        R, t, f = ref.R, ref.t, ref.focal_px
+        ok = np.isfinite(ref.cost) & (f > 0) & (f <= FOCAL_MAX_PX)
+        ok &= np.all(np.isfinite(ref.sq_err_px2), axis=1)
+        if not ok.all():
+            bad = np.flatnonzero(~ok)
+            self.n_fallbacks += len(bad)
+            Rb, tb, fb, okb = self._posest_each(facial_mm, bad)
+            R[bad], t[bad], f[bad], ok[bad] = Rb[bad], tb[bad], fb[bad], okb[bad]
+        sq = reprojection_sq_errors(self.uv_c, facial_mm, R, t, np.where(ok, f, 1.0))
+        sq[~ok] = np.inf
+        return R, t, f, ok, sq
+
+    def evaluate(self, genes, parents=None):
+        """All fitness terms of a population.
+
+        Parameters
+        ----------
+        genes : ndarray of shape (S, 3N)
+        parents : ndarray of shape (S,), int, or None
+            Population member each trial competes with (warm start); None = initial population.
+
+        Returns
+        -------
+        dict of str -> ndarray of shape (S,)
+            ``fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (NaN when off), and the
+            cameras under ``R``, ``t``, ``focal_px``.
+        """
+        facial = self.facial_landmarks(genes)
+        R, t, f, ok, sq = self.cameras(facial, parents)
+        mse = np.where(ok, np.mean(sq, axis=1), C_INF)
+        mse = np.where(np.isfinite(mse), mse, C_INF)
+        cam = facial[:, self.scd_index].mean(axis=1)
+        scd = np.linalg.norm(np.einsum("sij,sj->si", R, cam) + t, axis=1)
+        prior_R = self.photo.priors.head_rotation_skull2cam
+        dbeta = geodesic_angle_deg(R, prior_R) if prior_R is not None else np.zeros(len(R))
+        p_cam = camera_penalty(ok, f, scd, dbeta, self.photo.priors)
+        nan = np.full(len(R), np.nan)
+        p_skof = self.skof(R, t, f, ok) if self.skof else nan
+        p_pll = self.pll(R, t, f, ok) if self.pll else nan
+        fitness = mse + p_cam + np.nan_to_num(p_skof) + np.nan_to_num(p_pll)
+        return {
+            "fitness": fitness,
+            "mse_pix": mse,
+            "p_cam": p_cam,
+            "p_skof": p_skof,
+            "p_pll": p_pll,
+            "R": R,
+            "t": t,
+            "focal_px": f,
+            "success": ok,
+        }
+
+    def __call__(self, genes, parents):
+        terms = self.evaluate(genes, parents)
+        if parents is None:
+            self.R, self.t, self.focal = terms["R"], terms["t"], terms["focal_px"]
+        else:
+            self._trial = (terms["R"], terms["t"], terms["focal_px"])
+        return terms["fitness"]
+
+    def on_selection(self, accepted):
+        """Adopt the cameras of the accepted trials."""
+        R, t, f = self._trial
+        self.R[accepted], self.t[accepted], self.focal[accepted] = (
+            R[accepted],
+            t[accepted],
+            f[accepted],
+        )
+
+
+def lilium_sfo(skull, photo, options=LiliumOptions(), seed=0, depth_table=None, callback=None):
+    """Run Lilium on one skull and one photo.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    options : LiliumOptions
+    seed : int
+        Seeds DE and the RANSAC of POSEST calls: the same seed gives the same result.
+    depth_table : dict, optional
+    callback : callable, optional
+        ``callback(solver) -> bool`` after every generation (progress; True stops).
+
+    Returns
+    -------
+    SfoResult
+        ``extra`` holds ``history`` (best fitness per generation), ``generations``,
+        ``evaluations``, ``stop`` and ``genes``.
+    """
+    start = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    problem = LiliumProblem(skull, photo, options, depth_table, rng=rng)
+    solver = DifferentialEvolution(
+        problem, problem.cones.n_genes, problem.periodic, options.de, rng=rng, callback=callback
+    )
+    de = solver.solve()
+    best = problem.evaluate(de.x[None], parents=None)
+    ok = bool(best["success"][0])
+    facial = problem.facial_landmarks(de.x)[0]
+    skull2cam = None
+    if ok:
+        skull2cam = np.eye(4)
+        skull2cam[:3, :3], skull2cam[:3, 3] = best["R"][0], best["t"][0]
+    terms = {
+        k: (None if np.isnan(best[k][0]) else float(best[k][0]))
+        for k in ("mse_pix", "p_cam", "p_skof", "p_pll")
+    }
+    return SfoResult(
+        method="lilium",
+        variant=options.variant,
+        seed=seed,
+        skull_id=skull.id,
+        photo_id=photo.id,
+        skull2cam=skull2cam,
+        focal_px=float(best["focal_px"][0]) if ok else np.nan,
+        principal_point_px=problem.centre,
+        fitness=float(best["fitness"][0]),
+        terms=terms,
+        facial_landmarks_mm=dict(zip(problem.corr.facial_names, facial, strict=True)),
+        seconds=time.perf_counter() - start,
+        error="" if ok else "no camera found for the best soft-tissue estimate",
+        extra={
+            "history": de.history.tolist(),
+            "generations": de.nit,
+            "evaluations": de.nfev,
+            "stop": de.message,
+            "genes": de.x.tolist(),
+            "fallbacks": problem.n_fallbacks,
+        },
+    )
