@@ -21,18 +21,26 @@ def rotvec_to_matrix(rotvec):
     R : ndarray of shape (..., 3, 3)
     """
     rotvec = np.asarray(rotvec, dtype=float)
-    theta = np.linalg.norm(rotvec, axis=-1)[..., None, None]
-    k = np.zeros(rotvec.shape[:-1] + (3, 3))
-    x, y, z = rotvec[..., 0], rotvec[..., 1], rotvec[..., 2]
-    k[..., 0, 1], k[..., 0, 2] = -z, y
-    k[..., 1, 0], k[..., 1, 2] = z, -x
-    k[..., 2, 0], k[..., 2, 1] = -y, x
+    theta_sq = np.einsum("...i,...i->...", rotvec, rotvec)
+    theta = np.sqrt(theta_sq)
     small = theta < _SMALL_ANGLE
     safe = np.where(small, 1.0, theta)
-    a = np.where(small, 1.0 - theta**2 / 6.0, np.sin(safe) / safe)
-    b = np.where(small, 0.5 - theta**2 / 24.0, (1.0 - np.cos(safe)) / safe**2)
-    eye = np.broadcast_to(np.eye(3), k.shape)
-    return eye + a * k + b * (k @ k)
+    # R = I + a [v]x + b v v^T - b theta^2 I, with a = sin(theta)/theta, b = (1 - cos)/theta^2.
+    a = np.where(small, 1.0 - theta_sq / 6.0, np.sin(safe) / safe)
+    b = np.where(small, 0.5 - theta_sq / 24.0, (1.0 - np.cos(safe)) / safe**2)
+    R = (b[..., None, None] * rotvec[..., :, None]) * rotvec[..., None, :]
+    diag = 1.0 - b * theta_sq
+    x, y, z = a * rotvec[..., 0], a * rotvec[..., 1], a * rotvec[..., 2]
+    R[..., 0, 0] += diag
+    R[..., 1, 1] += diag
+    R[..., 2, 2] += diag
+    R[..., 0, 1] -= z
+    R[..., 1, 0] += z
+    R[..., 0, 2] += y
+    R[..., 2, 0] -= y
+    R[..., 1, 2] -= x
+    R[..., 2, 1] += x
+    return R
 
 
 def matrix_to_rotvec(R):

@@ -1,9 +1,11 @@
 """POSEST: pose and focal length from n >= 4 2D-3D correspondences (PnP+f).
 
 As in Lourakis & Terzakis' POSEST: MSAC over P4Pf samples, then Levenberg-Marquardt over the
-seven parameters on the inliers. A failure (fewer than four points, no real sample, focal length
-out of range, a point behind the camera) is a falsy :class:`PoseResult` carrying a message, not an
-exception.
+seven parameters on the inliers. The few best MSAC hypotheses are refined together (one batched
+call), each re-fitted to its own inlier set until that set settles (local optimisation, as in
+LO-RANSAC), and the refined camera with the lowest MSAC cost wins. A failure (fewer than four
+points, no real sample, focal length out of range, a point behind the camera) is a falsy
+:class:`PoseResult` carrying a message, not an exception.
 """
 
 from dataclasses import dataclass, field
@@ -13,6 +15,7 @@ import numpy as np
 from ..constants import FOCAL_MAX_PX, MIN_CORRESPONDENCES, RANSAC_THRESHOLD_PX
 from .ransac import RansacOptions, msac
 from .refine import RefineOptions, refine_batch
+from .residuals import reprojection_sq_errors
 
 
 @dataclass(frozen=True)
@@ -27,12 +30,16 @@ class PosestOptions:
         Points the Levenberg-Marquardt stage fits: MSAC's inliers (POSEST) or all points.
     focal_max_px : float
         Largest acceptable focal length; larger is a failure.
+    local_rounds : int
+        Refinements at most per hypothesis; after each, its inliers are re-classified with the
+        refined camera and, if they changed, it is refined again on the new set.
     """
 
     ransac: RansacOptions = field(default_factory=lambda: RansacOptions(RANSAC_THRESHOLD_PX))
     refine: RefineOptions = field(default_factory=RefineOptions)
     refine_on: str = "inliers"
     focal_max_px: float = FOCAL_MAX_PX
+    local_rounds: int = 4
 
 
 @dataclass(frozen=True)
@@ -126,21 +133,47 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0)
     c = np.asarray(principal_point_px, dtype=float)
     if len(uv) < MIN_CORRESPONDENCES:
         return failure(f"{len(uv)} correspondences, POSEST needs at least 4", c)
+    if options.refine_on not in ("inliers", "all"):
+        raise ValueError(f"refine_on must be 'inliers' or 'all', got {options.refine_on!r}")
     uv_c = uv - c
     hyp = msac(uv_c, X, options.ransac, rng)
     if not hyp:
         return failure(hyp.message, c)
-    weights = hyp.inliers.astype(float) if options.refine_on == "inliers" else np.ones(len(X))
-    if weights.sum() < MIN_CORRESPONDENCES:
-        weights = np.ones(len(X))
-    ref = refine_batch(
-        uv_c, X, hyp.R[None], hyp.t[None], [hyp.focal_px], weights[None], options.refine
-    )
-    R, t, f, sq = ref.R[0], ref.t[0], float(ref.focal_px[0]), ref.sq_err_px2[0]
-    why = check_camera(R, t, f, sq, options.focal_max_px)
-    if why:
-        return failure(why, c)
+    R, t, f, _ = hyp.candidates
+    tau_sq = options.ransac.threshold_px**2
+    sq = reprojection_sq_errors(uv_c, X, R, t, f)
+    on_inliers = options.refine_on == "inliers"
+    used = _used_points(sq, tau_sq) if on_inliers else np.ones(sq.shape, bool)
+    cost = np.empty(len(f))
+    todo = np.arange(len(f))  # hypotheses whose used points changed
+    for _ in range(max(options.local_rounds, 1)):
+        ref = refine_batch(
+            uv_c, X, R[todo], t[todo], f[todo], used[todo].astype(float), options.refine
+        )
+        R[todo], t[todo], f[todo] = ref.R, ref.t, ref.focal_px
+        sq[todo], cost[todo] = ref.sq_err_px2, ref.cost
+        if not on_inliers:
+            break
+        new_used = _used_points(sq[todo], tau_sq)
+        changed = np.any(new_used != used[todo], axis=1)
+        used[todo] = new_used
+        todo = todo[changed & (f[todo] <= options.focal_max_px)]
+        if len(todo) == 0:
+            break
+    score = cost if not on_inliers else np.minimum(sq, tau_sq).sum(axis=1)
+    why = [check_camera(R[k], t[k], f[k], sq[k], options.focal_max_px) for k in range(len(f))]
+    valid = np.array([not w for w in why])
+    if not valid.any():
+        return failure(why[int(np.argmin(score))], c)
+    k = int(np.argmin(np.where(valid, score, np.inf)))
     skull2cam = np.eye(4)
-    skull2cam[:3, :3], skull2cam[:3, 3] = R, t
-    errors = np.sqrt(sq)
-    return PoseResult(skull2cam, f, c, errors, errors < options.ransac.threshold_px)
+    skull2cam[:3, :3], skull2cam[:3, 3] = R[k], t[k]
+    errors = np.sqrt(sq[k])
+    return PoseResult(skull2cam, float(f[k]), c, errors, errors < options.ransac.threshold_px)
+
+
+def _used_points(sq_err_px2, tau_sq):
+    """Inliers (K, N) of K cameras; a camera with fewer than four keeps all its points."""
+    used = sq_err_px2 < tau_sq
+    used[used.sum(axis=1) < MIN_CORRESPONDENCES] = True
+    return used

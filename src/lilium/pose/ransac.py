@@ -22,6 +22,9 @@ class RansacOptions:
         Wanted probability of drawing one all-inlier sample (adaptive stopping).
     chunk : int
         Samples drawn and scored together (vectorised scoring).
+    n_candidates : int
+        Lowest-cost hypotheses kept for refinement (several starts guard the refinement
+        against a poor best sample, common when a distant head makes P4Pf ill-conditioned).
     """
 
     threshold_px: float = 12.0
@@ -29,11 +32,28 @@ class RansacOptions:
     min_iterations: int = 16
     success_prob: float = 0.9999
     chunk: int = 16
+    n_candidates: int = 4
 
 
 @dataclass(frozen=True)
 class RansacResult:
-    """Best MSAC hypothesis. Falsy when no sample gave a camera."""
+    """Best MSAC hypothesis, and the runners-up. Falsy when no sample gave a camera.
+
+    Attributes
+    ----------
+    R : ndarray of shape (3, 3) or None
+    t : ndarray of shape (3,) or None
+    focal_px : float
+    inliers : ndarray of shape (N,), bool, or None
+    cost : float
+        MSAC cost (sum of squared errors truncated at the threshold) of the best hypothesis.
+    n_samples : int
+        4-point samples drawn.
+    candidates : tuple (R, t, focal_px, cost) or None
+        The ``K <= n_candidates`` lowest-cost hypotheses, best first: arrays of shapes
+        (K, 3, 3), (K, 3), (K,), (K,).
+    message : str
+    """
 
     R: np.ndarray | None
     t: np.ndarray | None
@@ -41,6 +61,7 @@ class RansacResult:
     inliers: np.ndarray | None
     cost: float
     n_samples: int
+    candidates: tuple | None = None
     message: str = ""
 
     def __bool__(self):
@@ -75,7 +96,8 @@ def msac(uv_centred_px, points_mm, options=RansacOptions(), rng=None):
     rng = np.random.default_rng(rng)
     n = len(points_mm)
     tau_sq = options.threshold_px**2
-    best_cost, best = np.inf, None
+    best_cost = np.inf
+    kept = []  # (R, t, f, cost) of every scored hypothesis
     needed, drawn = options.max_iterations, 0
     while drawn < min(max(needed, options.min_iterations), options.max_iterations):
         Rs, ts, fs = [], [], []
@@ -91,14 +113,19 @@ def msac(uv_centred_px, points_mm, options=RansacOptions(), rng=None):
             continue
         sq = reprojection_sq_errors(uv_centred_px, points_mm, R, t, f)
         cost = np.minimum(sq, tau_sq).sum(axis=1)
+        kept.append((R, t, f, cost))
         k = int(np.argmin(cost))
         if cost[k] < best_cost:
             best_cost = float(cost[k])
-            inliers = sq[k] < tau_sq
-            best = (R[k], t[k], float(f[k]), inliers)
-            needed = _needed_iterations(inliers.mean(), options.success_prob)
-    if best is None:
+            needed = _needed_iterations((sq[k] < tau_sq).mean(), options.success_prob)
+    if not kept:
         return RansacResult(
-            None, None, np.nan, None, np.inf, drawn, "no 4-point sample gave a real camera"
+            None, None, np.nan, None, np.inf, drawn, message="no 4-point sample gave a real camera"
         )
-    return RansacResult(*best, cost=best_cost, n_samples=drawn)
+    R, t, f, cost = (np.concatenate(a) for a in zip(*kept, strict=True))
+    order = np.argsort(cost, kind="stable")[: max(options.n_candidates, 1)]
+    R, t, f, cost = R[order], t[order], f[order], cost[order]
+    sq = reprojection_sq_errors(uv_centred_px, points_mm, R[:1], t[:1], f[:1])[0]
+    return RansacResult(
+        R[0], t[0], float(f[0]), sq < tau_sq, float(cost[0]), drawn, candidates=(R, t, f, cost)
+    )

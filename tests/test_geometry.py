@@ -1,0 +1,152 @@
+"""Camera geometry and rotations: round trips against known answers."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from lilium.geometry import (
+    backproject_rays,
+    check_rotation,
+    check_skull2cam,
+    geodesic_angle_deg,
+    matrix_to_rotvec,
+    point_ray_distance,
+    principal_point_of,
+    project,
+    project_batch,
+    rotvec_to_matrix,
+    subject_camera_distance,
+)
+
+PRINCIPAL_POINT_PX = np.array([1999.5, 1499.5])
+
+
+def a_camera(rng):
+    skull2cam = np.eye(4)
+    skull2cam[:3, :3] = Rotation.random(random_state=rng.integers(2**31)).as_matrix()
+    skull2cam[:3, 3] = [20.0, -35.0, 1200.0]
+    return skull2cam
+
+
+def test_principal_point_is_the_pixel_centre_of_the_image():
+    assert np.array_equal(principal_point_of((4000, 3000)), [1999.5, 1499.5])
+
+
+def test_project_then_backproject_gives_rays_through_the_points():
+    rng = np.random.default_rng(0)
+    skull2cam = a_camera(rng)
+    points = rng.normal(scale=80.0, size=(30, 3))
+    uv = project(points, skull2cam, 3000.0, PRINCIPAL_POINT_PX)
+    origin, directions = backproject_rays(uv, skull2cam, 3000.0, PRINCIPAL_POINT_PX)
+    np.testing.assert_allclose(np.linalg.norm(directions, axis=1), 1.0, atol=1e-12)
+    np.testing.assert_allclose(point_ray_distance(points, origin, directions), 0.0, atol=1e-9)
+    # The origin is the camera centre: it projects nowhere (depth 0) and maps to 0 in the camera.
+    np.testing.assert_allclose(skull2cam[:3, :3] @ origin + skull2cam[:3, 3], 0.0, atol=1e-9)
+    # Points along a ray project to the same pixel.
+    further = origin + 1.5 * (points - origin)
+    np.testing.assert_allclose(
+        project(further, skull2cam, 3000.0, PRINCIPAL_POINT_PX), uv, atol=1e-8
+    )
+
+
+def test_point_ray_distance_of_an_offset_point():
+    d = point_ray_distance([[0.0, 3.0, 10.0]], [0.0, 0.0, 0.0], [[0.0, 0.0, 1.0]])
+    np.testing.assert_allclose(d, [3.0])
+
+
+def test_points_behind_the_camera_are_nan_and_rows_keep_their_order():
+    points = np.array([[0.0, 0.0, 100.0], [10.0, 0.0, -50.0], [0.0, 20.0, 200.0], [0, 0, 0.0]])
+    uv = project(points, np.eye(4), 1000.0, [0.0, 0.0])
+    assert uv.shape == (4, 2)
+    assert np.isnan(uv[1]).all() and np.isnan(uv[3]).all()
+    np.testing.assert_allclose(uv[0], [0.0, 0.0])
+    np.testing.assert_allclose(uv[2], [0.0, 100.0])
+
+
+def test_project_batch_matches_project():
+    rng = np.random.default_rng(1)
+    cams = [a_camera(rng) for _ in range(3)]
+    points = rng.normal(scale=60.0, size=(3, 10, 3))
+    points[1, 4] = [0.0, 0.0, -5000.0]  # far behind camera 1 whatever its rotation
+    cams[1][:3, :3] = np.eye(3)
+    focal = np.array([1000.0, 2000.0, 3000.0])
+    uv = project_batch(
+        points,
+        np.stack([c[:3, :3] for c in cams]),
+        np.stack([c[:3, 3] for c in cams]),
+        focal,
+        PRINCIPAL_POINT_PX,
+    )
+    for s in range(3):
+        np.testing.assert_allclose(
+            uv[s], project(points[s], cams[s], focal[s], PRINCIPAL_POINT_PX), equal_nan=True
+        )
+    assert np.isnan(uv[1, 4]).all()
+
+
+def test_subject_camera_distance():
+    skull2cam = np.eye(4)
+    skull2cam[:3, 3] = [30.0, 40.0, 1200.0]
+    np.testing.assert_allclose(
+        subject_camera_distance([0.0, 0.0, 0.0], skull2cam), 1201.0412, rtol=1e-7
+    )
+    rng = np.random.default_rng(2)
+    skull2cam = a_camera(rng)
+    points = rng.normal(size=(5, 3))
+    centre = -skull2cam[:3, :3].T @ skull2cam[:3, 3]
+    np.testing.assert_allclose(
+        subject_camera_distance(points, skull2cam), np.linalg.norm(points - centre, axis=1)
+    )
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 1e-4, 30.0, 90.0, 179.0, 180.0])
+def test_geodesic_angle_of_a_known_rotation(angle_deg):
+    axis = np.array([1.0, 2.0, -2.0]) / 3.0
+    R_a = Rotation.from_rotvec([0.3, -0.2, 0.5]).as_matrix()
+    R_b = rotvec_to_matrix(np.radians(angle_deg) * axis) @ R_a
+    assert geodesic_angle_deg(R_b, R_a) == pytest.approx(angle_deg, abs=1e-5)
+    assert geodesic_angle_deg(R_a, R_b) == pytest.approx(geodesic_angle_deg(R_b, R_a), abs=1e-9)
+
+
+def test_geodesic_angle_is_zero_for_identical_and_batched():
+    R = Rotation.random(5, random_state=3).as_matrix()
+    np.testing.assert_allclose(geodesic_angle_deg(R, R), 0.0, atol=1e-5)
+    assert geodesic_angle_deg(R, R).shape == (5,)
+
+
+def test_rotvec_to_matrix_matches_scipy_including_tiny_angles():
+    rng = np.random.default_rng(4)
+    rotvecs = rng.normal(size=(60, 3)) * np.repeat([1e-12, 1e-9, 1e-4, 1.0, 3.0, 0.0], 10)[:, None]
+    np.testing.assert_allclose(
+        rotvec_to_matrix(rotvecs), Rotation.from_rotvec(rotvecs).as_matrix(), atol=1e-14
+    )
+    assert rotvec_to_matrix(rotvecs.reshape(6, 10, 3)).shape == (6, 10, 3, 3)
+    big = rng.normal(size=(10, 3))
+    big *= rng.uniform(0.1, 3.0, (10, 1)) / np.linalg.norm(big, axis=1, keepdims=True)
+    np.testing.assert_allclose(matrix_to_rotvec(rotvec_to_matrix(big)), big, atol=1e-12)
+
+
+def test_check_skull2cam_accepts_a_rigid_transform():
+    T = a_camera(np.random.default_rng(5))
+    out = check_skull2cam(T.tolist())
+    assert out.dtype == float and np.array_equal(out, T)
+
+
+@pytest.mark.parametrize(
+    ("matrix", "match"),
+    [
+        (np.eye(3), r"4x4 matrix, got shape \(3, 3\)"),
+        (np.full((4, 4), np.nan), "NaN or infinite"),
+        (np.diag([1.0, 1.0, 2.0, 1.0]), "not a rotation"),
+        (np.diag([1.0, 1.0, -1.0, 1.0]), "not a rotation"),
+        (np.vstack([np.eye(4)[:3], [0.0, 0.0, 1.0, 1.0]]), "last row must be"),
+    ],
+)
+def test_check_skull2cam_errors(matrix, match):
+    with pytest.raises(ValueError, match=match):
+        check_skull2cam(matrix)
+
+
+def test_check_rotation_names_the_argument():
+    with pytest.raises(ValueError, match="head_rotation must be a 3x3"):
+        check_rotation(np.eye(4), name="head_rotation")
