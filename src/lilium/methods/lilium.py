@@ -137,7 +137,7 @@ class LiliumProblem:
             self.skof = self._prepare_skof()
         if self.use_pll:
             self.pll = self._prepare_pll()
-        self.R = self.t = self.focal = None  # cameras of the population members
+        self.R = self.t = self.focal = self.ok = None  # cameras of the population members
         self._trial = None
         self.n_fallbacks = 0
 
@@ -197,15 +197,23 @@ class LiliumProblem:
                 f0[:] = 1.0
         else:
             R0, t0, f0 = self.R[parents], self.t[parents], self.focal[parents]
+            # A member without a valid camera lends none: start from a valid member's.
+            invalid = ~self.ok[parents]
+            if invalid.any() and self.ok.any():
+                j = np.flatnonzero(self.ok)[0]
+                R0[invalid], t0[invalid], f0[invalid] = self.R[j], self.t[j], self.focal[j]
         ref = refine_batch(self.uv_c, facial_mm, R0, t0, f0, options=self.options.refine)
         R, t, f = ref.R, ref.t, ref.focal_px
-        ok = np.isfinite(ref.cost) & (f > 0) & (f <= FOCAL_MAX_PX)
-        ok &= np.all(np.isfinite(ref.sq_err_px2), axis=1)
-        if not ok.all():
-            bad = np.flatnonzero(~ok)
+        # Numerical failure (a point behind the camera): fall back to full POSEST. A focal length
+        # out of range is a real failure of that soft tissue (the fit runs off towards a weak
+        # perspective): P_cam's C_INF, no fallback.
+        broken = ~np.isfinite(ref.cost) | ~np.all(np.isfinite(ref.sq_err_px2), axis=1)
+        if broken.any():
+            bad = np.flatnonzero(broken)
             self.n_fallbacks += len(bad)
             Rb, tb, fb, okb = self._posest_each(facial_mm, bad)
-            R[bad], t[bad], f[bad], ok[bad] = Rb[bad], tb[bad], fb[bad], okb[bad]
+            R[bad], t[bad], f[bad] = Rb[bad], tb[bad], np.where(okb[bad], fb[bad], np.nan)
+        ok = (f > 0) & (f <= FOCAL_MAX_PX)
         sq = reprojection_sq_errors(self.uv_c, facial_mm, R, t, np.where(ok, f, 1.0))
         sq[~ok] = np.inf
         return R, t, f, ok, sq
@@ -252,20 +260,17 @@ class LiliumProblem:
 
     def __call__(self, genes, parents):
         terms = self.evaluate(genes, parents)
+        cameras = (terms["R"], terms["t"], terms["focal_px"], terms["success"])
         if parents is None:
-            self.R, self.t, self.focal = terms["R"], terms["t"], terms["focal_px"]
+            self.R, self.t, self.focal, self.ok = cameras
         else:
-            self._trial = (terms["R"], terms["t"], terms["focal_px"])
+            self._trial = cameras
         return terms["fitness"]
 
     def on_selection(self, accepted):
         """Adopt the cameras of the accepted trials."""
-        R, t, f = self._trial
-        self.R[accepted], self.t[accepted], self.focal[accepted] = (
-            R[accepted],
-            t[accepted],
-            f[accepted],
-        )
+        for mine, trial in zip((self.R, self.t, self.focal, self.ok), self._trial, strict=True):
+            mine[accepted] = trial[accepted]
 
 
 def lilium_sfo(skull, photo, options=LiliumOptions(), seed=0, depth_table=None, callback=None):

@@ -1,0 +1,63 @@
+import json
+
+import numpy as np
+import pytest
+
+from lilium.constants import C_INF
+from lilium.geometry import geodesic_angle_deg
+from lilium.io.case import read_photo, read_skull
+from lilium.methods.case import Priors
+from lilium.methods.lilium import LiliumOptions, LiliumProblem, camera_penalty, lilium_sfo
+from lilium.optimisation import DEOptions
+
+
+def _opts(variant="base", generations=250, population=30):
+    return LiliumOptions(variant, DEOptions(population, max_generations=generations))
+
+
+def test_camera_penalty_values():
+    priors = Priors((1000.0, 2000.0), (500.0, 800.0), np.eye(3), 10.0)
+    ok = np.array([True, True, True, False, True])
+    f = np.array([1500.0, 900.0, 2100.0, 1500.0, 20000.0])
+    scd = np.array([600.0, 400.0, 900.0, 600.0, 600.0])
+    dbeta = np.array([5.0, 12.0, 0.0, 0.0, 0.0])
+    p = camera_penalty(ok, f, scd, dbeta, priors)
+    np.testing.assert_allclose(p[:3], [0.0, 100**2 + 100**2 + 2**2, 100**2 + 100**2])
+    assert p[3] == C_INF and p[4] == C_INF
+    assert camera_penalty(ok[:1], f[1:2], scd[1:2], dbeta[1:2], Priors())[0] == 0.0
+
+
+def test_recovers_the_ground_truth_camera_on_a_noise_free_case(case):
+    subject_dir, photo_dir = case
+    truth = json.loads((photo_dir / "photo.json").read_text())["ground_truth"]
+    result = lilium_sfo(read_skull(subject_dir), read_photo(photo_dir), _opts(), seed=0)
+    assert result and result.terms["p_cam"] == 0.0
+    assert abs(result.focal_px - truth["focal_px"]) / truth["focal_px"] < 0.08
+    R_true = np.array(truth["skull2cam"])[:3, :3]
+    assert geodesic_angle_deg(result.skull2cam[:3, :3], R_true) < 2.0
+    # The true soft tissue lies in the cones: the fit gets within a few pixels.
+    assert result.terms["mse_pix"] < 10.0
+    history = result.extra["history"]
+    assert len(history) == 251 and history[-1] <= history[0] / 5
+
+
+def test_same_seed_same_result(case):
+    skull, photo = read_skull(case[0]), read_photo(case[1])
+    a = lilium_sfo(skull, photo, _opts(generations=15, population=10), seed=3)
+    b = lilium_sfo(skull, photo, _opts(generations=15, population=10), seed=3)
+    assert a.fitness == b.fitness and a.extra["genes"] == b.extra["genes"]
+    np.testing.assert_array_equal(a.skull2cam, b.skull2cam)
+
+
+def test_population_is_evaluated_at_once_and_terms_add_up(case):
+    problem = LiliumProblem(read_skull(case[0]), read_photo(case[1]), _opts())
+    genes = np.random.default_rng(0).random((12, problem.cones.n_genes))
+    terms = problem.evaluate(genes)
+    assert terms["fitness"].shape == (12,)
+    np.testing.assert_allclose(terms["fitness"], terms["mse_pix"] + terms["p_cam"])
+    assert np.all(np.isnan(terms["p_skof"])) and np.all(np.isnan(terms["p_pll"]))
+
+
+def test_unknown_variant(case):
+    with pytest.raises(ValueError, match="unknown Lilium variant 'fancy'"):
+        LiliumProblem(read_skull(case[0]), read_photo(case[1]), LiliumOptions("fancy"))
