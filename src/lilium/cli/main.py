@@ -11,7 +11,7 @@ import sys
 from .. import __version__
 
 #: Sub-command modules, in the order ``lilium --help`` lists them.
-COMMANDS = ["lilium.cli.sfo", "lilium.cli.demo"]
+COMMANDS = ["lilium.cli.sfo", "lilium.cli.demo", "lilium.cli.import_ct"]
 
 
 def build_parser():
