@@ -5,7 +5,7 @@ from lilium.optimisation import DEOptions, DifferentialEvolution, differential_e
 from lilium.optimisation.de import distinct_others, exponential_crossover_mask, fold_into_cube
 
 
-def sphere(pop, parents):
+def sphere(pop, parents, thresholds):
     return np.sum((pop - 0.3) ** 2, axis=1)
 
 
@@ -37,7 +37,7 @@ def test_periodic_genes_wrap_and_others_reflect():
 
 def test_periodic_optimum_across_the_seam():
     # Optimum at 0 == 1 on a circle: members on both sides of the seam are near it.
-    def circle(pop, parents):
+    def circle(pop, parents, thresholds):
         return np.sum(1 - np.cos(2 * np.pi * pop), axis=1)
 
     res = differential_evolution(
@@ -71,7 +71,7 @@ def test_stops_on_wall_clock_stagnation_and_callback():
     slow = DEOptions(8, max_generations=10**6, max_seconds=0.05)
     assert "wall-clock" in differential_evolution(sphere, 2, options=slow, rng=0).message
     flat = DEOptions(8, max_generations=10**6, stagnation_generations=5)
-    res = differential_evolution(lambda p, _: np.zeros(len(p)), 2, options=flat, rng=0)
+    res = differential_evolution(lambda p, *_: np.zeros(len(p)), 2, options=flat, rng=0)
     assert res.nit == 5 and "no improvement" in res.message
     seen = []
     solver = DifferentialEvolution(

@@ -3,28 +3,14 @@ import json
 import numpy as np
 import pytest
 
-from lilium.constants import C_INF
 from lilium.geometry import geodesic_angle_deg
 from lilium.io.case import read_photo, read_skull
-from lilium.methods.case import Priors
-from lilium.methods.lilium import LiliumOptions, LiliumProblem, camera_penalty, lilium_sfo
+from lilium.methods.lilium import LiliumOptions, LiliumProblem, lilium_sfo
 from lilium.optimisation import DEOptions
 
 
 def _opts(variant="base", generations=250, population=30):
     return LiliumOptions(variant, DEOptions(population, max_generations=generations))
-
-
-def test_camera_penalty_values():
-    priors = Priors((1000.0, 2000.0), (500.0, 800.0), np.eye(3), 10.0)
-    ok = np.array([True, True, True, False, True])
-    f = np.array([1500.0, 900.0, 2100.0, 1500.0, 20000.0])
-    scd = np.array([600.0, 400.0, 900.0, 600.0, 600.0])
-    dbeta = np.array([5.0, 12.0, 0.0, 0.0, 0.0])
-    p = camera_penalty(ok, f, scd, dbeta, priors)
-    np.testing.assert_allclose(p[:3], [0.0, 100**2 + 100**2 + 2**2, 100**2 + 100**2])
-    assert p[3] == C_INF and p[4] == C_INF
-    assert camera_penalty(ok[:1], f[1:2], scd[1:2], dbeta[1:2], Priors())[0] == 0.0
 
 
 def test_recovers_the_ground_truth_camera_on_a_noise_free_case(case):

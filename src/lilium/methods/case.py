@@ -8,28 +8,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..constants import MIN_CORRESPONDENCES
+from ..fitness.camera_penalty import CameraPriors
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 
 VIEWS = ("frontal", "lateral_left", "lateral_right")
 
 
-@dataclass(frozen=True)
-class Priors:
-    """A-priori camera information (SPEC section 1); ``None`` switches a penalty off.
-
-    Attributes
-    ----------
-    focal_px : tuple (lo, hi) or None
-    scd_mm : tuple (lo, hi) or None
-        Subject-to-camera distance interval (camera centre to facial nasion).
-    head_rotation_skull2cam : ndarray of shape (3, 3) or None
-    head_tolerance_deg : float or None
-    """
-
-    focal_px: tuple | None = None
-    scd_mm: tuple | None = None
-    head_rotation_skull2cam: np.ndarray | None = None
-    head_tolerance_deg: float | None = None
+#: A-priori camera information of a photo (focal and SCD intervals, head orientation and
+#: tolerance; each optional): the same object P_cam takes.
+Priors = CameraPriors
 
 
 @dataclass(frozen=True)

@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..constants import C_INF, FOCAL_MAX_PX
+from ..fitness.camera_penalty import camera_penalty_from_priors
 from ..geometry.camera import principal_point_of
-from ..geometry.rotations import geodesic_angle_deg
 from ..optimisation.de import DEOptions, DifferentialEvolution
 from ..pose.posest import PosestOptions, posest
 from ..pose.refine import RefineOptions, refine_batch
@@ -60,32 +60,6 @@ class LiliumOptions:
         default_factory=lambda: RefineOptions(max_iterations=20, cost_tol=1e-10)
     )
     posest: PosestOptions = field(default_factory=PosestOptions)
-
-
-def camera_penalty(success, focal_px, scd_mm, dbeta_deg, priors):
-    """P_cam of SPEC section 5 for a population.
-
-    Parameters
-    ----------
-    success : ndarray of shape (S,), bool
-    focal_px, scd_mm, dbeta_deg : ndarray of shape (S,)
-    priors : Priors
-
-    Returns
-    -------
-    ndarray of shape (S,)
-    """
-    bad = ~success | ~(focal_px > 0) | (focal_px > FOCAL_MAX_PX)
-    p = np.zeros(len(success))
-    if priors.focal_px is not None:
-        lo, hi = priors.focal_px
-        p += np.maximum(0, lo - focal_px) ** 2 + np.maximum(0, focal_px - hi) ** 2
-    if priors.scd_mm is not None:
-        lo, hi = priors.scd_mm
-        p += np.maximum(0, lo - scd_mm) ** 2 + np.maximum(0, scd_mm - hi) ** 2
-    if priors.head_rotation_skull2cam is not None:
-        p += np.maximum(0, dbeta_deg - priors.head_tolerance_deg) ** 2
-    return np.where(bad, C_INF, np.nan_to_num(p, nan=C_INF))
 
 
 def build_cones(skull, corr, depth_table=None):
@@ -145,17 +119,12 @@ class LiliumProblem:
     def _prepare_skof(self):
         from .lilium_terms import SkofTerm
 
-        if self.photo.face_mask is None:
-            raise ValueError(
-                f"photo {self.photo.id!r} has no face_mask.png; the skof variants need the face "
-                "mask (or use --variant base or pll)"
-            )
-        return SkofTerm(self.skull, self.photo)
+        return SkofTerm(self.skull, self.photo, self.centre)
 
     def _prepare_pll(self):
         from .lilium_terms import PllTerm
 
-        return PllTerm(self.skull, self.photo)
+        return PllTerm(self.skull, self.photo, self.centre)
 
     # -- evaluation -------------------------------------------------------------------------
     def facial_landmarks(self, genes):
@@ -218,7 +187,7 @@ class LiliumProblem:
         sq[~ok] = np.inf
         return R, t, f, ok, sq
 
-    def evaluate(self, genes, parents=None):
+    def evaluate(self, genes, parents=None, thresholds=None):
         """All fitness terms of a population.
 
         Parameters
@@ -226,40 +195,51 @@ class LiliumProblem:
         genes : ndarray of shape (S, 3N)
         parents : ndarray of shape (S,), int, or None
             Population member each trial competes with (warm start); None = initial population.
+        thresholds : ndarray of shape (S,), optional
+            Fitness each trial must reach to win. The image penalties (the expensive terms) are
+            skipped for a trial whose cheaper terms already exceed its threshold; its fitness is
+            then that lower bound and the skipped terms are NaN.
 
         Returns
         -------
         dict of str -> ndarray of shape (S,)
-            ``fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (NaN when off), and the
-            cameras under ``R``, ``t``, ``focal_px``.
+            ``fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (NaN when off or
+            skipped), ``success`` and the cameras ``R``, ``t``, ``focal_px``.
         """
         facial = self.facial_landmarks(genes)
         R, t, f, ok, sq = self.cameras(facial, parents)
+        S = len(R)
         mse = np.where(ok, np.mean(sq, axis=1), C_INF)
         mse = np.where(np.isfinite(mse), mse, C_INF)
         cam = facial[:, self.scd_index].mean(axis=1)
         scd = np.linalg.norm(np.einsum("sij,sj->si", R, cam) + t, axis=1)
-        prior_R = self.photo.priors.head_rotation_skull2cam
-        dbeta = geodesic_angle_deg(R, prior_R) if prior_R is not None else np.zeros(len(R))
-        p_cam = camera_penalty(ok, f, scd, dbeta, self.photo.priors)
-        nan = np.full(len(R), np.nan)
-        p_skof = self.skof(R, t, f, ok) if self.skof else nan
-        p_pll = self.pll(R, t, f, ok) if self.pll else nan
-        fitness = mse + p_cam + np.nan_to_num(p_skof) + np.nan_to_num(p_pll)
+        p_cam = camera_penalty_from_priors(f, scd, R, ok, self.photo.priors)
+        fitness = mse + p_cam
+        bound = np.full(S, np.inf) if thresholds is None else np.asarray(thresholds, float)
+        terms = {"p_skof": self.skof, "p_pll": self.pll}
+        values = {}
+        for name, term in terms.items():
+            values[name] = np.full(S, np.nan)
+            if term is None:
+                continue
+            todo = ok & (fitness <= bound)
+            if todo.any():
+                values[name][todo] = term(R[todo], t[todo], f[todo])
+                fitness[todo] += values[name][todo]
+            values[name][~ok] = 0.0
         return {
             "fitness": fitness,
             "mse_pix": mse,
             "p_cam": p_cam,
-            "p_skof": p_skof,
-            "p_pll": p_pll,
+            **values,
             "R": R,
             "t": t,
             "focal_px": f,
             "success": ok,
         }
 
-    def __call__(self, genes, parents):
-        terms = self.evaluate(genes, parents)
+    def __call__(self, genes, parents, thresholds=None):
+        terms = self.evaluate(genes, parents, thresholds)
         cameras = (terms["R"], terms["t"], terms["focal_px"], terms["success"])
         if parents is None:
             self.R, self.t, self.focal, self.ok = cameras

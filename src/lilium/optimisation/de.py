@@ -131,9 +131,12 @@ class DifferentialEvolution:
     Parameters
     ----------
     objective : callable
-        ``objective(population (S, D), parents (S,) int or None) -> (S,)`` fitness, lower is
-        better. ``parents[i]`` is the population index the trial ``i`` replaces (for warm starts);
-        ``None`` at initialisation.
+        ``objective(population (S, D), parents (S,) int or None, thresholds (S,) or None) -> (S,)``
+        fitness, lower is better. ``parents[i]`` is the population index trial ``i`` competes
+        with (for warm starts) and ``thresholds[i]`` that member's fitness; both are ``None`` at
+        initialisation. Where an objective can prove a trial worse than its threshold (a partial
+        sum of non-negative terms already above it) it may return that lower bound instead of
+        the full fitness: the trial loses either way, so the run is unchanged.
     n_genes : int
     periodic : array_like of shape (D,), bool, optional
         Genes that wrap (azimuths).
@@ -155,7 +158,7 @@ class DifferentialEvolution:
         self.callback = callback
         self._start = time.perf_counter()
         self.population = self.rng.random((options.population_size, n_genes))
-        self.fitness = np.asarray(objective(self.population, None), dtype=float)
+        self.fitness = np.asarray(objective(self.population, None, None), dtype=float)
         self.nfev = options.population_size
         self.nit = 0
         self.history = [float(self.fitness.min())]
@@ -202,7 +205,9 @@ class DifferentialEvolution:
         mutant = pop[r[:, 0]] + o.F * (pop[r[:, 1]] - pop[r[:, 2]])
         take = exponential_crossover_mask(S, D, o.CR, self.rng)
         trial = fold_into_cube(np.where(take, mutant, pop), self.periodic, self.rng)
-        trial_fitness = np.asarray(self.objective(trial, np.arange(S)), dtype=float)
+        trial_fitness = np.asarray(
+            self.objective(trial, np.arange(S), self.fitness.copy()), dtype=float
+        )
         self.nfev += S
         better = trial_fitness <= self.fitness
         before = self.fitness.min()
@@ -246,7 +251,7 @@ def differential_evolution(
     Examples
     --------
     >>> import numpy as np
-    >>> sphere = lambda pop, parents: np.sum((pop - 0.3) ** 2, axis=1)
+    >>> sphere = lambda pop, parents, thresholds: np.sum((pop - 0.3) ** 2, axis=1)
     >>> res = differential_evolution(sphere, 3, options=DEOptions(20, max_generations=200), rng=1)
     >>> bool(res.fun < 1e-10)
     True

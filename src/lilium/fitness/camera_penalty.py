@@ -1,0 +1,185 @@
+"""P_cam, the camera-plausibility term of SPEC section 5, over a whole population at once.
+
+``P_cam = C_INF * [no solution or f <= 0 or f > FOCAL_MAX_PX]
++ max(0, fmin - f)^2 + max(0, f - fmax)^2
++ max(0, SCDmin - SCD)^2 + max(0, SCD - SCDmax)^2
++ max(0, dbeta - beta_tol)^2``
+
+with f in pixels, SCD in mm and dbeta in degrees. A prior that is ``None`` switches its terms
+off. A quantity that is NaN while its prior is on (a camera that could not be measured) counts
+as a failure; the terms of a failed camera that are finite are still added, as the formula says,
+so failures stay ordered among themselves.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..constants import C_INF, FOCAL_MAX_PX
+from ..geometry.rotations import geodesic_angle_deg
+
+
+def _interval(value, name, unit):
+    if value is None:
+        return None
+    lo, hi = (float(x) for x in value)
+    if not (np.isfinite(lo) and np.isfinite(hi)) or lo > hi:
+        raise ValueError(f"{name} must be a finite interval [lo, hi] in {unit}, got {value}")
+    return lo, hi
+
+
+@dataclass(frozen=True)
+class CameraPriors:
+    """A priori camera information of one photo (SPEC 1 and 8); every field is optional.
+
+    Attributes
+    ----------
+    focal_px : (float, float) or None
+        Admissible focal length interval (pixels).
+    scd_mm : (float, float) or None
+        Admissible subject-to-camera distance interval (mm).
+    head_rotation_skull2cam : ndarray of shape (3, 3) or None
+        A priori head orientation (the rotation part of ``skull2cam``).
+    head_tolerance_deg : float or None
+        Largest deviation from it that costs nothing (degrees). The head term is on only when
+        both the rotation and the tolerance are given.
+    """
+
+    focal_px: tuple | None = None
+    scd_mm: tuple | None = None
+    head_rotation_skull2cam: np.ndarray | None = None
+    head_tolerance_deg: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "focal_px", _interval(self.focal_px, "focal_px", "pixels"))
+        object.__setattr__(self, "scd_mm", _interval(self.scd_mm, "scd_mm", "mm"))
+        if self.head_rotation_skull2cam is not None:
+            R = np.asarray(self.head_rotation_skull2cam, dtype=float)
+            if R.shape != (3, 3):
+                raise ValueError(
+                    f"head_rotation_skull2cam must be a 3x3 matrix, got shape {R.shape}"
+                )
+            object.__setattr__(self, "head_rotation_skull2cam", R)
+        if self.head_tolerance_deg is not None:
+            tol = float(self.head_tolerance_deg)
+            if not np.isfinite(tol) or tol < 0:
+                raise ValueError(f"head_tolerance_deg must be >= 0, got {tol}")
+            object.__setattr__(self, "head_tolerance_deg", tol)
+
+    @property
+    def uses_head(self):
+        return self.head_rotation_skull2cam is not None and self.head_tolerance_deg is not None
+
+
+def head_deviation_deg(R, R_prior):
+    """dbeta of SPEC 5: geodesic angle (degrees) of ``R @ R_prior.T``.
+
+    Parameters
+    ----------
+    R : array_like of shape (S, 3, 3)
+        Estimated head orientations (rotation of ``skull2cam``).
+    R_prior : array_like of shape (3, 3)
+
+    Returns
+    -------
+    dbeta_deg : ndarray of shape (S,)
+    """
+    return geodesic_angle_deg(np.asarray(R, dtype=float), np.asarray(R_prior, dtype=float))
+
+
+def _excess2(x, lo, hi):
+    return np.maximum(0.0, lo - x) ** 2 + np.maximum(0.0, x - hi) ** 2
+
+
+def camera_penalty(
+    focal_px,
+    scd_mm=None,
+    dbeta_deg=None,
+    success=None,
+    *,
+    focal_interval_px=None,
+    scd_interval_mm=None,
+    tolerance_deg=None,
+):
+    """P_cam of a population of cameras.
+
+    Parameters
+    ----------
+    focal_px : array_like of shape (S,)
+        Estimated focal lengths (pixels); NaN for a camera that does not exist.
+    scd_mm : array_like of shape (S,), optional
+        Subject-to-camera distances (mm); needed when ``scd_interval_mm`` is given.
+    dbeta_deg : array_like of shape (S,), optional
+        Head orientation deviations (degrees, :func:`head_deviation_deg`); needed when
+        ``tolerance_deg`` is given.
+    success : array_like of shape (S,) of bool, optional
+        False where POSEST returned no solution. Default: all True.
+    focal_interval_px, scd_interval_mm : (float, float), optional
+        Admissible intervals; None switches the term off.
+    tolerance_deg : float, optional
+        Head orientation tolerance; None switches the head term off.
+
+    Returns
+    -------
+    p_cam : ndarray of shape (S,)
+
+    Examples
+    --------
+    >>> camera_penalty([1000.0, 1300.0, 0.0], focal_interval_px=(800, 1200)).tolist()
+    [0.0, 10000.0, 1000000640000.0]
+    """
+    f = np.atleast_1d(np.asarray(focal_px, dtype=float))
+    ok = np.ones(f.shape, bool) if success is None else np.asarray(success, dtype=bool)
+    if ok.shape != f.shape:
+        raise ValueError(f"success has shape {ok.shape}, focal_px has shape {f.shape}")
+    fail = ~ok | ~np.isfinite(f) | (f <= 0) | (f > FOCAL_MAX_PX)
+    terms = np.zeros(f.shape)
+
+    def add(x, name, penalty):
+        nonlocal fail, terms
+        if x is None:
+            raise ValueError(f"{name} is needed when its prior is given")
+        x = np.broadcast_to(np.asarray(x, dtype=float), f.shape)
+        value = penalty(x)
+        fail = fail | ~np.isfinite(x)
+        terms = terms + np.where(np.isfinite(value), value, 0.0)
+
+    lo_hi = _interval(focal_interval_px, "focal_interval_px", "pixels")
+    if lo_hi is not None:
+        add(f, "focal_px", lambda x: _excess2(x, *lo_hi))
+    scd_lo_hi = _interval(scd_interval_mm, "scd_interval_mm", "mm")
+    if scd_lo_hi is not None:
+        add(scd_mm, "scd_mm", lambda x: _excess2(x, *scd_lo_hi))
+    if tolerance_deg is not None:
+        tol = float(tolerance_deg)
+        add(dbeta_deg, "dbeta_deg", lambda x: np.maximum(0.0, x - tol) ** 2)
+    return np.where(fail, C_INF, 0.0) + terms
+
+
+def camera_penalty_from_priors(focal_px, scd_mm, R, success, priors):
+    """P_cam of a population given :class:`CameraPriors`.
+
+    Parameters
+    ----------
+    focal_px, scd_mm : array_like of shape (S,)
+    R : array_like of shape (S, 3, 3)
+        Head orientations (rotation of each ``skull2cam``); NaN where none.
+    success : array_like of shape (S,) of bool
+    priors : CameraPriors
+
+    Returns
+    -------
+    p_cam : ndarray of shape (S,)
+    """
+    dbeta = None
+    if priors.uses_head:
+        dbeta = head_deviation_deg(R, priors.head_rotation_skull2cam)
+    return camera_penalty(
+        focal_px,
+        scd_mm,
+        dbeta,
+        success,
+        focal_interval_px=priors.focal_px,
+        scd_interval_mm=priors.scd_mm,
+        tolerance_deg=priors.head_tolerance_deg if priors.uses_head else None,
+    )

@@ -1,0 +1,160 @@
+"""Lilium's image penalties for a population of cameras: P_skof and P_pll.
+
+Glue between an SFO case (skull, photo) and the pure fitness functions of :mod:`lilium.fitness`:
+each term is prepared once per SFO (regions, facial curve, mask index, mesh topology) and then
+evaluated for a whole population of cameras ``(R (S, 3, 3), t (S, 3), focal_px (S,))``.
+
+P_skof uses the skull decimated to :data:`SKOF_FACES` faces: projecting 50k faces for every
+individual dominates the run time, and the silhouette of a decimated skull differs from the full
+one by a fraction of a percent of its pixels (measured by ``benchmarks/bench_lilium.py``).
+"""
+
+import numpy as np
+
+from ..fitness.curves import face_curve_from_mask
+from ..fitness.pll import PllContext
+from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
+from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_batch
+
+#: Faces of the skull used for P_skof (decimated when larger).
+SKOF_FACES = 8000
+
+
+def project_population(points_mm, R, t, focal_px, principal_point_px):
+    """Project one point set under S cameras.
+
+    Parameters
+    ----------
+    points_mm : ndarray of shape (K, 3)
+    R : ndarray of shape (S, 3, 3)
+    t : ndarray of shape (S, 3)
+    focal_px : ndarray of shape (S,)
+    principal_point_px : ndarray of shape (2,)
+
+    Returns
+    -------
+    uv : ndarray of shape (S, K, 2)
+        NaN at or behind the camera.
+    """
+    X = points_mm @ np.swapaxes(R, 1, 2) + t[:, None, :]
+    z = X[..., 2:3]
+    behind = z <= 1e-6
+    uv = principal_point_px + focal_px[:, None, None] * X[..., :2] / np.where(behind, 1.0, z)
+    return np.where(behind, np.nan, uv)
+
+
+def decimated(vertices_mm, faces, target_faces):
+    """The mesh with at most about ``target_faces`` faces (quadric decimation)."""
+    if len(faces) <= target_faces:
+        return vertices_mm, faces
+    from ..ct.mesh import decimate
+
+    return decimate(vertices_mm, faces, target_faces)
+
+
+class SkofTerm:
+    """P_skof = 100 x (projected skull pixels outside the face mask), for a population.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+        Must have a face mask.
+    centre : ndarray of shape (2,)
+        Principal point (pixels).
+    target_faces : int
+    """
+
+    def __init__(self, skull, photo, centre, target_faces=SKOF_FACES):
+        if photo.face_mask is None:
+            raise ValueError(
+                f"photo {photo.id!r} has no face_mask.png; the skof variants need the face mask "
+                "(or use the base or pll variant)"
+            )
+        self.vertices_mm, faces = decimated(skull.vertices_mm, skull.faces, target_faces)
+        self.context = prepare_skof(faces, photo.face_mask)
+        self.centre = centre
+
+    def outside_pixels(self, R, t, focal_px):
+        """Skull pixels outside the face mask, ``(S,)`` int."""
+        uv = project_population(self.vertices_mm, R, t, focal_px, self.centre)
+        return skull_outside_pixels_batch(
+            uv, topology=self.context.topology, mask_index=self.context.mask_index
+        )
+
+    def __call__(self, R, t, focal_px):
+        return skof_penalty(self.outside_pixels(R, t, focal_px)).astype(float)
+
+
+class PllTerm:
+    """P_pll between the skull's and the face's chin-jaw (frontal) or forehead (lateral) curves.
+
+    The skull region is cut once per SFO (:mod:`lilium.fitness.regions`); the facial curve is the
+    photo's ``face_curve.json`` or, when absent, derived from the face mask and landmarks.
+
+    Raises
+    ------
+    ValueError
+        A landmark the region or the facial curve needs is missing, or neither a face curve
+        nor a mask is given.
+    """
+
+    def __init__(self, skull, photo, centre):
+        view = photo.view
+        lm = skull.landmarks_mm
+        need = (
+            ("infradentale", "mental_foramen_l", "mental_foramen_r")
+            if view == "frontal"
+            else ("glabella", "metopion")
+        )
+        missing = [n for n in need if n not in lm]
+        if missing:
+            raise ValueError(
+                f"skull {skull.id!r}: the pll variants need the cranial landmarks "
+                f"{', '.join(missing)} (in cranial_landmarks.json) to cut the "
+                f"{'chin-jaw' if view == 'frontal' else 'forehead'} region"
+            )
+        frame = anatomical_frame(lm)
+        if view == "frontal":
+            region = chin_jaw_region(skull.vertices_mm, skull.faces, lm, frame)
+        else:
+            region = forehead_region(skull.vertices_mm, skull.faces, lm, frame)
+        if photo.face_curve_uv is not None:
+            face_curve = photo.face_curve_uv
+        elif photo.face_mask is not None:
+            face_curve = face_curve_from_mask(photo.face_mask, view, photo.landmarks_uv)
+        else:
+            raise ValueError(
+                f"photo {photo.id!r} has neither face_curve.json nor face_mask.png; the pll "
+                "variants need one of them"
+            )
+        if len(face_curve) < 2:
+            raise ValueError(
+                f"photo {photo.id!r}: the facial {'chin-jaw' if view == 'frontal' else 'forehead'}"
+                " curve is empty; check face_mask.png and the landmarks, or give face_curve.json"
+            )
+        self.region_vertices_mm = skull.vertices_mm[region.vertex_index]
+        self.context = PllContext.build(
+            region.faces, face_curve, view, image_shape=photo.image_size_wh[::-1]
+        )
+        self.span_mm = None if view == "frontal" else np.array([lm["glabella"], lm["metopion"]])
+        self.centre = centre
+
+    def __call__(self, R, t, focal_px):
+        uv = project_population(self.region_vertices_mm, R, t, focal_px, self.centre)
+        span_v = None
+        if self.span_mm is not None:
+            span_v = project_population(self.span_mm, R, t, focal_px, self.centre)[..., 1]
+        return self.context.evaluate_batch(uv, span_v)
+
+    def curves(self, R, t, focal_px):
+        """Skull and face curves ``(K, 2)``, ``(M, 2)`` of one camera (for overlays)."""
+        uv = project_population(
+            self.region_vertices_mm, R[None], t[None], np.array([focal_px]), self.centre
+        )[0]
+        span_v = None
+        if self.span_mm is not None:
+            span_v = project_population(
+                self.span_mm, R[None], t[None], np.array([focal_px]), self.centre
+            )[0, :, 1]
+        return self.context.skull_curve(uv, span_v), self.context.face_curve

@@ -1,0 +1,187 @@
+"""P_pll: curve detection, refinement, pairing and the three terms, on hand-made cases."""
+
+import numpy as np
+import pytest
+
+from lilium.fitness.curves import (
+    detect_curve,
+    face_curve_from_mask,
+    join_fragments,
+    order_points,
+    refine_curve,
+)
+from lilium.fitness.pll import (
+    PLL_NO_CURVE,
+    PllContext,
+    convergence_penalty,
+    pair_curves,
+    pll_penalty,
+    trim_curves,
+)
+
+# A rectangle of pixel centres u = 11..30, v = 21..40.
+RECT_UV = np.array([[10.5, 20.5], [30.5, 20.5], [30.5, 40.5], [10.5, 40.5]])
+RECT = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def line(u, v):
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    return np.column_stack([u, np.broadcast_to(np.asarray(v, dtype=float), u.shape)])
+
+
+# --- detection -------------------------------------------------------------------------------
+
+
+def test_frontal_curve_is_the_lowest_pixel_of_every_column():
+    curve = detect_curve(RECT_UV, RECT, "frontal")
+    assert np.array_equal(curve, line(np.arange(11, 31), 40))
+
+
+def test_lateral_curves_are_the_anterior_pixel_of_every_row_inside_the_span():
+    left = detect_curve(RECT_UV, RECT, "lateral_left", span_v=(30.2, 25))
+    assert np.array_equal(left, np.column_stack([np.full(6, 11.0), np.arange(25, 31)]))
+    right = detect_curve(RECT_UV, RECT, "lateral_right")
+    assert np.array_equal(right, np.column_stack([np.full(20, 30.0), np.arange(21, 41)]))
+
+
+def test_detection_drops_isolated_pixels_and_joins_steps():
+    # A right triangle whose hypotenuse drops 2 rows per column, plus a far sliver triangle
+    # that covers a single pixel centre (60, 60).
+    uv = np.array(
+        [[10.5, 10.5], [20.5, 10.5], [10.5, 30.5], [59.8, 59.8], [60.4, 59.8], [59.8, 60.4]]
+    )
+    faces = np.array([[0, 1, 2], [3, 4, 5]])
+    curve = detect_curve(uv, faces, "frontal")
+    assert curve[:, 0].max() < 60
+    steps = np.abs(np.diff(curve, axis=0)).max(axis=1)
+    assert np.all(steps == 1)  # 8-connected
+    # Hypotenuse v = 10.5 + 2 (20.5 - u): row 29 at u = 11, row 11 at u = 20.
+    assert curve[0].tolist() == [11.0, 29.0] and curve[-1].tolist() == [20.0, 11.0]
+
+
+def test_join_fragments_inserts_straight_segments():
+    joined = join_fragments([[0, 0], [3, 0], [3, 0], [5, 2]])
+    assert joined.tolist() == [[0, 0], [1, 0], [2, 0], [3, 0], [4, 1], [5, 2]]
+
+
+def test_refine_orders_and_orients_a_shuffled_curve():
+    pts = line(np.arange(20), 5)[np.random.default_rng(0).permutation(20)]
+    assert np.array_equal(order_points(pts)[:, 0], np.arange(20)) or np.array_equal(
+        order_points(pts)[:, 0], np.arange(20)[::-1]
+    )
+    refined = refine_curve(pts, "frontal", ordered=False)
+    assert np.array_equal(refined, line(np.arange(20), 5))
+    assert np.array_equal(refine_curve(line([9, 0], 5), "frontal"), line(np.arange(10), 5))
+
+
+def test_face_curve_from_mask():
+    mask = np.zeros((60, 60), bool)
+    mask[10:46, 5:37] = True  # last face row 45, columns 5..36
+    curve = face_curve_from_mask(mask, "frontal", {"cheilion_l": (30.4, 25), "cheilion_r": (8, 26)})
+    assert np.array_equal(curve, line(np.arange(8, 31), 45))
+    lat = face_curve_from_mask(mask, "lateral_left", {"glabella": (0, 30), "metopion": (0, 20)})
+    assert np.array_equal(lat, np.column_stack([np.full(11, 5.0), np.arange(20, 31)]))
+    lat = face_curve_from_mask(mask, "lateral_right", {"glabella": (0, 30), "metopion": (0, 20)})
+    assert np.all(lat[:, 0] == 36)
+    with pytest.raises(ValueError, match="needs the landmarks"):
+        face_curve_from_mask(mask, "frontal", {"cheilion_l": (1, 1)})
+    with pytest.raises(ValueError, match="view must be one of"):
+        face_curve_from_mask(mask, "oblique", {})
+
+
+# --- terms -----------------------------------------------------------------------------------
+
+
+def test_parallel_curves_have_zero_penalty():
+    terms = pll_penalty(line(np.arange(10), 100), line(np.arange(10), 105), "frontal")
+    assert (terms.delta_d, terms.p_conv, terms.p_int, terms.total) == (0, 0, 0, 0)
+    assert terms.n_pairs == 10 and terms
+
+
+def test_parallel_curves_of_different_lengths_are_trimmed_to_zero():
+    terms = pll_penalty(line(np.arange(10, 30), 100), line(np.arange(0, 40), 106), "frontal")
+    assert terms.total == 0.0
+
+
+def test_crossing_curves_count_every_violating_pair():
+    skull = line(np.arange(10), 100)
+    face = np.vstack([line(np.arange(5), 105), line(np.arange(5, 10), 95)])
+    terms = pll_penalty(skull, face, "frontal", trim=False)
+    assert terms.p_int == 5000.0  # u = 5..9: s.v = 100 >= p.v = 95
+    assert terms.delta_d == 0.0 and terms.p_conv == 0.0 and terms.total == 5000.0
+
+
+def test_lateral_violations_depend_on_the_looking_direction():
+    skull = np.column_stack([[50.0, 52, 48], [10.0, 11, 12]])
+    face = np.column_stack([[45.0, 45, 45], [10.0, 11, 12]])
+    # lateral_left: face points to -u, the skin is at smaller u: s.u <= p.u is wrong.
+    assert pll_penalty(skull, face, "lateral_left", trim=False).p_int == 0.0
+    assert pll_penalty(skull, face, "lateral_right", trim=False).p_int == 3000.0
+    assert pll_penalty(skull - [10, 0], face, "lateral_left", trim=False).p_int == 3000.0
+
+
+def test_one_converging_end_costs_four_times_its_deviation():
+    skull = line([0, 10, 20, 30, 40], 100)
+    face = np.array([[0, 110], [10, 110], [20, 110], [30, 110], [40, 102.0]])
+    s, p, d = pair_curves(skull, face)
+    assert np.allclose(d, [10, 10, 10, 10, 2])
+    terms = pll_penalty(skull, face, "frontal", trim=False)
+    # mean 8.4: delta_1 = 1.6 <= 2.1, delta_N = 6.4 > 2.1
+    assert terms.p_conv == pytest.approx(4 * 6.4)
+    assert terms.delta_d == pytest.approx(8.0)
+    assert terms.total == pytest.approx(8.0 + 25.6)
+
+
+def test_convergence_formula():
+    assert convergence_penalty([1, 10, 10, 10, 1]) == pytest.approx(2 * (5.4 + 5.4))
+    assert convergence_penalty([1, 10, 10, 10, 10]) == pytest.approx(4 * 7.2)
+    assert convergence_penalty([5, 5, 5]) == 0.0
+    assert convergence_penalty([0, 0]) == 0.0
+
+
+def test_unpaired_face_points_are_paired_to_the_nearest_skull_point_in_curve_order():
+    skull = line([10, 11, 12], 100)
+    face = line([8, 9, 10, 11, 12, 13], 103)
+    s, p, d = pair_curves(skull, face)
+    assert p[:, 0].tolist() == [8, 9, 10, 11, 12, 13]
+    assert s[:, 0].tolist() == [10, 10, 10, 11, 12, 12]
+    assert d[0] == pytest.approx(np.hypot(2, 3))
+
+
+def test_trimming_uses_the_end_normals_of_the_other_curve():
+    skull = line(np.arange(10, 21), 100)
+    face = line(np.arange(0, 31), 110)
+    s, p = trim_curves(skull, face)
+    assert np.array_equal(s, skull)
+    assert p[0, 0] == 10 and p[-1, 0] == 20
+
+
+def test_empty_curve_fails_as_a_value():
+    terms = pll_penalty(np.zeros((0, 2)), line([1, 2], 3), "frontal")
+    assert not terms and terms.total == PLL_NO_CURVE and np.isnan(terms.delta_d)
+
+
+def test_context_end_to_end_on_a_projected_rectangle():
+    mask = np.zeros((60, 60), bool)
+    mask[15:46, 5:37] = True
+    face = face_curve_from_mask(mask, "frontal", {"cheilion_l": (8, 25), "cheilion_r": (33, 25)})
+    ctx = PllContext.build(RECT, face, "frontal", image_shape=mask.shape)
+    terms = ctx.evaluate(RECT_UV)
+    assert terms.total == 0.0 and terms.n_pairs == 20
+    # Push the skull 10 px down: it now lies below the chin: 20 violations, d = 5 everywhere.
+    terms = ctx.evaluate(RECT_UV + [0, 10])
+    assert terms.p_int == 20_000.0 and terms.delta_d == 0.0
+    assert ctx.evaluate_batch(np.stack([RECT_UV, RECT_UV + [0, 10]])).tolist() == [0.0, 20_000.0]
+
+
+def test_context_end_to_end_lateral_left_with_span():
+    mask = np.zeros((60, 60), bool)
+    mask[10:50, 5:37] = True  # anterior (smallest u) face column: 5
+    span = {"glabella": (20, 36), "metopion": (20, 24)}
+    face = face_curve_from_mask(mask, "lateral_left", span)
+    ctx = PllContext.build(RECT, face, "lateral_left", image_shape=mask.shape)
+    terms = ctx.evaluate(RECT_UV, span_v=(24, 36))
+    assert terms.total == 0.0 and terms.n_pairs == 13  # rows 24..36, 6 px apart
+    # Skull pushed 8 px anterior (to -u): it pokes out of the forehead by 2 px everywhere.
+    terms = ctx.evaluate(RECT_UV - [8, 0], span_v=(24, 36))
+    assert terms.p_int == 13_000.0 and terms.delta_d == 0.0
