@@ -11,7 +11,12 @@ import sys
 from .. import __version__
 
 #: Sub-command modules, in the order ``lilium --help`` lists them.
-COMMANDS = ["lilium.cli.sfo", "lilium.cli.demo", "lilium.cli.import_ct"]
+COMMANDS = [
+    "lilium.cli.sfo",
+    "lilium.cli.demo",
+    "lilium.cli.case",
+    "lilium.cli.import_ct",
+]
 
 
 def build_parser():

@@ -95,11 +95,42 @@ def read_skull(folder, axes_path=None):
         "skull mesh",
         "put the skull mesh (millimetres) there",
     )
-    vertices, faces = read_mesh(mesh_path)
     lm_path = folder / "cranial_landmarks.json"
-    landmarks = parse_points(
-        lm_path, "landmarks", _field(lm_path, read_json(lm_path), "landmarks"), CRANIAL_NAMES, 3
-    )
+    if not lm_path.is_file():
+        from .formats import find_landmark_file
+
+        # A Slicer / MeshLab / CSV file instead (cranial_landmarks.csv, skull.mrk.json, ...).
+        lm_path = find_landmark_file(folder, ["cranial_landmarks", "skull"]) or lm_path
+    axes_path = axes_path or folder / "soft_tissue_axes.json"
+    return skull_from_files(mesh_path, lm_path, axes_path, skull_id=folder.name)
+
+
+def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
+    """A :class:`Skull` from a mesh file and a landmark file of any supported format.
+
+    Parameters
+    ----------
+    mesh_path : str or Path
+        PLY, OBJ or STL (millimetres).
+    landmarks_path : str or Path
+        ``cranial_landmarks.json`` (SPEC section 8), or any file
+        :func:`lilium.io.formats.read_landmarks` reads (3D Slicer, MeshLab, CSV, JSON; aliases).
+    axes_path : str or Path, optional
+        ``soft_tissue_axes.json``; absent axes default to the outward skull-surface normal.
+    skull_id : str, optional
+        Defaults to the mesh's folder name for ``skull.*`` and to the mesh's stem otherwise.
+    """
+    mesh_path, lm_path = Path(mesh_path), Path(landmarks_path)
+    if skull_id is None:
+        skull_id = mesh_path.parent.name if mesh_path.stem == "skull" else mesh_path.stem
+    vertices, faces = read_mesh(mesh_path)
+    if lm_path.name == "cranial_landmarks.json" or not lm_path.is_file():
+        raw = _field(lm_path, read_json(lm_path), "landmarks")
+        landmarks = parse_points(lm_path, "landmarks", raw, CRANIAL_NAMES, 3)
+    else:
+        from .formats import read_landmarks
+
+        landmarks = read_landmarks(lm_path, "cranial")
     extent = np.ptp(vertices, axis=0).max()
     for name, p in landmarks.items():
         gap = np.min(np.linalg.norm(vertices - p, axis=1))
@@ -109,8 +140,8 @@ def read_skull(folder, axes_path=None):
                 "must be in the mesh's frame and units"
             )
     axes = {}
-    axes_path = Path(axes_path) if axes_path else folder / "soft_tissue_axes.json"
-    if axes_path.is_file():
+    axes_path = Path(axes_path) if axes_path else None
+    if axes_path is not None and axes_path.is_file():
         raw = _field(axes_path, read_json(axes_path), "axes")
         for name, a in parse_points(axes_path, "axes", raw, CRANIAL_NAMES, 3).items():
             norm = np.linalg.norm(a)
@@ -121,7 +152,7 @@ def read_skull(folder, axes_path=None):
     if missing:
         normals = surface_normals_at(vertices, faces, np.array([landmarks[n] for n in missing]))
         axes.update(zip(missing, normals, strict=True))
-    return Skull(folder.name, vertices, faces, landmarks, axes)
+    return Skull(skull_id, vertices, faces, landmarks, axes)
 
 
 def _interval(path, priors, key):
@@ -210,16 +241,19 @@ def read_photo(folder, load_image=True):
     view = _field(meta_path, meta, "view")
     if view not in VIEWS:
         raise ValueError(f"{meta_path}: view must be one of {', '.join(VIEWS)}, got {view!r}")
-    landmarks = parse_points(
-        meta_path, "landmarks", _field(meta_path, meta, "landmarks"), FACIAL_NAMES, 2
-    )
-    w, h = size_wh
-    for name, (u, v) in landmarks.items():
-        if not (-0.5 <= u <= w - 0.5 and -0.5 <= v <= h - 0.5):
-            raise ValueError(
-                f"{meta_path}: landmarks.{name} = ({u:g}, {v:g}) lies outside the {w}x{h} image "
-                f"{image_path.name}; u is the column and v the row, in pixels"
-            )
+    lm_path = meta_path
+    if isinstance(meta, dict) and "landmarks" not in meta:
+        from .formats import find_landmark_file, read_landmarks
+
+        # Facial landmarks in a file of their own (facial_landmarks.csv, landmarks.json, ...).
+        lm_path = find_landmark_file(folder, ["facial_landmarks", "landmarks"]) or meta_path
+    if lm_path == meta_path:
+        landmarks = parse_points(
+            meta_path, "landmarks", _field(meta_path, meta, "landmarks"), FACIAL_NAMES, 2
+        )
+    else:
+        landmarks = read_landmarks(lm_path, "facial")
+    check_in_image(lm_path, landmarks, size_wh, image_path.name)
     priors = parse_priors(meta_path, meta.get("priors"))
     mask_path = folder / "face_mask.png"
     mask = read_mask(mask_path, size_wh) if mask_path.is_file() else None
@@ -240,6 +274,70 @@ def read_photo(folder, load_image=True):
         mask,
         curve,
         priors,
+        image if load_image else None,
+    )
+
+
+def check_in_image(path, landmarks_uv, image_size_wh, image_name):
+    """Raise a ``ValueError`` naming ``path`` when a landmark lies outside the image."""
+    w, h = image_size_wh
+    for name, (u, v) in landmarks_uv.items():
+        if not (-0.5 <= u <= w - 0.5 and -0.5 <= v <= h - 0.5):
+            raise ValueError(
+                f"{path}: landmarks.{name} = ({u:g}, {v:g}) lies outside the {w}x{h} image "
+                f"{image_name}; u is the column and v the row, in pixels"
+            )
+
+
+def photo_from_files(
+    image_path,
+    landmarks_path,
+    view="frontal",
+    mask_path=None,
+    priors=None,
+    photo_id=None,
+    load_image=True,
+):
+    """A :class:`Photo` from an image file and a facial landmark file of any supported format.
+
+    Parameters
+    ----------
+    image_path : str or Path
+        PNG or JPEG.
+    landmarks_path : str or Path
+        Facial landmarks (pixels, ``u`` = column, ``v`` = row): CSV ``name,u,v``, JSON
+        ``{"landmarks": {name: [u, v]}}`` or ``{name: [u, v]}``; aliases accepted.
+    view : {"frontal", "lateral_left", "lateral_right"}
+    mask_path : str or Path, optional
+        Face mask PNG (non-zero = face), the photo's size.
+    priors : Priors, optional
+    photo_id : str, optional
+        Defaults to the image's stem.
+    """
+    from .formats import read_landmarks
+
+    image_path = Path(image_path)
+    if not image_path.is_file():
+        raise ValueError(f"{image_path}: file not found; check the photo's path")
+    if view not in VIEWS:
+        raise ValueError(f"{image_path}: view must be one of {', '.join(VIEWS)}, got {view!r}")
+    image = read_image(image_path)
+    size_wh = (image.shape[1], image.shape[0])
+    landmarks = read_landmarks(landmarks_path, "facial")
+    check_in_image(landmarks_path, landmarks, size_wh, image_path.name)
+    mask = None
+    if mask_path is not None:
+        if not Path(mask_path).is_file():
+            raise ValueError(f"{mask_path}: file not found; check the face mask's path")
+        mask = read_mask(mask_path, size_wh)
+    return Photo(
+        photo_id or image_path.stem,
+        size_wh,
+        view,
+        landmarks,
+        mask,
+        None,
+        priors or Priors(),
         image if load_image else None,
     )
 

@@ -57,7 +57,7 @@ class LiliumOptions:
     variant: str = "skof+pll"
     de: DEOptions = field(default_factory=DEOptions)
     refine: RefineOptions = field(
-        default_factory=lambda: RefineOptions(max_iterations=20, cost_tol=1e-10)
+        default_factory=lambda: RefineOptions(max_iterations=10, cost_tol=1e-8, gradient_tol=1e-8)
     )
     posest: PosestOptions = field(default_factory=PosestOptions)
 
@@ -148,6 +148,14 @@ class LiliumProblem:
                 )
         return R, t, f, ok
 
+    def _initial_camera(self, facial_mm):
+        """Camera of the first member whose POSEST succeeds (a 1 m guess if none does)."""
+        for points in facial_mm:
+            pose = posest(self.corr.uv_px, points, self.centre, self.options.posest, rng=self.rng)
+            if pose:
+                return pose.skull2cam[:3, :3], pose.skull2cam[:3, 3], pose.focal_px
+        return np.eye(3), np.array([0.0, 0.0, 1000.0]), 1000.0
+
     def cameras(self, facial_mm, parents):
         """Cameras of a population: warm-started LM, POSEST where that fails.
 
@@ -157,13 +165,14 @@ class LiliumProblem:
         """
         S = len(facial_mm)
         if parents is None:
-            R0, t0, f0, ok = self._posest_each(facial_mm, range(S))
-            # Failed starts borrow a successful member's camera for the refinement below.
-            if ok.any():
-                j = np.flatnonzero(ok)[0]
-                R0[~ok], t0[~ok], f0[~ok] = R0[j], t0[j], f0[j]
-            else:
-                f0[:] = 1.0
+            # One POSEST, then every member refines from that camera (members it does not suit
+            # fall back to their own POSEST below).
+            R1, t1, f1 = self._initial_camera(facial_mm)
+            R0, t0, f0 = (
+                np.repeat(R1[None], S, axis=0),
+                np.repeat(t1[None], S, axis=0),
+                np.full(S, f1),
+            )
         else:
             R0, t0, f0 = self.R[parents], self.t[parents], self.focal[parents]
             # A member without a valid camera lends none: start from a valid member's.

@@ -1,0 +1,125 @@
+"""Lilium vs POSEST-SFO on generated Exp. C photos, positive pairs (a script, not a test).
+
+For every photo of a generated dataset's Exp. C (noisy landmarks, perturbed soft-tissue axes) it
+runs, on its own subject's skull, POSEST-SFO and each Lilium variant one after the other in this
+process (one core), and prints per method and view: the back-projection error (BPE, mm), the share
+of implausible overlays (any skull pixel outside the face mask), and the time per SFO.
+
+    python benchmarks/bench_lilium.py --subjects 4 --photos 2
+    python benchmarks/bench_lilium.py --dataset DIR   # reuse a dataset from `lilium synth`
+"""
+
+import argparse
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from lilium.evaluation.metrics import back_projection_error_from_dicts, implausible_sfo
+from lilium.fitness.skof import skull_raster
+from lilium.geometry.camera import project
+from lilium.io.case import read_photo, read_skull
+from lilium.io.jsonio import read_json
+from lilium.methods.lilium import VARIANTS, LiliumOptions, lilium_sfo
+from lilium.methods.posest_sfo import posest_sfo
+from lilium.optimisation import DEOptions
+
+
+def evaluate(result, skull, photo, truth, facial_truth):
+    """BPE (mm) and implausibility of one SFO result."""
+    if not result:
+        return np.nan, True, np.nan
+    bpe = back_projection_error_from_dicts(
+        facial_truth,
+        truth["landmarks_noise_free"],
+        result.skull2cam,
+        result.focal_px,
+        result.principal_point_px,
+    )
+    uv = project(skull.vertices_mm, result.skull2cam, result.focal_px, result.principal_point_px)
+    w, h = photo.image_size_wh
+    raster = skull_raster(uv, skull.faces, (h, w))
+    imp = implausible_sfo(raster, photo.face_mask)
+    return bpe, imp.outside_px > 0, imp.percent_outside
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--dataset", type=Path, help="existing dataset folder (default: generate)")
+    p.add_argument("--subjects", type=int, default=4)
+    p.add_argument("--photos", type=int, default=2, help="frontal (and lateral) photos each")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--axes-set", type=int, default=1, help="Exp. C perturbed axes set (1-5)")
+    p.add_argument("--variants", default=",".join(VARIANTS))
+    p.add_argument("--generations", type=int, default=DEOptions().max_generations)
+    p.add_argument("--population", type=int, default=DEOptions().population_size)
+    p.add_argument("--limit", type=int, help="use only the first N photos")
+    args = p.parse_args(argv)
+
+    root = args.dataset
+    if root is None:
+        from lilium.synthetic.dataset import generate_dataset
+
+        root = Path(tempfile.mkdtemp(prefix="lilium-bench-"))
+        t0 = time.perf_counter()
+        generate_dataset(root, args.subjects, args.photos, seed=args.seed, experiments=("C",))
+        print(f"dataset: {root} ({time.perf_counter() - t0:.0f} s to generate)")
+    index = read_json(root / "dataset.json")
+    photos = index["photos"][: args.limit] if args.limit else index["photos"]
+    variants = [v for v in args.variants.split(",") if v]
+    de = DEOptions(args.population, max_generations=args.generations)
+    rows = []
+    for k, entry in enumerate(photos):
+        photo_dir = root / entry["paths"]["C"]
+        truth = read_json(photo_dir / "photo.json")["ground_truth"]
+        subject_dir = root / "subjects" / entry["subject"]
+        skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{args.axes_set}.json")
+        photo = read_photo(photo_dir)
+        facial_truth = read_json(subject_dir / "facial_landmarks.json")["landmarks"]
+        runs = [("posest-sfo", lambda s=skull, p=photo: posest_sfo(s, p))]
+        runs += [
+            (
+                f"lilium {v}",
+                lambda v=v, s=skull, p=photo: lilium_sfo(s, p, LiliumOptions(v, de), seed=0),
+            )
+            for v in variants
+        ]
+        for name, run in runs:
+            t0 = time.perf_counter()
+            result = run()
+            seconds = time.perf_counter() - t0
+            bpe, implausible, pct = evaluate(result, skull, photo, truth, facial_truth)
+            rows.append((name, entry["view"].split("_")[0], bpe, implausible, pct, seconds))
+            print(
+                f"[{k + 1}/{len(photos)}] {entry['id']:>8} {name:<18} BPE {bpe:6.2f} mm  "
+                f"implausible {str(implausible):5}  {seconds:7.2f} s",
+                flush=True,
+            )
+
+    print(
+        f"\nExp. C positive pairs: {len(photos)} photos, DE population {de.population_size}, "
+        f"{de.max_generations} generations at most, axes set C{args.axes_set}"
+    )
+    print(
+        f"{'method':<18} {'view':<8} {'n':>3} {'BPE mean':>9} {'BPE med':>8} "
+        f"{'implaus %':>9} {'s/SFO med':>9} {'s/SFO mean':>10}"
+    )
+    for name in dict.fromkeys(r[0] for r in rows):
+        for view in ("frontal", "lateral"):
+            sel = [r for r in rows if r[0] == name and r[1] == view]
+            if not sel:
+                continue
+            bpe = [r[2] for r in sel]
+            sec = [r[5] for r in sel]
+            print(
+                f"{name:<18} {view:<8} {len(sel):>3} {np.nanmean(bpe):9.3f} "
+                f"{np.nanmedian(bpe):8.3f} {100 * np.mean([r[3] for r in sel]):9.1f} "
+                f"{statistics.median(sec):9.3f} {np.mean(sec):10.3f}"
+            )
+    return rows
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,513 @@
+"""Landmark files users already have, converted to the canonical names of SPEC section 2.
+
+Readers
+-------
+- 3D Slicer markups: ``.mrk.json`` (schema v1) and ``.fcsv`` (Markups fiducial CSV);
+- MeshLab picked points: ``.pp`` (XML);
+- CSV: ``name,x,y,z`` (cranial, mm) or ``name,u,v`` (facial, pixels), with or without a header
+  (a header may name the columns ``name``/``label``/``landmark`` and ``x,y,z`` or ``u,v``);
+  ``,``, ``;`` or tab separated;
+- JSON: the SPEC format ``{"landmarks": {name: coords}}``, a flat ``{name: coords}``, or a
+  Slicer markups document.
+
+Names
+-----
+Names are matched case-, space- and hyphen-insensitively against the aliases common in the
+craniometric and anthropometric literature (``n``, ``Nasion``, ``N`` -> ``nasion``; ``gn`` ->
+``gnathion``; ``A point`` -> ``subspinale`` ...). The cranial (bone) and facial (skin) sets have
+separate alias tables: ``sn`` is the facial subnasale, ``ss`` the cranial subspinale; a facial
+prime (``pg'``) or a ``soft tissue`` prefix is accepted only in the facial set.
+
+Sides are the *subject's* left and right, written as a suffix or prefix in any of these forms:
+``ex_l``, ``exL``, ``ex l``, ``ex(L)``, ``ex left``, ``l_ex``, ``Left ex``, ``R. Zygion``.
+A bilateral landmark without a side is an error (the side cannot be guessed).
+
+Slicer coordinate systems: markups stored in RAS are converted to LPS (Slicer's file default,
+also the frame Slicer writes meshes in) unless told otherwise; see :func:`read_landmarks`.
+"""
+
+import csv
+import difflib
+import json
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from ..softtissue.landmarks import CRANIAL_NAMES, FACIAL_NAMES, base_name, side
+
+KINDS = ("cranial", "facial")
+
+#: Suffixes :func:`read_landmarks` understands, longest first.
+LANDMARK_SUFFIXES = (".mrk.json", ".fcsv", ".pp", ".csv", ".tsv", ".txt", ".json")
+
+#: Aliases per base name (no side). Keys are normalised (lower case, ``_`` separators).
+CRANIAL_ALIASES = {
+    "glabella": ("g", "gl", "gla", "glab"),
+    "nasion": ("n", "na", "nas"),
+    "metopion": ("m", "met", "metop"),
+    "bregma": ("b", "br", "breg"),
+    "prosthion": ("pr", "pros", "sd", "supradentale", "upper_alveolare", "alveolare"),
+    "subspinale": ("ss", "a", "a_point", "point_a", "a_pt", "pt_a"),
+    "pogonion": ("pg", "pog", "pgn"),
+    "gnathion": ("gn", "gnath"),
+    "infradentale": ("id", "lower_alveolare"),
+    "ectoconchion": ("ec", "ek", "ecto", "ektoconchion"),
+    "dacryon": ("d", "da", "dac", "dacrion"),
+    "zygion": ("zy", "zyg"),
+    "gonion": ("go", "gon"),
+    "alare": ("al", "ala", "alare_point"),
+    "frontotemporale": ("ft", "fmt", "frontotemporal"),
+    "porion": ("po",),
+    "orbitale": ("or", "orb"),
+    "mental_foramen": ("mf", "mentale", "foramen_mentale", "mental", "mnf"),
+}
+
+#: Facial (skin) aliases; a prime or ``soft tissue`` prefix is stripped before the look-up.
+FACIAL_ALIASES = {
+    "glabella": ("g", "gl", "gla", "glab"),
+    "nasion": ("n", "na", "nas"),
+    "metopion": ("m", "met", "metop"),
+    "bregma": ("b", "br"),
+    "labiale_superius": (
+        "ls",
+        "lab_sup",
+        "labrale_superius",
+        "labiale_sup",
+        "upper_lip",
+        "ul",
+    ),
+    "subnasale": ("sn", "subn"),
+    "pogonion": ("pg", "pog"),
+    "gnathion": ("gn", "gnath", "menton_gnathion"),
+    "exocanthion": (
+        "ex",
+        "exo",
+        "ectocanthion",
+        "exocanthus",
+        "lateral_canthus",
+        "outer_canthus",
+        "outer_eye_corner",
+    ),
+    "endocanthion": (
+        "en",
+        "endo",
+        "entocanthion",
+        "endocanthus",
+        "medial_canthus",
+        "inner_canthus",
+        "inner_eye_corner",
+    ),
+    "zygion": ("zy", "zyg"),
+    "gonion": ("go", "gon"),
+    "alare": ("al", "ala"),
+    "frontotemporale": ("ft", "frontotemporal"),
+    "cheilion": ("ch", "mouth_corner", "stomion_laterale"),
+}
+
+_SIDE_WORDS = {"l": "l", "left": "l", "lt": "l", "r": "r", "right": "r", "rt": "r"}
+_PRIME = re.compile(r"['\u2019\u2032`]+")
+
+
+def _known(kind):
+    if kind == "cranial":
+        return CRANIAL_NAMES, CRANIAL_ALIASES
+    if kind == "facial":
+        return FACIAL_NAMES, FACIAL_ALIASES
+    raise ValueError(f"kind must be one of {', '.join(KINDS)}, got {kind!r}")
+
+
+def _alias_table(kind):
+    """Normalised alias -> canonical base name, for one landmark set."""
+    names, aliases = _known(kind)
+    table = {}
+    for name in names:
+        table[base_name(name)] = base_name(name)
+    for base, words in aliases.items():
+        for word in words:
+            table[word] = base
+    return table
+
+
+_TABLES = {kind: _alias_table(kind) for kind in KINDS}
+_SIDED = {kind: {base_name(n) for n in _known(kind)[0] if side(n)} for kind in KINDS}
+
+
+def normalise_name(name):
+    """Lower-case ``name`` with ``_`` between its words: ``"Zygion-L"`` -> ``"zygion_l"``.
+
+    CamelCase and a trailing capital side letter are split: ``"exR"`` -> ``"ex_r"``.
+    """
+    text = str(name).strip()
+    text = re.sub(r"([a-z])([A-Z])", r"\1_\2", text)
+    text = re.sub(r"[^0-9A-Za-z'\u2019\u2032`]+", "_", text).strip("_")
+    return text.lower()
+
+
+def _strip_facial_decorations(key):
+    key = _PRIME.sub("", key).strip("_")
+    for prefix in ("soft_tissue_", "softtissue_", "st_", "skin_"):
+        if key.startswith(prefix):
+            key = key[len(prefix) :]
+    return key
+
+
+def _side_splits(key):
+    """Candidate ``(base, side)`` readings of a normalised name, most explicit first."""
+    parts = key.split("_")
+    out = []
+    if len(parts) > 1 and parts[-1] in _SIDE_WORDS:
+        out.append(("_".join(parts[:-1]), _SIDE_WORDS[parts[-1]]))
+    if len(parts) > 1 and parts[0] in _SIDE_WORDS:
+        out.append(("_".join(parts[1:]), _SIDE_WORDS[parts[0]]))
+    # Glued single letter: "exl", "gor" (only when the rest is a known alias).
+    if len(key) > 1 and key[-1] in "lr":
+        out.append((key[:-1].rstrip("_"), key[-1]))
+    if len(key) > 1 and key[0] in "lr":
+        out.append((key[1:].lstrip("_"), key[0]))
+    return out
+
+
+def canonical_name(name, kind):
+    """The canonical name of a landmark written in any of the accepted ways, or None.
+
+    Parameters
+    ----------
+    name : str
+        As written in the user's file.
+    kind : {"cranial", "facial"}
+
+    Returns
+    -------
+    str or None
+        ``None`` when the name is not recognised; :func:`name_error` explains why.
+
+    Examples
+    --------
+    >>> canonical_name("ExR", "facial")
+    'exocanthion_r'
+    >>> canonical_name("A point", "cranial")
+    'subspinale'
+    """
+    table, sided = _TABLES[kind], _SIDED[kind]
+    key = normalise_name(name)
+    if kind == "facial":
+        key = _strip_facial_decorations(key)
+    if key in table and table[key] not in sided:
+        return table[key]
+    if key in table:  # a bilateral name written without its side
+        return None
+    for base, s in _side_splits(key):
+        if kind == "facial":
+            base = _strip_facial_decorations(base)
+        if base in table and table[base] in sided:
+            return f"{table[base]}_{s}"
+    return None
+
+
+def name_error(path, field, name, kind):
+    """The ``ValueError`` for a name :func:`canonical_name` does not recognise."""
+    names, _ = _known(kind)
+    other = "facial" if kind == "cranial" else "cranial"
+    table, key = _TABLES[kind], normalise_name(name)
+    if kind == "facial":
+        key = _strip_facial_decorations(key)
+    if key in table:
+        base = table[key]
+        return ValueError(
+            f"{path}: {field}: landmark {name!r} ({base}) needs a side; write {base}_l or "
+            f"{base}_r (the subject's left or right)"
+        )
+    elsewhere = canonical_name(name, other)
+    if elsewhere is not None:
+        return ValueError(
+            f"{path}: {field}: {name!r} is a {other} landmark ({elsewhere}) but this file holds "
+            f"{kind} landmarks; use the {kind} name (see SPEC section 2) or the other file"
+        )
+    choices = list(names) + list(table)
+    close = difflib.get_close_matches(key, choices, n=1, cutoff=0.6)
+    if close:
+        guess = close[0] if close[0] in names else table[close[0]]
+        hint = f"did you mean {guess!r}?"
+    else:
+        hint = f"use a {kind} name of SPEC section 2 (e.g. {names[0]!r})"
+    return ValueError(f"{path}: {field}: unknown {kind} landmark {name!r}; {hint}")
+
+
+def canonical_points(path, entries, kind, dim):
+    """Validate and rename ``(name, coords, where)`` entries read from a file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file, for messages.
+    entries : iterable of (str, sequence, str)
+        Name as written, coordinates, and where in the file it was (e.g. ``"line 3"``).
+    kind : {"cranial", "facial"}
+    dim : int
+        3 (mm) or 2 (pixels).
+
+    Returns
+    -------
+    dict of str -> ndarray of shape (dim,)
+        Keyed by canonical name.
+    """
+    out, origin = {}, {}
+    for name, coords, where in entries:
+        canonical = canonical_name(name, kind)
+        if canonical is None:
+            raise name_error(path, where, name, kind)
+        try:
+            point = np.asarray(coords, dtype=float)
+        except (TypeError, ValueError):
+            point = np.empty(0)
+        if point.shape != (dim,):
+            raise ValueError(
+                f"{path}: {where}: {name!r} must have {dim} numeric coordinates, got {coords!r}"
+            )
+        if not np.all(np.isfinite(point)):
+            raise ValueError(
+                f"{path}: {where}: {name!r} has NaN or infinite coordinates; give its "
+                "coordinates or remove it"
+            )
+        if canonical in out:
+            raise ValueError(
+                f"{path}: {where}: {name!r} and {origin[canonical]!r} are both {canonical}; "
+                "keep one of them"
+            )
+        out[canonical], origin[canonical] = point, name
+    if not out:
+        raise ValueError(f"{path}: no landmarks found; place landmarks and save the file again")
+    return out
+
+
+def landmark_format(path):
+    """The format of a landmark file from its name: ``mrk.json``, ``fcsv``, ``pp``, ``csv``,
+    ``json``; ``ValueError`` for anything else."""
+    name = Path(path).name.lower()
+    for suffix in LANDMARK_SUFFIXES:
+        if name.endswith(suffix):
+            return {".tsv": "csv", ".txt": "csv"}.get(suffix, suffix[1:])
+    raise ValueError(
+        f"{path}: unknown landmark file type; use .mrk.json or .fcsv (3D Slicer), .pp (MeshLab), "
+        ".csv (name,x,y,z or name,u,v) or .json"
+    )
+
+
+def read_landmarks(path, kind, coordinate_system="LPS"):
+    """Read a landmark file of any supported format.
+
+    Parameters
+    ----------
+    path : str or Path
+    kind : {"cranial", "facial"}
+        Cranial files hold 3D points in the mesh's frame (mm), facial files 2D pixel points
+        ``(u = column, v = row)``.
+    coordinate_system : {"LPS", "RAS", None}
+        For 3D Slicer files only: the frame to return (Slicer writes meshes in LPS by default).
+        Points stored in the other one get x and y negated. ``None`` keeps them as stored.
+
+    Returns
+    -------
+    dict of str -> ndarray of shape (3,) or (2,)
+        Keyed by canonical name.
+
+    Raises
+    ------
+    ValueError
+        Missing or unreadable file, unknown or side-less landmark name (with the closest
+        known), non-numeric or NaN coordinates, duplicates, no landmarks at all.
+    """
+    _known(kind)
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{path}: file not found; check the landmark file's path")
+    fmt = landmark_format(path)
+    dim = 3 if kind == "cranial" else 2
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read the file ({exc}); save it as UTF-8 text") from exc
+    if fmt == "json":
+        data = _load_json(path, text)
+        if isinstance(data, dict) and "markups" in data:
+            entries, system = _slicer_json_entries(path, data)
+        else:
+            entries, system = _json_entries(path, data), None
+    elif fmt == "mrk.json":
+        entries, system = _slicer_json_entries(path, _load_json(path, text))
+    elif fmt == "fcsv":
+        entries, system = _fcsv_entries(path, text)
+    elif fmt == "pp":
+        entries, system = _pp_entries(path, text), None
+    else:
+        entries, system = _csv_entries(path, text, dim), None
+    points = canonical_points(path, entries, kind, dim)
+    if system and coordinate_system and system != coordinate_system and dim == 3:
+        points = {k: v * np.array([-1.0, -1.0, 1.0]) for k, v in points.items()}
+    return points
+
+
+def _load_json(path, text):
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not valid JSON ({exc}); fix the file's syntax") from exc
+
+
+def _json_entries(path, data):
+    if isinstance(data, dict) and "landmarks" in data:
+        data, prefix = data["landmarks"], "landmarks."
+    else:
+        prefix = ""
+    if not isinstance(data, dict):
+        raise ValueError(
+            f'{path}: expected {{"landmarks": {{name: [coords]}}}} or {{name: [coords]}}'
+        )
+    return [(name, value, f"{prefix}{name}") for name, value in data.items()]
+
+
+def _slicer_system(value):
+    """Slicer writes the frame as ``LPS``/``RAS`` or, in old files, ``0`` (RAS) / ``1`` (LPS)."""
+    value = str(value).strip().upper()
+    return {"0": "RAS", "1": "LPS", "RAS": "RAS", "LPS": "LPS"}.get(value)
+
+
+def _slicer_json_entries(path, data):
+    markups = data.get("markups") if isinstance(data, dict) else None
+    if not isinstance(markups, list) or not markups:
+        raise ValueError(f"{path}: no 'markups' list; export the markups from 3D Slicer again")
+    entries, system = [], None
+    for m, markup in enumerate(markups):
+        system = _slicer_system(markup.get("coordinateSystem", "LPS")) or system
+        units = markup.get("coordinateUnits", "mm")
+        if units not in ("mm", ["mm"]):
+            raise ValueError(
+                f"{path}: markups[{m}].coordinateUnits is {units!r}; save the points in mm"
+            )
+        for k, point in enumerate(markup.get("controlPoints") or []):
+            status = point.get("positionStatus", "defined")
+            if status != "defined" or "position" not in point:
+                continue  # an unplaced or skipped point
+            label = point.get("label") or point.get("id") or f"point {k + 1}"
+            entries.append((label, point["position"], f"markups[{m}].controlPoints[{k}]"))
+    return entries, system
+
+
+def _fcsv_entries(path, text):
+    system, columns, entries = "LPS", None, []
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            key, _, value = stripped.lstrip("#").partition("=")
+            if key.strip().lower() == "coordinatesystem":
+                system = _slicer_system(value) or system
+            elif key.strip().lower() == "columns":
+                columns = [c.strip().lower() for c in value.split(",")]
+            continue
+        row = next(csv.reader([line]))
+        cols = columns or ["id", "x", "y", "z"] + [""] * 7 + ["label"]
+        record = dict(zip(cols, row, strict=False))
+        if not {"x", "y", "z"} <= record.keys():
+            raise ValueError(f"{path}: line {number}: expected id,x,y,z,...,label columns")
+        label = record.get("label") or record.get("id") or f"point {number}"
+        entries.append((label, _numbers(record["x"], record["y"], record["z"]), f"line {number}"))
+    return entries, system
+
+
+def _pp_entries(path, text):
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise ValueError(
+            f"{path}: not a valid MeshLab .pp file ({exc}); save the picked points again"
+        ) from exc
+    entries = []
+    for k, point in enumerate(root.iter("point")):
+        if point.get("active", "1").strip() == "0":
+            continue  # unticked in MeshLab's picking dialogue
+        name = point.get("name") or f"point {k + 1}"
+        coords = _numbers(*(point.get(a, "") for a in "xyz"))
+        entries.append((name, coords, f"point {name!r}"))
+    return entries
+
+
+def _numbers(*values):
+    out = []
+    for value in values:
+        try:
+            out.append(float(str(value).strip()))
+        except ValueError:
+            return list(values)
+    return out
+
+
+def _is_number(text):
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+_NAME_COLUMNS = ("name", "label", "landmark", "id", "point")
+_COORD_COLUMNS = {3: (("x", "y", "z"),), 2: (("u", "v"), ("x", "y"), ("column", "row"))}
+
+
+def _csv_entries(path, text, dim):
+    lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
+    if not lines:
+        raise ValueError(f"{path}: no landmarks found; write one landmark per line")
+    delimiter = max(",;\t", key=lines[0].count)
+    rows = list(csv.reader(lines, delimiter=delimiter))
+    header = [c.strip().lower() for c in rows[0]]
+    name_col, coord_cols, start = 0, list(range(1, dim + 1)), 0
+    if len(header) > dim and not any(_is_number(c) for c in header):
+        start = 1
+        name_col = next((header.index(c) for c in _NAME_COLUMNS if c in header), 0)
+        for names in _COORD_COLUMNS[dim]:
+            if all(c in header for c in names):
+                coord_cols = [header.index(c) for c in names]
+                break
+        else:
+            want = " or ".join(",".join(n) for n in _COORD_COLUMNS[dim])
+            raise ValueError(f"{path}: header {rows[0]!r} has no {want} columns; name them so")
+    entries = []
+    for number, row in enumerate(rows[start:], start=start + 1):
+        if len(row) <= max(name_col, *coord_cols):
+            raise ValueError(
+                f"{path}: line {number}: expected a name and {dim} coordinates, got {row!r}"
+            )
+        coords = _numbers(*(row[c] for c in coord_cols))
+        entries.append((row[name_col].strip(), coords, f"line {number}"))
+    return entries
+
+
+def find_landmark_file(folder, stems):
+    """A landmark file in ``folder`` under one of ``stems`` (any supported suffix), or the only
+    Slicer/MeshLab file there; ``None`` when there is none.
+
+    Raises
+    ------
+    ValueError
+        Several candidate files and no way to tell which one is meant.
+    """
+    folder = Path(folder)
+    for stem in stems:
+        for suffix in LANDMARK_SUFFIXES:
+            if (folder / f"{stem}{suffix}").is_file():
+                return folder / f"{stem}{suffix}"
+    found = sorted(
+        p
+        for p in folder.iterdir()
+        if p.is_file() and p.name.lower().endswith((".mrk.json", ".fcsv", ".pp"))
+    )
+    if len(found) > 1:
+        raise ValueError(
+            f"{folder}: several landmark files ({', '.join(p.name for p in found)}); keep one or "
+            f"name it {stems[0]}.<suffix>"
+        )
+    return found[0] if found else None

@@ -1,0 +1,210 @@
+"""``lilium case``: folders or plain files in, per-photo results and one HTML report out; every
+bad input a one-line error naming the file, the field and the fix."""
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+from PIL import Image
+from PIL.TiffImagePlugin import IFDRational
+
+from lilium.cli.main import main
+from lilium.io.mesh import write_mesh
+
+#: Literature-style names for the plain-file case (canonical -> as a user might write it).
+FACIAL_ALIASES = {"nasion": "n", "exocanthion_l": "exL", "exocanthion_r": "ex_r", "subnasale": "sn"}
+CRANIAL_ALIASES = {"nasion": "N", "ectoconchion_l": "ec_l", "subspinale": "A point"}
+
+
+@pytest.fixture
+def files(case, tmp_path):
+    """The stand-in case as the files a practitioner has: mesh, Slicer .fcsv, image, CSV, mask."""
+    subject_dir, photo_dir = case
+    folder = tmp_path / "files"
+    folder.mkdir()
+    shutil.copy(subject_dir / "skull.ply", folder / "skull.ply")
+    cranial = json.loads((subject_dir / "cranial_landmarks.json").read_text())["landmarks"]
+    lines = ["# Markups fiducial file version = 4.11", "# CoordinateSystem = LPS"]
+    for k, (name, (x, y, z)) in enumerate(cranial.items()):
+        label = CRANIAL_ALIASES.get(name, name)
+        lines.append(f"vtkMRMLMarkupsFiducialNode_{k},{x},{y},{z},0,0,0,1,1,1,0,{label},,")
+    (folder / "skull.fcsv").write_text("\n".join(lines) + "\n")
+    meta = json.loads((photo_dir / "photo.json").read_text())
+    rows = [f"{FACIAL_ALIASES.get(n, n)},{u},{v}" for n, (u, v) in meta["landmarks"].items()]
+    (folder / "front.csv").write_text("name,u,v\n" + "\n".join(rows) + "\n")
+    shutil.copy(photo_dir / "image.png", folder / "front.png")
+    shutil.copy(photo_dir / "face_mask.png", folder / "front_mask.png")
+    return folder
+
+
+def _run(argv, capsys):
+    code = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_folders_two_photos_one_report(case, tmp_path, capsys):
+    subject_dir, photo_dir = case
+    out = tmp_path / "out"
+    argv = ["case", "--skull", subject_dir, "--photo", photo_dir, "--photo", photo_dir]
+    code, stdout, err = _run(argv + ["--method", "posest-sfo", "--out", out], capsys)
+    assert code == 0, err
+    for photo_id in ("standin_frontal", "standin_frontal_2"):
+        result = json.loads((out / photo_id / "result.json").read_text())
+        assert result["method"] == "posest-sfo" and result["camera"]["focal_px"] > 0
+        assert (out / photo_id / "overlay.png").is_file()
+    text = (out / "report.html").read_text()
+    assert 'id="sfo-1"' in text and 'id="sfo-2"' in text and "standin_frontal_2" in text
+    assert "2470-2730 px (photo.json)" in text
+    assert "report:" in stdout
+
+
+def test_plain_files_with_aliases_and_both_methods(files, tmp_path, capsys):
+    out = tmp_path / "out"
+    argv = ["case", "--skull", files / "skull.ply", "--photo", files / "front.png"]
+    argv += ["--method", "posest-sfo", "--method", "lilium", "--variant", "base"]
+    argv += ["--generations", "3", "--population", "12", "--scd-mm", "800", "1000"]
+    code, _, err = _run(argv + ["--focal-px", "2400", "2800", "--out", out], capsys)
+    assert code == 0, err
+    posest = json.loads((out / "front" / "posest-sfo" / "result.json").read_text())
+    lilium = json.loads((out / "front" / "lilium-base" / "result.json").read_text())
+    assert (
+        "nasion" in posest["facial_landmarks_3d"] and "subnasale" in posest["facial_landmarks_3d"]
+    )
+    assert len(lilium["history"]) >= 1
+    text = (out / "report.html").read_text()
+    assert "skull.fcsv" in text and "front_mask.png" in text  # found next to mesh and image
+    assert "command line --focal-px" in text and "--scd-mm 800 1000" in text
+    assert 'class="fit"' in text  # Lilium's fitness curve
+
+
+def test_focal_prior_from_exif(files, tmp_path, capsys):
+    exif = Image.Exif()
+    exif.get_ifd(0x8769)[0xA405] = 90  # FocalLengthIn35mmFilm
+    exif.get_ifd(0x8769)[0x920A] = IFDRational(9.0)
+    Image.open(files / "front.png").save(files / "front.jpg", quality=95, exif=exif)
+    out = tmp_path / "out"
+    argv = ["case", "--skull", files / "skull.ply", "--landmarks", files / "skull.fcsv"]
+    argv += ["--photo", files / "front.jpg", "--photo-landmarks", files / "front.csv"]
+    code, _, err = _run(argv + ["--method", "posest-sfo", "--out", out], capsys)
+    assert code == 0, err
+    text = (out / "report.html").read_text()
+    assert "EXIF FocalLengthIn35mmFilm 90 mm" in text
+    code, _, _ = _run(argv + ["--method", "posest-sfo", "--no-exif", "--out", out], capsys)
+    assert "none (penalty off)" in (out / "report.html").read_text()
+
+
+def _one_line_error(capsys, argv, *needles):
+    code, _, err = _run(argv, capsys)
+    assert code == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+    return lines[0]
+
+
+def _argv(files, tmp_path, **change):
+    paths = {
+        "skull": files / "skull.ply",
+        "landmarks": files / "skull.fcsv",
+        "photo": files / "front.png",
+        "photo-landmarks": files / "front.csv",
+    }
+    paths.update(change)
+    argv = ["case", "--method", "posest-sfo", "--out", tmp_path / "out"]
+    for key, value in paths.items():
+        argv += [f"--{key}", value]
+    return argv
+
+
+def test_missing_files(files, tmp_path, capsys):
+    _one_line_error(
+        capsys, _argv(files, tmp_path, skull=files / "nope.ply"), "nope.ply", "--skull not found"
+    )
+    _one_line_error(
+        capsys,
+        _argv(files, tmp_path, **{"photo-landmarks": files / "gone.csv"}),
+        "gone.csv",
+        "file not found",
+    )
+    (files / "front.csv").rename(files / "elsewhere.csv")
+    argv = ["case", "--skull", files / "skull.ply", "--photo", files / "front.png"]
+    _one_line_error(
+        capsys, argv + ["--out", tmp_path], "front.png", "give it with --photo-landmarks"
+    )
+
+
+def test_unreadable_files(files, tmp_path, capsys):
+    (files / "front.csv").write_bytes(b"\xff\xfe\x00\x81binary")
+    _one_line_error(capsys, _argv(files, tmp_path), "front.csv", "cannot read", "UTF-8")
+    (files / "skull.ply").write_bytes(b"ply\nformat garbage\n")
+    _one_line_error(capsys, _argv(files, tmp_path), "skull.ply", "cannot read the mesh")
+
+
+def test_unknown_landmark_suggests_the_closest(files, tmp_path, capsys):
+    text = (files / "front.csv").read_text().replace("\nn,", "\nnasoin,")
+    (files / "front.csv").write_text(text)
+    _one_line_error(
+        capsys, _argv(files, tmp_path), "front.csv", "line", "'nasoin'", "did you mean 'nasion'"
+    )
+
+
+def test_nan_coordinates(files, tmp_path, capsys):
+    lines = (files / "skull.fcsv").read_text().splitlines()
+    fields = lines[2].split(",")
+    fields[2] = "nan"
+    lines[2] = ",".join(fields)
+    (files / "skull.fcsv").write_text("\n".join(lines))
+    _one_line_error(capsys, _argv(files, tmp_path), "skull.fcsv", "line 3", "NaN", "remove it")
+
+
+def test_too_few_usable_landmarks(files, tmp_path, capsys):
+    lines = (files / "front.csv").read_text().splitlines()
+    (files / "front.csv").write_text("\n".join(lines[:4]) + "\n")  # header + 3 landmarks
+    _one_line_error(
+        capsys, _argv(files, tmp_path), "front.csv", "only 3 usable landmark pairs", "at least 4"
+    )
+
+
+def test_degenerate_mesh(files, tmp_path, capsys):
+    v = np.array([[0, 0, 0], [100, 0, 0], [0, 100, 0], [100, 100, 0]], dtype=float)
+    write_mesh(files / "flat.ply", v, np.array([[0, 1, 2], [1, 3, 2]]))
+    _one_line_error(
+        capsys, _argv(files, tmp_path, skull=files / "flat.ply"), "flat.ply", "degenerate mesh"
+    )
+
+
+def test_empty_and_wrong_size_masks(files, tmp_path, capsys):
+    Image.new("L", (1200, 900), 0).save(files / "front_mask.png")
+    _one_line_error(capsys, _argv(files, tmp_path), "front_mask.png", "empty", "paint the face")
+    Image.new("L", (600, 450), 255).save(files / "front_mask.png")
+    _one_line_error(
+        capsys, _argv(files, tmp_path), "front_mask.png", "600x450", "make the mask the photo's"
+    )
+
+
+def test_landmark_off_the_image(files, tmp_path, capsys):
+    lines = (files / "front.csv").read_text().splitlines()
+    lines = ["n,5000,10" if ln.startswith("n,") else ln for ln in lines]
+    (files / "front.csv").write_text("\n".join(lines) + "\n")
+    _one_line_error(
+        capsys, _argv(files, tmp_path), "front.csv", "landmarks.nasion", "outside the 1200x900"
+    )
+
+
+def test_corrupt_image(files, tmp_path, capsys):
+    (files / "front.png").write_bytes(b"\x89PNG\r\n\x1a\n truncated")
+    _one_line_error(capsys, _argv(files, tmp_path), "front.png", "cannot read the image", "PNG")
+
+
+def test_command_line_mistakes(files, case, tmp_path, capsys):
+    _one_line_error(
+        capsys,
+        _argv(files, tmp_path) + ["--focal-px", "3000", "2000"],
+        "--focal-px must be LO HI with 0 < LO <= HI",
+    )
+    _, photo_dir = case
+    argv = _argv(files, tmp_path) + ["--photo", photo_dir, "--photo-landmarks", files / "x.csv"]
+    _one_line_error(capsys, argv, "--photo-landmarks given 2 times for 1 photo", "once per")

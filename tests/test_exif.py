@@ -1,0 +1,86 @@
+"""The focal prior from EXIF: FocalLength with the sensor size, or FocalLengthIn35mmFilm."""
+
+import numpy as np
+import pytest
+from PIL import Image
+from PIL.TiffImagePlugin import IFDRational
+
+from lilium.io.exif import focal_prior_from_exif, read_exif
+
+
+def _jpeg(path, size_wh=(600, 400), model=None, **exif_ifd):
+    exif = Image.Exif()
+    if model:
+        exif[0x0110] = model
+    tags = {
+        "focal_mm": 0x920A,
+        "plane_x": 0xA20E,
+        "plane_unit": 0xA210,
+        "pixel_x": 0xA002,
+        "pixel_y": 0xA003,
+        "f35": 0xA405,
+    }
+    ifd = exif.get_ifd(0x8769)
+    for key, value in exif_ifd.items():
+        ifd[tags[key]] = IFDRational(value) if isinstance(value, float) else value
+    Image.new("RGB", size_wh, (90, 90, 90)).save(path, exif=exif)
+    return path
+
+
+def test_focal_plane_resolution(tmp_path):
+    # 50 mm lens, 6000 px across a 36 mm sensor (mm units), image saved at 600 px (1/10).
+    path = _jpeg(
+        tmp_path / "a.jpg",
+        focal_mm=50.0,
+        plane_x=6000 / 36,
+        plane_unit=4,
+        pixel_x=6000,
+        pixel_y=4000,
+    )
+    prior = focal_prior_from_exif(path)
+    expected = 50 * 600 / 36
+    assert prior.estimate_px == pytest.approx(expected, rel=1e-3)
+    assert prior.focal_px == pytest.approx((0.95 * expected, 1.05 * expected), rel=1e-3)
+    assert "FocalPlaneXResolution" in prior.source
+
+
+def test_inch_units(tmp_path):
+    path = _jpeg(tmp_path / "a.jpg", focal_mm=35.0, plane_x=4000 / (23.5 / 25.4), plane_unit=2)
+    # No PixelXDimension: the stored image is taken as the original (4000 px / 23.5 mm).
+    assert focal_prior_from_exif(path).estimate_px == pytest.approx(35 * 4000 / 23.5, rel=1e-3)
+
+
+def test_sensor_width_given_and_from_the_table(tmp_path):
+    path = _jpeg(tmp_path / "a.jpg", model="Canon EOS 5D Mark IV", focal_mm=85.0)
+    assert focal_prior_from_exif(path).estimate_px == pytest.approx(85 * 600 / 36)
+    assert "built-in table" in focal_prior_from_exif(path).source
+    given = focal_prior_from_exif(path, sensor_width_mm=24.0)
+    assert given.estimate_px == pytest.approx(85 * 600 / 24)
+    with pytest.raises(ValueError, match="sensor width must be a positive number"):
+        focal_prior_from_exif(path, sensor_width_mm=-1)
+
+
+def test_35mm_equivalent_covers_both_conventions(tmp_path):
+    path = _jpeg(tmp_path / "a.jpg", size_wh=(400, 300), model="Phone X", focal_mm=4.2, f35=26)
+    prior = focal_prior_from_exif(path)
+    diagonal = 26 * 500 / np.hypot(36, 24)
+    width = 26 * 400 / 36
+    assert prior.focal_px[0] == pytest.approx(0.95 * min(diagonal, width))
+    assert prior.focal_px[1] == pytest.approx(1.05 * max(diagonal, width))
+    assert "FocalLengthIn35mmFilm 26" in prior.source
+
+
+def test_no_exif_gives_none(tmp_path):
+    path = tmp_path / "plain.png"
+    Image.new("RGB", (50, 40)).save(path)
+    assert focal_prior_from_exif(path) is None
+    assert read_exif(path) == {"image_size_wh": (50, 40)}
+    # A focal length alone (no sensor size, unknown camera) is not enough.
+    assert focal_prior_from_exif(_jpeg(tmp_path / "b.jpg", model="Unknown", focal_mm=50.0)) is None
+
+
+def test_corrupt_image(tmp_path):
+    path = tmp_path / "bad.jpg"
+    path.write_bytes(b"\xff\xd8 not a jpeg")
+    with pytest.raises(ValueError, match=r"bad.jpg: cannot read the image"):
+        focal_prior_from_exif(path)

@@ -1,0 +1,205 @@
+"""Landmark files users already have (Slicer, MeshLab, CSV, JSON) and literature aliases."""
+
+import json
+
+import numpy as np
+import pytest
+
+from lilium.io.case import read_skull
+from lilium.io.formats import canonical_name, find_landmark_file, read_landmarks
+
+POINTS = {"nasion": [1.0, 2.0, 3.0], "zygion_l": [4.0, 5.0, 6.0], "subspinale": [7, 8, 9.5]}
+
+
+@pytest.mark.parametrize(
+    ("written", "kind", "canonical"),
+    [
+        ("n", "cranial", "nasion"),
+        ("Nasion", "facial", "nasion"),
+        ("N", "cranial", "nasion"),
+        ("gn", "cranial", "gnathion"),
+        ("Pog", "cranial", "pogonion"),
+        ("pg'", "facial", "pogonion"),
+        ("soft tissue pogonion", "facial", "pogonion"),
+        ("g", "facial", "glabella"),
+        ("ex_l", "facial", "exocanthion_l"),
+        ("exR", "facial", "exocanthion_r"),
+        ("Ex (L)", "facial", "exocanthion_l"),
+        ("left ex", "facial", "exocanthion_l"),
+        ("R. Zygion", "cranial", "zygion_r"),
+        ("zy-right", "cranial", "zygion_r"),
+        ("ZygionL", "cranial", "zygion_l"),
+        ("GoR", "cranial", "gonion_r"),
+        ("al_l", "facial", "alare_l"),
+        ("ftR", "cranial", "frontotemporale_r"),
+        ("sn", "facial", "subnasale"),
+        ("ls", "facial", "labiale_superius"),
+        ("Labrale superius", "facial", "labiale_superius"),
+        ("ch_r", "facial", "cheilion_r"),
+        ("en l", "facial", "endocanthion_l"),
+        ("Lateral canthus R", "facial", "exocanthion_r"),
+        ("ec_l", "cranial", "ectoconchion_l"),
+        ("dR", "cranial", "dacryon_r"),
+        ("pr", "cranial", "prosthion"),
+        ("ss", "cranial", "subspinale"),
+        ("A point", "cranial", "subspinale"),
+        ("id", "cranial", "infradentale"),
+        ("PoL", "cranial", "porion_l"),
+        ("po_r", "cranial", "porion_r"),
+        ("Or-L", "cranial", "orbitale_l"),
+        ("mf r", "cranial", "mental_foramen_r"),
+        ("mental_foramen_l", "cranial", "mental_foramen_l"),
+        ("frontotemporale_l", "facial", "frontotemporale_l"),
+    ],
+)
+def test_aliases_map_to_canonical_names(written, kind, canonical):
+    assert canonical_name(written, kind) == canonical
+
+
+@pytest.mark.parametrize(
+    ("written", "kind"),
+    [
+        ("sn", "cranial"),  # subnasale is on the skin; the bone has subspinale
+        ("ss", "facial"),
+        ("ex_l", "cranial"),  # exocanthion is facial; the bone has ectoconchion
+        ("ec_l", "facial"),
+        ("pr", "facial"),
+        ("ls", "cranial"),
+        ("pg'", "cranial"),
+        ("zygion", "cranial"),  # no side
+        ("F-1", "cranial"),
+    ],
+)
+def test_names_are_per_set_and_sides_required(written, kind):
+    assert canonical_name(written, kind) is None
+
+
+def _write(path, text):
+    path.write_text(text)
+    return path
+
+
+def _check(points):
+    assert set(points) == set(POINTS)
+    for name, value in POINTS.items():
+        np.testing.assert_allclose(points[name], value)
+
+
+def test_slicer_mrk_json(tmp_path):
+    labels = {"nasion": "n", "zygion_l": "Zy_L", "subspinale": "A point"}
+    doc = {
+        "@schema": "https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadable/"
+        "Markups/Resources/Schema/markups-schema-v1.0.3.json#",
+        "markups": [
+            {
+                "type": "Fiducial",
+                "coordinateSystem": "LPS",
+                "coordinateUnits": "mm",
+                "controlPoints": [
+                    {"id": str(k), "label": labels[n], "position": p, "positionStatus": "defined"}
+                    for k, (n, p) in enumerate(POINTS.items())
+                ]
+                + [{"id": "9", "label": "gn", "positionStatus": "undefined"}],
+            }
+        ],
+    }
+    _check(read_landmarks(_write(tmp_path / "s.mrk.json", json.dumps(doc)), "cranial"))
+    # RAS points come back in LPS (Slicer's mesh frame): x and y negated.
+    doc["markups"][0]["coordinateSystem"] = "RAS"
+    ras = read_landmarks(_write(tmp_path / "ras.mrk.json", json.dumps(doc)), "cranial")
+    np.testing.assert_allclose(ras["nasion"], [-1, -2, 3])
+
+
+def test_slicer_fcsv(tmp_path):
+    lines = [
+        "# Markups fiducial file version = 4.11",
+        "# CoordinateSystem = LPS",
+        "# columns = id,x,y,z,ow,ox,oy,oz,vis,sel,lock,label,desc,associatedNodeID",
+    ]
+    for k, (name, (x, y, z)) in enumerate(POINTS.items()):
+        lines.append(f"vtkMRMLMarkupsFiducialNode_{k},{x},{y},{z},0,0,0,1,1,1,0,{name},,")
+    _check(read_landmarks(_write(tmp_path / "s.fcsv", "\n".join(lines)), "cranial"))
+
+
+def test_meshlab_pp(tmp_path):
+    names = {"nasion": "N", "zygion_l": "zyL", "subspinale": "ss"}
+    points = "".join(
+        f'<point x="{x}" y="{y}" z="{z}" active="1" name="{names[n]}"/>'
+        for n, (x, y, z) in POINTS.items()
+    )
+    text = (
+        "<!DOCTYPE PickedPoints><PickedPoints><DocumentData><DataFileName name='s.ply'/>"
+        f'</DocumentData>{points}<point x="0" y="0" z="0" active="0" name="gn"/></PickedPoints>'
+    )
+    _check(read_landmarks(_write(tmp_path / "s.pp", text), "cranial"))
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "name,x,y,z\nnasion,1,2,3\nzygion_l,4,5,6\nsubspinale,7,8,9.5\n",
+        "nasion,1,2,3\nZy L,4,5,6\nss,7,8,9.5\n",
+        "x;y;z;label\n1;2;3;N\n4;5;6;zygion_l\n7;8;9.5;subspinale\n",
+    ],
+)
+def test_csv(tmp_path, text):
+    _check(read_landmarks(_write(tmp_path / "s.csv", text), "cranial"))
+
+
+def test_facial_csv_and_json(tmp_path):
+    csv_points = read_landmarks(
+        _write(tmp_path / "f.csv", "name,u,v\nn,10,20\nexR,30,40\n"), "facial"
+    )
+    assert set(csv_points) == {"nasion", "exocanthion_r"}
+    np.testing.assert_allclose(csv_points["exocanthion_r"], [30, 40])
+    flat = read_landmarks(_write(tmp_path / "f.json", '{"sn": [1, 2], "ls": [3, 4]}'), "facial")
+    assert set(flat) == {"subnasale", "labiale_superius"}
+    spec = read_landmarks(
+        _write(tmp_path / "g.json", '{"landmarks": {"nasion": [1, 2, 3]}}'), "cranial"
+    )
+    np.testing.assert_allclose(spec["nasion"], [1, 2, 3])
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "match"),
+    [
+        ("a.csv", "nasoin,1,2,3\n", r"a.csv: line 1: unknown cranial landmark 'nasoin'; did you "),
+        ("a.csv", "zygion,1,2,3\n", r"'zygion' \(zygion\) needs a side; write zygion_l"),
+        ("a.csv", "sn,1,2,3\n", r"'sn' is a facial landmark \(subnasale\) but this file holds"),
+        ("a.csv", "nasion,1,nan,3\n", r"a.csv: line 1: 'nasion' has NaN"),
+        ("a.csv", "nasion,1,2\n", r"a.csv: line 1: expected a name and 3 coordinates"),
+        ("a.csv", "nasion,1,x,3\n", r"'nasion' must have 3 numeric coordinates"),
+        ("a.csv", "n,1,2,3\nnasion,1,2,3\n", r"'nasion' and 'n' are both nasion; keep one"),
+        ("a.csv", "", r"a.csv: no landmarks found"),
+        ("a.pp", "<PickedPoints><point", r"not a valid MeshLab .pp file"),
+        ("a.mrk.json", "{", r"not valid JSON"),
+        ("a.mrk.json", '{"markups": []}', r"no 'markups' list"),
+        ("a.xyz", "n 1 2 3", r"unknown landmark file type; use .mrk.json"),
+    ],
+)
+def test_bad_files_name_the_file_the_field_and_the_fix(tmp_path, name, text, match):
+    with pytest.raises(ValueError, match=match):
+        read_landmarks(_write(tmp_path / name, text), "cranial")
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(ValueError, match=r"nope.fcsv: file not found"):
+        read_landmarks(tmp_path / "nope.fcsv", "cranial")
+
+
+def test_subject_folder_with_a_slicer_file_instead_of_the_json(case):
+    subject_dir, _ = case
+    spec = json.loads((subject_dir / "cranial_landmarks.json").read_text())["landmarks"]
+    (subject_dir / "cranial_landmarks.json").unlink()
+    lines = ["# CoordinateSystem = LPS"]
+    lines += [
+        f"p{k},{x},{y},{z},0,0,0,1,1,1,0,{n},," for k, (n, (x, y, z)) in enumerate(spec.items())
+    ]
+    (subject_dir / "skull.fcsv").write_text("\n".join(lines))
+    assert find_landmark_file(subject_dir, ["cranial_landmarks", "skull"]).name == "skull.fcsv"
+    skull = read_skull(subject_dir)
+    assert set(skull.landmarks_mm) == set(spec)
+    (subject_dir / "other.pp").write_text("<PickedPoints/>")
+    (subject_dir / "skull.fcsv").rename(subject_dir / "mine.fcsv")
+    with pytest.raises(ValueError, match=r"several landmark files \(mine.fcsv, other.pp\)"):
+        read_skull(subject_dir)
