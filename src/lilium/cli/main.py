@@ -15,6 +15,7 @@ COMMANDS = [
     "lilium.cli.sfo",
     "lilium.cli.demo",
     "lilium.cli.case",
+    "lilium.cli.synth",
     "lilium.cli.import_ct",
 ]
 

@@ -1,0 +1,19 @@
+"""Evaluation of SFO results against synthetic ground truth (SPEC section 7)."""
+
+from .metrics import (
+    ImplausibleSFO,
+    back_projection_error,
+    back_projection_error_from_dicts,
+    back_projection_errors,
+    implausible_sfo,
+    rank_of_true,
+)
+
+__all__ = [
+    "ImplausibleSFO",
+    "back_projection_error",
+    "back_projection_error_from_dicts",
+    "back_projection_errors",
+    "implausible_sfo",
+    "rank_of_true",
+]

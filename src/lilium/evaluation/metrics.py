@@ -1,0 +1,162 @@
+"""Scores of the paper's evaluation protocol (SPEC section 7), as pure functions.
+
+- :func:`back_projection_error` (BPE, mm): for every ground-truth facial landmark ``F_i`` (visible
+  or not), the distance from ``F_i`` to the ray that the *estimated* camera back-projects through
+  the landmark's noise-free ground-truth image point; mean over the landmarks. The ground-truth
+  camera scores 0.
+- :func:`rank_of_true`: rank of the true skull among the scores of one photo against every skull
+  (1 = best, ties share the mean rank).
+- :func:`implausible_sfo`: skull pixels outside the face mask.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.camera import backproject_rays, point_ray_distance
+
+
+def back_projection_errors(facial_points_mm, uv_true, skull2cam, focal_px, principal_point_px):
+    """Per-landmark back-projection errors (mm).
+
+    Parameters
+    ----------
+    facial_points_mm : array_like of shape (N, 3)
+        Ground-truth 3D facial landmarks ``F_i`` (skull frame).
+    uv_true : array_like of shape (N, 2)
+        Their noise-free ground-truth image points (pixels).
+    skull2cam : array_like of shape (4, 4)
+        The *estimated* camera pose.
+    focal_px : float
+        The estimated focal length.
+    principal_point_px : array_like of shape (2,)
+
+    Returns
+    -------
+    errors_mm : ndarray of shape (N,)
+    """
+    points = np.asarray(facial_points_mm, dtype=float).reshape(-1, 3)
+    uv = np.asarray(uv_true, dtype=float).reshape(-1, 2)
+    if len(points) != len(uv):
+        raise ValueError(
+            f"facial_points_mm has {len(points)} points but uv_true {len(uv)}; "
+            "give one image point per 3D landmark, in the same order"
+        )
+    if not focal_px > 0:
+        raise ValueError(f"focal_px must be positive, got {focal_px}")
+    origin, directions = backproject_rays(uv, skull2cam, focal_px, principal_point_px)
+    return point_ray_distance(points, origin, directions)
+
+
+def back_projection_error(facial_points_mm, uv_true, skull2cam, focal_px, principal_point_px):
+    """BPE (mm): the mean of :func:`back_projection_errors` over all landmarks."""
+    errors = back_projection_errors(
+        facial_points_mm, uv_true, skull2cam, focal_px, principal_point_px
+    )
+    if len(errors) == 0:
+        raise ValueError("no landmarks: BPE needs at least one ground-truth facial landmark")
+    return float(np.mean(errors))
+
+
+def back_projection_error_from_dicts(
+    facial_landmarks_mm, landmarks_noise_free, skull2cam, focal_px, principal_point_px
+):
+    """BPE over the landmark names present in both dicts (``facial_landmarks.json`` and the
+    ``ground_truth.landmarks_noise_free`` of ``photo.json``)."""
+    names = sorted(set(facial_landmarks_mm) & set(landmarks_noise_free))
+    if not names:
+        raise ValueError("the 3D facial landmarks and the image points share no landmark name")
+    return back_projection_error(
+        [facial_landmarks_mm[n] for n in names],
+        [landmarks_noise_free[n] for n in names],
+        skull2cam,
+        focal_px,
+        principal_point_px,
+    )
+
+
+def rank_of_true(scores, true_index, lower_is_better=True):
+    """Rank of the true candidate among ``scores`` (1 = best; ties share the mean rank).
+
+    NaN scores (failed SFOs) count as worse than every finite score.
+
+    Parameters
+    ----------
+    scores : array_like of shape (K,)
+        One score per candidate skull.
+    true_index : int
+        Index of the true skull in ``scores``.
+    lower_is_better : bool
+        True for fitness / mean pixel error.
+
+    Returns
+    -------
+    rank : float
+        In ``[1, K]``; e.g. 1.5 when the true skull ties with one other for the best score.
+
+    Examples
+    --------
+    >>> rank_of_true([3.0, 1.0, 1.0, 5.0], 1)
+    1.5
+    """
+    s = np.asarray(scores, dtype=float).ravel()
+    if not 0 <= true_index < len(s):
+        raise ValueError(f"true_index {true_index} is outside the {len(s)} scores")
+    if not lower_is_better:
+        s = -s
+    s = np.where(np.isnan(s), np.inf, s)
+    target = s[true_index]
+    better = np.count_nonzero(s < target)
+    tied = np.count_nonzero(s == target)  # includes the true one
+    return better + (tied + 1) / 2.0
+
+
+@dataclass(frozen=True)
+class ImplausibleSFO:
+    """Skull pixels outside the face mask.
+
+    Attributes
+    ----------
+    outside_px : int
+        ``|S \\ F|``.
+    skull_px : int
+        ``|S|``.
+    percent_outside : float
+        ``100 |S \\ F| / |S|`` (0 for an empty skull raster).
+    """
+
+    outside_px: int
+    skull_px: int
+    percent_outside: float
+
+    @property
+    def implausible(self):
+        """Any skull pixel outside the face mask."""
+        return self.outside_px > 0
+
+
+def implausible_sfo(skull_mask, face_mask):
+    """Count the projected-skull pixels that fall outside the face mask.
+
+    Parameters
+    ----------
+    skull_mask : array_like of shape (H, W)
+        Non-zero where the projected skull covers the pixel (the union of its triangles).
+    face_mask : array_like of shape (H, W)
+        Non-zero = face/head pixels.
+
+    Returns
+    -------
+    ImplausibleSFO
+    """
+    s = np.asarray(skull_mask) != 0
+    f = np.asarray(face_mask) != 0
+    if s.shape != f.shape:
+        raise ValueError(
+            f"skull_mask {s.shape} and face_mask {f.shape} differ in shape; rasterise the skull "
+            "at the photo's resolution"
+        )
+    skull_px = int(np.count_nonzero(s))
+    outside_px = int(np.count_nonzero(s & ~f))
+    percent = 100.0 * outside_px / skull_px if skull_px else 0.0
+    return ImplausibleSFO(outside_px, skull_px, percent)

@@ -1,0 +1,269 @@
+"""Generate a synthetic evaluation dataset on disk (SPEC sections 7 and 8).
+
+Layout under ``out_dir``::
+
+    dataset.json                      index (subjects, photos, ranges, noise, seed)
+    subjects/<sid>/                   the subject folder (``subjects.write_subject``)
+    subjects/<sid>/axes_C<k>.json     k = 1..5: perturbed soft-tissue axes of profile C,
+                                      ``{"axes": {...}}`` like soft_tissue_axes.json
+    photos/<exp>/<pid>/               exp in A, B, C; pid = <sid>_f<kk> (frontal) or <sid>_l<kk>
+        image.png, face_mask.png      rendered once per pid (the mask as a 1-bit PNG); B/C hold
+                                      hard links to A's files
+                                      (copies where links are not possible)
+        photo.json, face_curve.json
+
+Every subject ``k`` draws from its own child of ``np.random.SeedSequence(seed)``, so the output
+does not depend on the number of worker processes or their scheduling. The photos of experiments
+A, B and C share their camera and render; B and C share their noisy landmarks too (C differs from
+B only in the soft-tissue axes given to the methods, listed in ``photo.json`` as
+``"soft_tissue_axes_sets"``, file names relative to the *tested* skull's subject folder).
+"""
+
+import os
+import shutil
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ..io.jsonio import write_json
+from . import noise as _noise
+from . import photos as _photos
+
+#: PNG compression level (0-9): 1 is several times faster than the default for these renders.
+PNG_COMPRESSION = 1
+
+
+def subject_ids(n_subjects):
+    """``["s01", "s02", ...]`` (at least two digits)."""
+    width = max(2, len(str(n_subjects)))
+    return [f"s{k + 1:0{width}d}" for k in range(n_subjects)]
+
+
+def photo_id(subject_id, view, k):
+    """``<sid>_f<kk>`` for frontal photos, ``<sid>_l<kk>`` for lateral ones."""
+    return f"{subject_id}_{'f' if view == 'frontal' else 'l'}{k:02d}"
+
+
+def write_png(path, image, bilevel=False):
+    """Write an RGB ``(H, W, 3)`` or grey ``(H, W)`` uint8 image as PNG.
+
+    ``bilevel=True`` writes a 1-bit PNG (non-zero -> 255 when read back), about ten times faster
+    than 8-bit for masks.
+    """
+    image = np.asarray(image)
+    if image.ndim == 3:
+        image = image[..., ::-1]  # RGB -> BGR for OpenCV
+    params = [cv2.IMWRITE_PNG_COMPRESSION, PNG_COMPRESSION]
+    if bilevel:
+        params += [cv2.IMWRITE_PNG_BILEVEL, 1]
+    if not cv2.imwrite(str(path), image, params):
+        raise ValueError(f"{path}: could not write the PNG")
+
+
+def _link_or_copy(src, dst):
+    dst = Path(dst)
+    if dst.exists():
+        dst.unlink()
+    try:
+        os.link(src, dst)
+    except OSError:
+        shutil.copyfile(src, dst)
+
+
+def write_photo_folders(photos_root, pid, subject_id, photo, experiments, noisy_uv, axes_files):
+    """Write one photo's folders, one per experiment; returns ``{exp: relative path}``."""
+    photos_root = Path(photos_root)
+    first = None
+    paths = {}
+    curve = {k: np.asarray(v).tolist() for k, v in photo.face_curve.items()}
+    for exp in experiments:
+        folder = photos_root / exp / pid
+        folder.mkdir(parents=True, exist_ok=True)
+        if first is None:
+            write_png(folder / "image.png", photo.image)
+            write_png(
+                folder / "face_mask.png", photo.face_mask.astype(np.uint8) * 255, bilevel=True
+            )
+            first = folder
+        else:
+            _link_or_copy(first / "image.png", folder / "image.png")
+            _link_or_copy(first / "face_mask.png", folder / "face_mask.png")
+        extra = {"soft_tissue_axes_sets": list(axes_files)} if exp == "C" else None
+        record = _photos.photo_record(
+            photo,
+            subject_id,
+            noise=exp,
+            landmarks_uv=None if exp == "A" else noisy_uv,
+            extra=extra,
+        )
+        write_json(folder / "photo.json", record)
+        if curve:
+            write_json(folder / "face_curve.json", curve)
+        paths[exp] = f"photos/{exp}/{pid}"
+    return paths
+
+
+def _default_subject_api():
+    # Imported lazily: the procedural generator is a separate module.
+    from .subjects import make_subject, write_subject
+
+    return make_subject, write_subject
+
+
+def _generate_subject(task):
+    """Worker: make, write and photograph one subject. Returns its index entries."""
+    (out_dir, subject_id, seed_seq, n_photos, experiments, ranges, factory, writer) = task
+    cv2.setNumThreads(1)
+    start = time.perf_counter()
+    if factory is None or writer is None:
+        default_factory, default_writer = _default_subject_api()
+        factory = factory or default_factory
+        writer = writer or default_writer
+    out_dir = Path(out_dir)
+    subject_seq, axes_seq, photos_seq = seed_seq.spawn(3)
+    subject = factory(subject_id, np.random.default_rng(subject_seq))
+    subject_dir = out_dir / "subjects" / subject_id
+    writer(subject_dir, subject)
+
+    axes_files = []
+    if "C" in experiments:
+        axes = getattr(subject, "soft_tissue_axes", None) or {}
+        sets = _noise.perturbed_axes_sets(axes, np.random.default_rng(axes_seq))
+        for k, axes_set in enumerate(sets, start=1):
+            name = f"axes_C{k}.json"
+            write_json(subject_dir / name, {"axes": axes_set})
+            axes_files.append(name)
+
+    head = _photos.prepare_head(subject)
+    views = _photos.photo_views(n_photos)
+    photo_seqs = photos_seq.spawn(len(views))
+    counters = {"frontal": 0, "lateral": 0}
+    entries = []
+    for view, seq in zip(views, photo_seqs, strict=True):
+        camera_seq, noise_seq = seq.spawn(2)
+        key = "frontal" if view == "frontal" else "lateral"
+        pid = photo_id(subject_id, view, counters[key])
+        counters[key] += 1
+        photo = _photos.make_photo(head, view, np.random.default_rng(camera_seq), ranges)
+        noisy = _noise.perturb_landmarks(photo.landmarks_uv, np.random.default_rng(noise_seq))
+        paths = write_photo_folders(
+            out_dir / "photos", pid, subject_id, photo, experiments, noisy, axes_files
+        )
+        entries.append(
+            {
+                "id": pid,
+                "subject": subject_id,
+                "view": view,
+                "image_size": list(photo.camera.image_size_wh),
+                "n_visible_landmarks": len(photo.visible),
+                "paths": paths,
+            }
+        )
+    subject_entry = {
+        "id": subject_id,
+        "path": f"subjects/{subject_id}",
+        "axes_C": axes_files,
+        "seconds": time.perf_counter() - start,
+    }
+    return subject_entry, entries
+
+
+def generate_dataset(
+    out_dir,
+    n_subjects,
+    n_photos,
+    seed=0,
+    experiments=_noise.NOISE_PROFILES,
+    progress=None,
+    workers=2,
+    ranges=_photos.CameraRanges(),
+    subject_factory=None,
+    subject_writer=None,
+):
+    """Generate subjects and their photos for the experiments A/B/C; write ``dataset.json``.
+
+    Parameters
+    ----------
+    out_dir : path
+    n_subjects : int
+    n_photos : int
+        Frontal photos per subject; as many lateral ones (split left/right).
+    seed : int
+    experiments : sequence of {"A", "B", "C"}
+    progress : callable, optional
+        ``progress(done_subjects, n_subjects)`` after each subject.
+    workers : int
+        Processes over subjects (1 = in this process).
+    ranges : photos.CameraRanges
+    subject_factory, subject_writer : callable, optional
+        ``factory(subject_id, rng) -> subject`` and ``writer(folder, subject)``; default
+        ``lilium.synthetic.subjects.make_subject`` / ``write_subject``. With ``workers > 1``
+        they must be picklable (module-level functions).
+
+    Returns
+    -------
+    dict
+        The index written to ``out_dir/dataset.json``.
+    """
+    experiments = tuple(_noise.check_profile(e) for e in experiments)
+    if not experiments:
+        raise ValueError("experiments is empty; give at least one of A, B, C")
+    if n_subjects < 1 or n_photos < 1:
+        raise ValueError(f"need n_subjects >= 1 and n_photos >= 1, got {n_subjects}, {n_photos}")
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    ids = subject_ids(n_subjects)
+    seqs = np.random.SeedSequence(seed).spawn(n_subjects)
+    tasks = [
+        (str(out_dir), sid, seq, n_photos, experiments, ranges, subject_factory, subject_writer)
+        for sid, seq in zip(ids, seqs, strict=True)
+    ]
+    results = {}
+    if workers <= 1:
+        for task in tasks:
+            results[task[1]] = _generate_subject(task)
+            if progress is not None:
+                progress(len(results), n_subjects)
+    else:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            futures = {pool.submit(_generate_subject, t): t[1] for t in tasks}
+            for future in as_completed(futures):
+                results[futures[future]] = future.result()
+                if progress is not None:
+                    progress(len(results), n_subjects)
+
+    subjects, photos = [], []
+    for sid in ids:
+        subject_entry, entries = results[sid]
+        subjects.append(subject_entry)
+        photos.extend(entries)
+    index = {
+        "format": "lilium-synthetic-dataset",
+        "version": 1,
+        "seed": seed,
+        "n_subjects": n_subjects,
+        "n_photos_per_view": n_photos,
+        "experiments": list(experiments),
+        "camera_ranges": ranges.as_dict(),
+        "min_visible_landmarks": _photos.MIN_VISIBLE_LANDMARKS,
+        "priors": {
+            "focal_fraction": _photos.PRIOR_FOCAL_FRACTION,
+            "scd_fraction": _photos.PRIOR_SCD_FRACTION,
+            "head_rotation": "true rotation",
+            "head_tolerance_deg": _photos.PRIOR_HEAD_TOLERANCE_DEG,
+        },
+        "noise": {
+            "landmark_px": _noise.LANDMARK_NOISE_PX,
+            "axis_deg": _noise.AXIS_NOISE_DEG,
+            "n_axes_sets": _noise.N_AXES_SETS,
+        },
+        "subjects": subjects,
+        "photos": photos,
+        "seconds": time.perf_counter() - start,
+    }
+    write_json(out_dir / "dataset.json", index)
+    return index
