@@ -55,7 +55,7 @@ def main(argv=None):
     p.add_argument("--variants", default=",".join(VARIANTS))
     p.add_argument("--generations", type=int, default=DEOptions().max_generations)
     p.add_argument("--population", type=int, default=DEOptions().population_size)
-    p.add_argument("--limit", type=int, help="use only the first N photos")
+    p.add_argument("--limit", type=int, help="use only N photos (spread over the dataset)")
     args = p.parse_args(argv)
 
     root = args.dataset
@@ -67,7 +67,10 @@ def main(argv=None):
         generate_dataset(root, args.subjects, args.photos, seed=args.seed, experiments=("C",))
         print(f"dataset: {root} ({time.perf_counter() - t0:.0f} s to generate)")
     index = read_json(root / "dataset.json")
-    photos = index["photos"][: args.limit] if args.limit else index["photos"]
+    photos = index["photos"]
+    if args.limit and args.limit < len(photos):
+        pick = np.linspace(0, len(photos) - 1, args.limit).round().astype(int)
+        photos = [photos[i] for i in pick]
     variants = [v for v in args.variants.split(",") if v]
     de = DEOptions(args.population, max_generations=args.generations)
     rows = []

@@ -1,6 +1,6 @@
 import pytest
 
-from lilium.demo import make_standin_case
+from standin_case import make_standin_case
 
 
 @pytest.fixture

@@ -1,131 +1,55 @@
-"""A small built-in case the package makes itself, and the demo run on it.
+"""The demo: a realistic case built from the package's own generator, solved both ways.
 
-The stand-in head is deliberately simple (an ellipsoidal vault with landmarks at fixed directions
-on it) until the procedural subject generator of :mod:`lilium.synthetic` replaces it; what matters
-here is that the whole path - case folders, POSEST-SFO, result and overlay - runs on a fresh
-machine with nothing downloaded.
+One procedural subject (skull, face, landmarks, true soft tissue) and one frontal and one lateral
+photo of it, with the realistic noise of the paper's Exp. C: landmarks moved by up to 5 px and the
+soft-tissue directions given to the methods perturbed by up to 30 degrees. Both photos go through
+``lilium case`` with POSEST-SFO and Lilium; as the truth is known, the demo also reports each
+method's back-projection error (BPE, mm).
 """
 
 from pathlib import Path
 
-import numpy as np
+from .evaluation.metrics import back_projection_error_from_dicts
+from .io.jsonio import read_json
 
-from .geometry.camera import principal_point_of, project
-from .geometry.rotations import rotvec_to_matrix
-from .imaging.overlay import render_mesh_shaded
-from .io.jsonio import write_json
-from .io.mesh import write_mesh
-from .io.results import write_png
-from .softtissue.depths import depth_stats
-from .softtissue.landmarks import CRANIAL_TO_FACIAL
-
-#: Semi-axes (mm) of the stand-in skull: half breadth, half height, half length.
-SKULL_RADII_MM = np.array([70.0, 85.0, 92.0])
-
-#: Landmark directions on the stand-in (azimuth from the front towards the subject's left,
-#: elevation), degrees. Skull frame: x = subject's left, y = up, z = anterior.
-_DIRECTIONS_DEG = {
-    "glabella": (0, 12),
-    "nasion": (0, 5),
-    "metopion": (0, 35),
-    "bregma": (0, 80),
-    "subspinale": (0, -22),
-    "prosthion": (0, -30),
-    "pogonion": (0, -50),
-    "gnathion": (0, -56),
-    "ectoconchion": (38, 0),
-    "dacryon": (12, 2),
-    "zygion": (62, -12),
-    "gonion": (58, -45),
-    "alare": (9, -14),
-    "frontotemporale": (30, 28),
-}
+#: Subjects and photos per view of the demo dataset.
+DEMO_SUBJECTS, DEMO_PHOTOS = 1, 1
 
 
-def _direction(azimuth_deg, elevation_deg):
-    az, el = np.radians(azimuth_deg), np.radians(elevation_deg)
-    return np.array([np.sin(az) * np.cos(el), np.sin(el), np.cos(az) * np.cos(el)])
-
-
-def _ellipsoid(radii_mm, subdivisions=4):
-    import trimesh
-
-    sphere = trimesh.creation.icosphere(subdivisions=subdivisions)
-    return np.asarray(sphere.vertices) * radii_mm, np.asarray(sphere.faces)
-
-
-def _surface_point(direction, radii_mm):
-    """Where the ray from the centre along ``direction`` meets the ellipsoid, and the normal."""
-    s = 1.0 / np.sqrt(np.sum((direction / radii_mm) ** 2))
-    p = s * direction
-    n = p / radii_mm**2
-    return p, n / np.linalg.norm(n)
-
-
-def make_standin_case(folder, seed=0):
-    """Write a stand-in subject and one frontal photo of it.
+def build_demo_case(folder, seed=0):
+    """Generate the demo's subject and photos.
 
     Returns
     -------
-    subject_dir, photo_dir : Path
+    subject_dir : Path
+    photo_dirs : list of Path
+        Frontal then lateral (Exp. C).
+    axes_path : Path
+        The perturbed soft-tissue axes the methods are given.
     """
-    rng = np.random.default_rng(seed)
-    folder = Path(folder)
-    subject_dir, photo_dir = folder / "subjects" / "standin", folder / "photos" / "standin_frontal"
-    cranial, facial, axes = {}, {}, {}
-    for base, (az, el) in _DIRECTIONS_DEG.items():
-        sides = [("_l", 1), ("_r", -1)] if az else [("", 1)]
-        for suffix, sign in sides:
-            p, n = _surface_point(_direction(sign * az, el), SKULL_RADII_MM)
-            name = base + suffix
-            depth = depth_stats(name).mean_mm + rng.normal(0, 0.5)
-            cranial[name], axes[name] = p, n
-            facial[CRANIAL_TO_FACIAL[name]] = p + depth * n
-    skull_v, skull_f = _ellipsoid(SKULL_RADII_MM)
-    skin_v, skin_f = _ellipsoid(SKULL_RADII_MM + 8.0)
-    write_mesh(subject_dir / "skull.ply", skull_v, skull_f)
-    write_mesh(subject_dir / "face.ply", skin_v, skin_f)
-    write_json(subject_dir / "cranial_landmarks.json", {"landmarks": cranial})
-    write_json(subject_dir / "soft_tissue_axes.json", {"axes": axes})
-    write_json(subject_dir / "facial_landmarks.json", {"landmarks": facial})
+    from .synthetic.dataset import generate_dataset
 
-    # Frontal camera: looks along the skull's -z, x right = subject's right, y down.
-    size_wh, focal_px, scd_mm = (1200, 900), 2600.0, 900.0
-    # Facing the camera the subject's left is on the image's right: cam x = skull x,
-    # cam y (down) = -skull y, cam z (forward, into the face) = -skull z.
-    R = np.diag([1.0, -1.0, -1.0])
-    R = rotvec_to_matrix(np.radians([4.0, -9.0, 2.0])) @ R
-    skull2cam = np.eye(4)
-    skull2cam[:3, :3] = R
-    skull2cam[:3, 3] = np.array([0.0, 0.0, scd_mm]) - R @ facial["nasion"]
-    centre = principal_point_of(size_wh)
-    shade, covered = render_mesh_shaded(skin_v, skin_f, skull2cam, focal_px, centre, size_wh)
-    image = np.full(size_wh[::-1] + (3,), 40, dtype=np.uint8)
-    skin_rgb = np.array([224, 172, 140])
-    image[covered] = (shade[covered, None] * skin_rgb).astype(np.uint8)
-    names = list(facial)
-    uv = project(np.array([facial[n] for n in names]), skull2cam, focal_px, centre)
-    write_png(photo_dir / "image.png", image)
-    write_png(photo_dir / "face_mask.png", np.repeat(covered[..., None] * 255, 3, axis=2))
-    write_json(
-        photo_dir / "photo.json",
-        {
-            "view": "frontal",
-            "landmarks": dict(zip(names, uv, strict=True)),
-            "priors": {
-                "focal_px": [0.95 * focal_px, 1.05 * focal_px],
-                "scd_mm": [0.9 * scd_mm, 1.1 * scd_mm],
-                "head_rotation_skull2cam": R,
-                "head_tolerance_deg": 10,
-            },
-            "ground_truth": {
-                "subject": "standin",
-                "skull2cam": skull2cam,
-                "focal_px": focal_px,
-                "scd_mm": scd_mm,
-                "noise": "A",
-                "landmarks_noise_free": dict(zip(names, uv, strict=True)),
-            },
-        },
+    folder = Path(folder)
+    index = generate_dataset(
+        folder, DEMO_SUBJECTS, DEMO_PHOTOS, seed=seed, experiments=("C",), workers=1
     )
-    return subject_dir, photo_dir
+    subject_dir = folder / index["subjects"][0]["path"]
+    photo_dirs = [folder / p["paths"]["C"] for p in index["photos"]]
+    return subject_dir, photo_dirs, subject_dir / "axes_C1.json"
+
+
+def ground_truth_bpe(result_path, subject_dir, photo_dir):
+    """BPE (mm) of a written ``result.json`` against the synthetic ground truth (NaN if failed)."""
+    result = read_json(result_path)
+    if result["camera"] is None:
+        return float("nan")
+    truth = read_json(Path(photo_dir) / "photo.json")["ground_truth"]
+    facial = read_json(Path(subject_dir) / "facial_landmarks.json")["landmarks"]
+    camera = result["camera"]
+    return back_projection_error_from_dicts(
+        facial,
+        truth["landmarks_noise_free"],
+        camera["skull2cam"],
+        camera["focal_px"],
+        camera["principal_point_px"],
+    )

@@ -1,4 +1,4 @@
-"""``lilium demo``: build the built-in case and superimpose its skull with POSEST-SFO."""
+"""``lilium demo``: build a realistic case from built-in data and superimpose it both ways."""
 
 import time
 from pathlib import Path
@@ -8,26 +8,44 @@ def register(subparsers):
     p = subparsers.add_parser("demo", help="run a demo SFO on built-in data", description=__doc__)
     p.add_argument("--out", type=Path, default=Path("lilium-demo"), help="output folder")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--variant", default="skof+pll", help="Lilium variant (default skof+pll)")
     p.set_defaults(func=run)
 
 
 def run(args):
-    from ..demo import make_standin_case
-    from .sfo import run_sfo
+    from ..demo import build_demo_case, ground_truth_bpe
+    from .main import main
 
     start = time.perf_counter()
-    subject_dir, photo_dir = make_standin_case(args.out / "case", seed=args.seed)
-    out = args.out / "posest-sfo"
-    result = run_sfo(subject_dir, photo_dir, out)
-    status = "ok" if result else f"failed ({result.error})"
-    print(f"Lilium demo: POSEST-SFO {status}")
-    if result:
-        print(
-            f"  focal {result.focal_px:.0f} px, mean landmark error {result.fitness:.2f} px, "
-            f"{result.seconds * 1e3:.1f} ms"
-        )
-    print(f"  case:    {args.out / 'case'}")
-    print(f"  result:  {out / 'result.json'}")
-    print(f"  overlay: {out / 'overlay.png'}")
-    print(f"  total {time.perf_counter() - start:.1f} s")
-    return 0 if result else 1
+    out = Path(args.out)
+    print("Lilium demo: generating a subject and a frontal and a lateral photo ...", flush=True)
+    subject_dir, photo_dirs, axes = build_demo_case(out / "data", seed=args.seed)
+    argv = ["case", "--skull", str(subject_dir), "--axes", str(axes)]
+    for photo in photo_dirs:
+        argv += ["--photo", str(photo)]
+    argv += [
+        "--method",
+        "posest-sfo",
+        "--method",
+        "lilium",
+        "--variant",
+        args.variant,
+        "--seed",
+        str(args.seed),
+        "--title",
+        "Lilium demo (synthetic, Exp. C noise)",
+        "--out",
+        str(out / "case"),
+    ]
+    code = main(argv)
+    print("\nAgainst the known truth (back-projection error, mm; lower is better):")
+    for photo in photo_dirs:
+        for tag in ("posest-sfo", f"lilium-{args.variant}"):
+            result = out / "case" / photo.name / tag / "result.json"
+            if result.is_file():
+                bpe = ground_truth_bpe(result, subject_dir, photo)
+                print(f"  {photo.name:<10} {tag:<18} {bpe:6.2f}")
+    print(f"\n  report:  {out / 'case' / 'report.html'}  (open it in a browser)")
+    print(f"  data:    {out / 'data'}")
+    print(f"  total {time.perf_counter() - start:.0f} s")
+    return code
