@@ -221,8 +221,10 @@ class LiliumProblem:
         mse = np.where(ok, np.mean(sq, axis=1), C_INF)
         mse = np.where(np.isfinite(mse), mse, C_INF)
         cam = facial[:, self.scd_index].mean(axis=1)
-        scd = np.linalg.norm(np.einsum("sij,sj->si", R, cam) + t, axis=1)
-        p_cam = camera_penalty_from_priors(f, scd, R, ok, self.photo.priors)
+        # Cameras that ran off (huge focal and depth) overflow here; P_cam gives them C_INF.
+        with np.errstate(over="ignore", invalid="ignore"):
+            scd = np.linalg.norm(np.einsum("sij,sj->si", R, cam) + t, axis=1)
+            p_cam = camera_penalty_from_priors(f, scd, R, ok, self.photo.priors)
         fitness = mse + p_cam
         bound = np.full(S, np.inf) if thresholds is None else np.asarray(thresholds, float)
         terms = {"p_skof": self.skof, "p_pll": self.pll}
