@@ -185,3 +185,75 @@ def test_context_end_to_end_lateral_left_with_span():
     # Skull pushed 8 px anterior (to -u): it pokes out of the forehead by 2 px everywhere.
     terms = ctx.evaluate(RECT_UV - [8, 0], span_v=(24, 36))
     assert terms.p_int == 13_000.0 and terms.delta_d == 0.0
+
+
+# --- batched evaluation ----------------------------------------------------------------------
+
+
+def _bumpy_sheet(n=14, rng=0):
+    """A bumpy triangulated sheet (K, 3) mm and its faces."""
+    rng = np.random.default_rng(rng)
+    x, y = np.meshgrid(np.linspace(-30, 30, n), np.linspace(-20, 20, n))
+    z = 3 * np.sin(x / 7) * np.cos(y / 5) + rng.normal(0, 0.3, x.shape)
+    verts = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
+    idx = np.arange(n * n).reshape(n, n)
+    a, b, c, d = idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]
+    faces = np.vstack(
+        [np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)]
+    )
+    # Drop a few faces: holes and isolated slivers make the rasters less regular.
+    keep = rng.random(len(faces)) > 0.05
+    return verts, faces[keep]
+
+
+def _random_projections(verts, S, rng, spread):
+    from scipy.spatial.transform import Rotation
+
+    R = Rotation.from_rotvec(np.deg2rad(spread) * rng.standard_normal((S, 3))).as_matrix()
+    t = np.array([0.0, 0.0, 400.0]) + 5 * rng.standard_normal((S, 3))
+    f = 1500 * (1 + 0.1 * rng.standard_normal(S))
+    X = verts @ np.swapaxes(R, 1, 2) + t[:, None]
+    return np.array([320.0, 240.0]) + f[:, None, None] * X[..., :2] / X[..., 2:3]
+
+
+@pytest.mark.parametrize("view", ["frontal", "lateral_left", "lateral_right"])
+def test_batched_pll_equals_the_reference_on_random_cameras(view):
+    rng = np.random.default_rng(7)
+    verts, faces = _bumpy_sheet()
+    uv = _random_projections(verts, 40, rng, spread=12.0)
+    ref_curve = detect_curve(uv[0] + [3.0, 6.0], faces, view)
+    ctx = PllContext.build(faces, ref_curve, view, image_shape=(480, 640))
+    uv[1] = np.nan  # behind the camera: no curve
+    uv[2, :5] = np.nan  # partly behind
+    uv[3] += 5000.0  # far off the image: the clipped-window path
+    uv[4] = uv[4, :1]  # collapsed to a point
+    span_v = None
+    if view != "frontal":
+        span_v = np.column_stack([uv[:, 0, 1] + 40, uv[:, -1, 1] - 40])
+    ref = np.array(
+        [ctx.evaluate(u, None if span_v is None else span_v[i]).total for i, u in enumerate(uv)]
+    )
+    batch = ctx.evaluate_batch(uv, span_v)
+    np.testing.assert_array_equal(batch, ref)
+    assert ref[1] == PLL_NO_CURVE and np.isfinite(ref).all()
+    assert (ref < PLL_NO_CURVE).sum() >= 30
+
+
+def test_batched_curves_equal_detect_curve():
+    from lilium.fitness.curves import detect_curves_batch
+
+    rng = np.random.default_rng(3)
+    verts, faces = _bumpy_sheet(rng=3)
+    uv = _random_projections(verts, 25, rng, spread=20.0)
+    topo = PllContext.build(faces, line(np.arange(5), 0), "frontal").topology
+    for view in ("frontal", "lateral_left", "lateral_right"):
+        batch = detect_curves_batch(uv, view, topology=topo, image_shape=(480, 640))
+        for i in range(len(uv)):
+            ref = detect_curve(uv[i], faces, view, image_shape=(480, 640))
+            np.testing.assert_array_equal(batch.curve(i), ref)
+
+
+def test_pairing_ties_go_to_the_lowest_index():
+    # (5, 10) is 2 px from both (3, 10) and (7, 10): the first face point wins.
+    s, p, d = pair_curves([[5.0, 10.0]], [[3.0, 10.0], [7.0, 10.0]])
+    assert p[0].tolist() == [3.0, 10.0] and d[0] == 2.0

@@ -78,8 +78,11 @@ class SkofTerm:
     def outside_pixels(self, R, t, focal_px):
         """Skull pixels outside the face mask, ``(S,)`` int."""
         uv = project_population(self.vertices_mm, R, t, focal_px, self.centre)
+        # No culling: exact either way, and at ~8k faces culling costs 5-30 % more than it saves
+        # (the culled interior leaves open borders, i.e. more contour edges to scan;
+        # benchmarks/bench_terms.py cases).
         return skull_outside_pixels_batch(
-            uv, topology=self.context.topology, mask_index=self.context.mask_index
+            uv, topology=self.context.topology, mask_index=self.context.mask_index, cull=False
         )
 
     def __call__(self, R, t, focal_px):
