@@ -193,3 +193,21 @@ def test_procedural_subject_skull_stays_inside_the_face_mask():
         assert implausible_sfo(skull, photo.face_mask).percent_outside < 0.05, view
         assert n_usable_landmarks(photo) >= MIN_VISIBLE_LANDMARKS
         assert photo.face_curve
+
+
+def test_true_skull_projects_inside_the_face_mask():
+    """The neck cut never cuts the skull: at the true camera P_skof is 0 (as in a real photo)."""
+    from lilium.fitness.skof import skull_outside_pixels
+    from lilium.geometry.camera import principal_point_of, project
+    from lilium.synthetic.photos import make_photo, prepare_head
+    from lilium.synthetic.subjects import make_subject
+
+    subject = make_subject("s1", rng=1)
+    head = prepare_head(subject)
+    rng = np.random.default_rng(2)
+    for view in ("frontal", "lateral_left", "lateral_right"):
+        photo = make_photo(head, view, rng)
+        cam = photo.camera
+        centre = principal_point_of(cam.image_size_wh)
+        uv = project(subject.skull_vertices_mm, cam.skull2cam, cam.focal_px, centre)
+        assert skull_outside_pixels(uv, subject.skull_faces, photo.face_mask) == 0

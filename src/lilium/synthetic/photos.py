@@ -32,9 +32,10 @@ away from the camera hide the midline ones) is drawn again, camera and all.
 
 The face mask is the part of the render showing the head: skin triangles above a neck cut.
 In front of the gonia the cut is the plane through the facial gnathion and both facial gonia
-(the lower border of the jaw) lowered by :data:`NECK_CUT_MARGIN_MM`; behind the gonia it is the
-horizontal plane through the gonia, lowered by the same margin. A skin mesh without a neck loses
-at most a thin band under the chin.
+(the lower border of the jaw); behind the gonia it is the horizontal plane through the gonia.
+Each plane is lowered by :data:`NECK_CUT_MARGIN_MM`, and further where needed so that the whole
+skull lies above it: as in a real photo, the true skull projects inside the face mask (its
+P_skof is 0). The cut is a property of the subject, the same in every photo.
 """
 
 from dataclasses import dataclass, field
@@ -212,7 +213,36 @@ class SyntheticPhoto:
     face_curve: dict = field(default_factory=dict)
 
 
-def head_faces_of(skin_vertices_mm, skin_faces, facial_landmarks, margin_mm=NECK_CUT_MARGIN_MM):
+def _neck_planes(facial_landmarks):
+    """Signed heights (mm) above the jaw plane and above the gonion plane, as functions."""
+    gl = np.asarray(facial_landmarks["gonion_l"], dtype=float)
+    gr = np.asarray(facial_landmarks["gonion_r"], dtype=float)
+    gonion_y = 0.5 * (gl[1] + gr[1])
+    gonion_z = 0.5 * (gl[2] + gr[2])
+    if "gnathion" in facial_landmarks:
+        gn = np.asarray(facial_landmarks["gnathion"], dtype=float)
+        normal = np.cross(gl - gn, gr - gn)
+        if normal[1] < 0:
+            normal = -normal
+        normal /= np.linalg.norm(normal)
+    else:
+        gn, normal = np.array([0.0, gonion_y, 0.0]), np.array([0.0, 1.0, 0.0])
+
+    def heights(points):
+        points = np.asarray(points, dtype=float)
+        anterior = points[:, 2] > gonion_z
+        return anterior, (points - gn) @ normal, points[:, 1] - gonion_y
+
+    return heights
+
+
+def head_faces_of(
+    skin_vertices_mm,
+    skin_faces,
+    facial_landmarks,
+    margin_mm=NECK_CUT_MARGIN_MM,
+    skull_vertices_mm=None,
+):
     """Which skin triangles belong to the head (above the neck cut, see the module notes).
 
     Parameters
@@ -222,6 +252,12 @@ def head_faces_of(skin_vertices_mm, skin_faces, facial_landmarks, margin_mm=NECK
     facial_landmarks : dict
         Needs ``gonion_l``, ``gonion_r`` (and ``gnathion`` for the jaw plane); without the gonia
         every triangle counts as head.
+    margin_mm : float
+        How far the cut planes are lowered at least.
+    skull_vertices_mm : array_like of shape (K, 3), optional
+        When given, each plane is lowered further where needed so that the whole skull lies
+        above it (plus ``margin_mm``): the true skull then projects inside the face mask, as
+        it does in a real photo.
 
     Returns
     -------
@@ -232,22 +268,16 @@ def head_faces_of(skin_vertices_mm, skin_faces, facial_landmarks, margin_mm=NECK
     centroids = vertices[faces].mean(axis=1)
     if "gonion_l" not in facial_landmarks or "gonion_r" not in facial_landmarks:
         return np.ones(len(faces), dtype=bool)
-    gl = np.asarray(facial_landmarks["gonion_l"], dtype=float)
-    gr = np.asarray(facial_landmarks["gonion_r"], dtype=float)
-    gonion_y = 0.5 * (gl[1] + gr[1])
-    gonion_z = 0.5 * (gl[2] + gr[2])
-    below_gonia = centroids[:, 1] < gonion_y - margin_mm
-    if "gnathion" in facial_landmarks:
-        gn = np.asarray(facial_landmarks["gnathion"], dtype=float)
-        normal = np.cross(gl - gn, gr - gn)
-        if normal[1] < 0:
-            normal = -normal
-        normal /= np.linalg.norm(normal)
-        below_jaw = (centroids - gn) @ normal < -margin_mm
-    else:
-        below_jaw = below_gonia
-    anterior = centroids[:, 2] > gonion_z
-    neck = np.where(anterior, below_jaw, below_gonia)
+    heights = _neck_planes(facial_landmarks)
+    margin_jaw = margin_gonia = margin_mm
+    if skull_vertices_mm is not None:
+        anterior, jaw, gonia = heights(skull_vertices_mm)
+        if anterior.any():
+            margin_jaw = max(margin_mm, margin_mm - jaw[anterior].min())
+        if (~anterior).any():
+            margin_gonia = max(margin_mm, margin_mm - gonia[~anterior].min())
+    anterior, jaw, gonia = heights(centroids)
+    neck = np.where(anterior, jaw < -margin_jaw, gonia < -margin_gonia)
     return ~neck
 
 
@@ -266,7 +296,8 @@ def prepare_head(subject):
     facial = {k: np.asarray(v, dtype=float) for k, v in subject.facial_landmarks.items()}
     if not facial:
         raise ValueError("the subject has no facial landmarks; a photo needs them")
-    head = head_faces_of(vertices, faces, facial)
+    skull = getattr(subject, "skull_vertices_mm", None)
+    head = head_faces_of(vertices, faces, facial, skull_vertices_mm=skull)
     head_points = vertices[np.unique(faces[head])]
     hull = head_points[ConvexHull(head_points).vertices]
     names = tuple(facial)
