@@ -112,21 +112,26 @@ def test_frontal_sees_both_eyes(head):
 
 def test_face_curves(head):
     frontal = make_photo(head, "frontal", 2, SMALL)
-    curve = frontal.face_curve["chin_jaw"]
+    curve = frontal.face_curve["chin_jaw"].astype(int)
     lm = frontal.landmarks_uv
     lo, hi = sorted([lm["cheilion_l"][0], lm["cheilion_r"][0]])
-    assert len(curve) > 10 and np.all(np.diff(curve[:, 0]) > 0)
+    # Ordered along u; the joined 8-connected curve may step vertically within a column.
+    assert len(curve) > 10 and np.all(np.diff(curve[:, 0]) >= 0)
     assert curve[:, 0].min() >= lo - 1 and curve[:, 0].max() <= hi + 1
-    assert np.all(frontal.face_mask[curve[:, 1], curve[:, 0]])
-    # Lower boundary: the pixel below is not face.
-    below = np.minimum(curve[:, 1] + 1, frontal.face_mask.shape[0] - 1)
-    assert not np.any(frontal.face_mask[below, curve[:, 0]])
+    # Boundary pixels of the mask, joined into one curve by straight segments (SPEC 5), so a
+    # few joining pixels may fall off the mask.
+    on_mask = frontal.face_mask[curve[:, 1], curve[:, 0]]
+    assert on_mask.mean() > 0.9
+    # Lower boundary: below almost every curve pixel lies background (the joining steps of the
+    # 8-connected curve aside).
+    below = np.minimum(curve[on_mask, 1] + 1, frontal.face_mask.shape[0] - 1)
+    assert frontal.face_mask[below, curve[on_mask, 0]].mean() < 0.05
     assert curve[:, 1].max() > lm["pogonion"][1]  # the chin bottom is below pogonion
 
     lateral = make_photo(head, "lateral_left", 2, SMALL)
-    fh = lateral.face_curve["forehead"]
+    fh = lateral.face_curve["forehead"].astype(int)
     lo, hi = sorted([lateral.landmarks_uv["glabella"][1], lateral.landmarks_uv["metopion"][1]])
-    assert np.all(np.diff(fh[:, 1]) > 0) and fh[:, 1].min() >= lo - 1 and fh[:, 1].max() <= hi + 1
+    assert np.all(np.diff(fh[:, 1]) >= 0) and fh[:, 1].min() >= lo - 1 and fh[:, 1].max() <= hi + 1
     left_of = np.maximum(fh[:, 0] - 1, 0)
     assert not np.any(lateral.face_mask[fh[:, 1], left_of])
     assert face_curve_from_mask(lateral.face_mask, "frontal", {}) == {}

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fitness import curves as _curves
 from ..geometry.camera import principal_point_of, subject_camera_distance
 from ..geometry.rotations import rotvec_to_matrix
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
@@ -381,60 +382,24 @@ def sample_camera(head, view, rng, ranges=CameraRanges()):
 
 
 def face_curve_from_mask(mask, view, landmarks_uv):
-    """The facial contour curve from the face-mask outline (SPEC section 5).
+    """The photo's facial contour curve from its face mask, for ``face_curve.json``.
 
-    Frontal: the lowest mask pixel of every column between the cheilion u-coordinates
-    (chin-jaw). Lateral: the most anterior mask pixel (leftmost for ``lateral_left``, rightmost
-    for ``lateral_right``) of every row between the glabella and metopion v-coordinates
-    (forehead).
-
-    Parameters
-    ----------
-    mask : ndarray of shape (H, W), bool
-    view : str
-    landmarks_uv : dict
-        Needs ``cheilion_l``/``cheilion_r`` (frontal) or ``glabella``/``metopion`` (lateral).
+    The rule of SPEC section 5 (:func:`lilium.fitness.curves.face_curve_from_mask`): the chin-jaw
+    between the cheilion u-coordinates (frontal) or the forehead between the glabella and metopion
+    v-coordinates (lateral).
 
     Returns
     -------
     dict
-        ``{"chin_jaw": ndarray (N, 2)}`` ordered by u, or ``{"forehead": ndarray (N, 2)}``
-        ordered by v (top to bottom); ``{}`` when the bounding landmarks are missing.
+        ``{"chin_jaw": ndarray (N, 2)}`` or ``{"forehead": ndarray (N, 2)}``; ``{}`` when a
+        bounding landmark is missing.
     """
     check_view(view)
-    mask = np.asarray(mask, dtype=bool)
-    height, width = mask.shape
-
-    def _coord(name, axis):
-        value = landmarks_uv.get(name)
-        if value is None or not np.all(np.isfinite(value)):
-            return None
-        return float(value[axis])
-
-    if view == "frontal":
-        a, b = _coord("cheilion_l", 0), _coord("cheilion_r", 0)
-        if a is None or b is None:
-            return {}
-        lo, hi = max(0, int(np.ceil(min(a, b)))), min(width - 1, int(np.floor(max(a, b))))
-        cols = np.arange(lo, hi + 1)
-        sub = mask[:, cols]
-        has = sub.any(axis=0)
-        rows = height - 1 - np.argmax(sub[::-1], axis=0)
-        curve = np.column_stack([cols[has], rows[has]])
-        return {"chin_jaw": curve}
-    a, b = _coord("glabella", 1), _coord("metopion", 1)
-    if a is None or b is None:
+    needed = ("cheilion_l", "cheilion_r") if view == "frontal" else ("glabella", "metopion")
+    if not all(n in landmarks_uv and np.all(np.isfinite(landmarks_uv[n])) for n in needed):
         return {}
-    lo, hi = max(0, int(np.ceil(min(a, b)))), min(height - 1, int(np.floor(max(a, b))))
-    rows = np.arange(lo, hi + 1)
-    sub = mask[rows]
-    has = sub.any(axis=1)
-    if view == "lateral_left":
-        cols = np.argmax(sub, axis=1)
-    else:
-        cols = width - 1 - np.argmax(sub[:, ::-1], axis=1)
-    curve = np.column_stack([cols[has], rows[has]])
-    return {"forehead": curve}
+    key = "chin_jaw" if view == "frontal" else "forehead"
+    return {key: _curves.face_curve_from_mask(mask, view, landmarks_uv)}
 
 
 def render_photo(head, camera):
