@@ -124,3 +124,34 @@ def test_write_subject_folder(tmp_path, subjects):
 def test_make_subject_accepts_a_seed():
     with pytest.raises(TypeError):
         make_subject("x", rng="not a seed")
+
+
+def test_facial_landmarks_on_the_skin_for_many_seeds():
+    """Every facial landmark lies on the skin mesh (meshing keeps the piece of skin it is on)."""
+    from lilium.synthetic.subjects import distance_to_mesh
+
+    for seed in range(10):
+        s = make_subject(f"s{seed:02d}", rng=seed)
+        pts = np.array([s.facial_landmarks[n] for n in FACIAL_NAMES])
+        d = distance_to_mesh(s.skin_vertices_mm, s.skin_faces, pts)
+        assert d.max() < 1.5, (seed, FACIAL_NAMES[int(np.argmax(d))], float(d.max()))
+
+
+def test_silhouette_landmarks_are_seen_in_frontal_and_profile_views(subjects):
+    """Subnasale, zygia, gonia are seen straight from the front; labiale superius, pogonion
+    and gnathion in a true profile (z-buffer test of lilium.synthetic.photos)."""
+    from lilium.synthetic import photos as P
+
+    frontal = ("subnasale", "zygion_l", "zygion_r", "gonion_l", "gonion_r")
+    profile = ("labiale_superius", "pogonion", "gnathion")
+    for s in subjects:
+        head = P.prepare_head(s)
+        for yaw, names in ((0.0, frontal), (90.0, profile), (-90.0, profile)):
+            R = P.head_rotation(yaw, 0.0, 0.0)
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = R, np.array([0.0, 0.0, 1500.0]) - R @ head.nasion_mm
+            view = "frontal" if yaw == 0 else ("lateral_right" if yaw > 0 else "lateral_left")
+            cam = P.PhotoCamera(view, T, 3000.0, (1280, 960), 1500.0, yaw, 0.0, 0.0)
+            photo = P.render_photo(head, cam)
+            for n in names:
+                assert n in photo.visible, (s.subject_id, yaw, n)

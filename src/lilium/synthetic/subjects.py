@@ -62,6 +62,31 @@ DEFAULT_DEPTH_MM = 5.5
 DEPTH_KERNEL_MM = 16.0
 #: Width (mm) of the Gaussian bumps that make the skin pass through the facial targets.
 BUMP_MM = 5.0
+#: Rise (mm per mm forward) of the lower border of the nose from the subnasale to the tip.
+NOSE_RISE = 0.42
+#: Silhouette pads: (facial landmark, axis removed from its normal, radius mm). x (0) for the
+#: profile, z (2) for the frontal outline.
+PADS = (
+    ("zygion_l", 2, 9.0),
+    ("zygion_r", 2, 9.0),
+    ("gonion_l", 2, 9.0),
+    ("gonion_r", 2, 9.0),
+    ("pogonion", 0, 7.0),
+    ("gnathion", 0, 6.0),
+)
+#: Facial landmarks whose lines of sight are cleared (see :func:`_sight_lines`).
+SIGHT_NAMES = (
+    "zygion_l",
+    "zygion_r",
+    "gonion_l",
+    "gonion_r",
+    "subnasale",
+    "labiale_superius",
+    "pogonion",
+    "gnathion",
+)
+#: Far-side yaw (degrees) up to which the zygia and gonia stay visible in frontal views.
+SIGHT_YAW_DEG = 13.0
 #: Lowest skin point (mm): the neck is cut here.
 NECK_CUT_Y_MM = -165.0
 
@@ -170,6 +195,14 @@ def _arch(half_width, z_front, z_back, n=17):
     return np.column_stack(
         [half_width * np.sin(theta), z_back + (z_front - z_back) * np.cos(theta)]
     )
+
+
+def _body_arch(half_width, z_front, z_back, n=21, power=1.4):
+    """Points ``(x, z)`` of the mandibular body, gonion to gonion: ``z`` falls as ``|x|^power``,
+    so the two halves converge towards the chin (about 24 deg off the sagittal plane at the
+    gonia) and the gonia are the widest points of the lower jaw."""
+    t = np.linspace(-1.0, 1.0, n)
+    return np.column_stack([half_width * t, z_front - (z_front - z_back) * np.abs(t) ** power])
 
 
 def _sweep(bone, xz, y_centre, half_width, half_height, radius, k=1.5):
@@ -383,7 +416,7 @@ def build_bone(s, rng):
 
     # Mandible: body swept along an arch from gonion to gonion, chin, rami, condyles, coronoids.
     g = d["gonion"]
-    body = _arch(g[0], d["chin_z"] - 4.0, g[2] + 2.0, 21)
+    body = _body_arch(g[0], d["chin_z"] - 4.0, g[2] + 2.0, 21)
     w = np.abs(np.linspace(-1, 1, 21))  # 0 at the chin, 1 at the gonia
     top = d["infradentale_y"] + 3.0 * w
     bottom = d["menton_y"] + 3.0 + (g[1] - d["menton_y"] - 2.0) * w
@@ -530,17 +563,13 @@ def locate_cranial_landmarks(bone, design):
         lm["zygion" + sfx] = _support(
             bone, (sx * d["zygion_x"], 0.0, 24.0), (sx, 0, 0), (0, 1, 0), (0, 0, 1), 6.0, 20.0
         )
+        # Gonion: the corner of the angle, extreme laterally-down-back (the soft tissue over it
+        # is measured laterally, on the masseter).
         g0 = d["gonion"] * (sx, 1, 1)
-        lm["gonion" + sfx] = _support(
-            bone,
-            g0,
-            (sx * 0.35, -1.0, -1.0),
-            (0, 1, -1) / np.sqrt(2),
-            (1, 0, 0),
-            14.0,
-            4.0,
-            0.5,
-        )
+        g_dir = np.array([sx * 1.0, -0.22, -0.22])
+        g_e1 = np.array([0.0, 1.0, -1.0]) / np.sqrt(2)
+        g_e2 = np.cross(g_dir / np.linalg.norm(g_dir), g_e1)
+        lm["gonion" + sfx] = _support(bone, g0, g_dir, g_e1, g_e2, 14.0, 4.0, 0.5)
         lm["frontotemporale" + sfx] = _support(
             bone,
             (sx * 42.0, d["brow_y"] + 18.0, 60.0),
@@ -651,18 +680,20 @@ def _support_field(bone, d, s):
     for sx in (1, -1):
         o = d["orbit"] * (sx, 1, 1)
         parts.append((("e", o + (0, 0, 11.0), (12.0, 12.0, 12.0)), 2.0))  # eyeball
+        # Temporalis: fills the temporal fossa above the arch, never wider than the zygia.
         parts.append(
-            (("e", (sx * (B / 2 - 12.0), 12.0, 34.0), (12.0, 30.0, 28.0)), 8.0)
+            (("e", (sx * (B / 2 - 13.0), 24.0, 32.0), (10.0, 24.0, 24.0)), 6.0)
         )  # temporalis
         g = d["gonion"] * (sx, 1, 1)
-        a = np.array([sx * (d["zygion_x"] - 8.0), -6.0, 24.0])
-        b = np.array([g[0] + sx * 2.0, g[1] + 8.0, g[2] + 12.0])
-        parts.append((("c", a, b, 6.0, 4.0), 12.0))  # masseter
-        parts.append((("e", (sx * 36.0 * fw, -32.0, 50.0), (14.0, 22.0, 24.0)), 16.0))  # cheek
+        # Masseter: medial of the line zygion-gonion, so that both stay the widest points.
+        a = np.array([sx * (d["zygion_x"] - 13.0), -8.0, 26.0])
+        b = np.array([g[0] - sx * 7.0, g[1] + 14.0, g[2] + 16.0])
+        parts.append((("c", a, b, 5.0, 4.0), 8.0))  # masseter
+        parts.append((("e", (sx * 33.0 * fw, -32.0, 52.0), (12.0, 20.0, 22.0)), 12.0))  # cheek
     parts.append((("e", (0.0, d["occlusal_y"], 66.0), (26.0 * fw, 12.0, 20.0)), 6.0))  # mouth
     parts.append((("e", d["nasal_aperture"] - (0, 0, 6.0), d["nasal_aperture_radii"]), 2.0))
     parts.append((("e", (0.0, d["menton_y"] + 6.0, 38.0), (34.0, 14.0, 40.0)), 12.0))  # floor
-    parts.append((("c", (0.0, -60.0, -22.0), (0.0, -200.0, -30.0), 50.0, 52.0), 24.0))  # neck
+    parts.append((("c", (0.0, -60.0, -22.0), (0.0, -200.0, -30.0), 44.0, 46.0), 20.0))  # neck
     for spec, k in parts:
         if spec[0] == "e":
             c, r = np.asarray(spec[1], float), np.asarray(spec[2], float)
@@ -716,72 +747,134 @@ def _distance_outside(field):
     return gaussian_filter(dist, 1.0)
 
 
-def build_skin(bone, d, s, targets, depths):
-    """The skin field (negative inside) passing through every facial target.
+def _pad(field, target, direction, flat_axis, radius, margin=1.0):
+    """Make ``target`` the tip of a rounded pad of the skin (in place).
 
-    Parameters
-    ----------
-    targets : dict of facial name -> ndarray of shape (3,)
-    depths : dict of facial name -> float (mm)
+    The pad's outward normal at the target is ``direction`` with its ``flat_axis`` component
+    removed (0 = x for the profile, 2 = z for the frontal outline), so the target lies on the
+    silhouette of views along that axis. The skin around is first pushed ``margin`` mm behind
+    the target (a Gaussian of width ``radius``), then a sphere of ``radius`` touching the
+    target from inside is added.
     """
-    sup = _support_field(bone, d, s)
-    skin = sup.copy()
-    names = list(targets)
-    anchors = [targets[n] for n in names]
-    anchor_depths = [depths[n] for n in names]
-    for sx in (1, -1):  # thin eyelids over the eyeballs
-        anchors.append(d["orbit"] * (sx, 1, 1) + (0, 0, 24.0))
-        anchor_depths.append(2.0)
-    skin.values = _distance_outside(sup) - _depth_field(skin, anchors, anchor_depths)
-
-    # Nose.
-    fn, fsn = targets["nasion"], targets["subnasale"]
-    tip = fsn + np.array([0.0, 6.0, s.nose_projection_mm])
-    dorsum_a, dorsum_b = fn - (0, 5.0, 5.0), tip - (0, -2.0, 8.0)
-    skin.combine(
-        lambda p: capsule(p, dorsum_a, dorsum_b, 5.0, 7.5),
-        np.minimum(dorsum_a, dorsum_b) - 14,
-        np.maximum(dorsum_a, dorsum_b) + 14,
-        "union",
-        5.0,
-    )
-    c_tip = tip - (0, 0, 7.5)
-    skin.combine(
-        lambda p: ellipsoid(p, c_tip, (10.0, 8.5, 8.0)), c_tip - 18, c_tip + 18, "union", 4
-    )
-    for sx, nm in ((1, "alare_l"), (-1, "alare_r")):
-        fa = targets[nm]
-        c = fa - (sx * 6.0, -1.0, 3.0)
-        skin.combine(lambda p, c=c: ellipsoid(p, c, (7.0, 7.0, 10.0)), c - 16, c + 16, "union", 4)
-    col_a, col_b = tip + (0, -4.0, -4.0), fsn + (0, 1.5, -1.0)
-    skin.combine(lambda p: capsule(p, col_a, col_b, 3.5, 3.0), col_b - 16, col_a + 16, "union", 2)
-    # Lips.
-    fls = targets["labiale_superius"]
-    c_up = fls + (0, 1.5, -9.5)
-    skin.combine(lambda p: ellipsoid(p, c_up, (24.0, 7.0, 9.5)), c_up - 30, c_up + 30, "union", 4)
-    c_lo = fls + (0, -11.5, -11.5)
-    skin.combine(lambda p: ellipsoid(p, c_lo, (22.0, 6.5, 9.5)), c_lo - 30, c_lo + 30, "union", 4)
-    stomion_y = fls[1] - 5.0
-    m_a, m_b = np.array([-25.0, stomion_y, fls[2] - 8.0]), np.array([25.0, stomion_y, fls[2] - 8.0])
-    skin.combine(lambda p: capsule(p, m_a, m_b, 1.2), m_a - 6, m_b + (0, 6, 20), "subtract", 1.0)
-    # Ears, lateral to porion.
-    for sx in (1, -1):
-        por = d["canal"] * (sx, 1, 1)
-        hit = skin.ray_hit([(sx * 101.0, por[1], por[2])], (-sx, 0, 0))[0]
-        c = np.array([hit[0] + sx * 3.0, por[1] + 6.0, por[2] - 8.0])
-        r = np.array([2.5, 29.0, 15.0]) * s.ear
-        rot = rotation_xyz(-15.0, sx * 12.0, 0.0)
-        skin.combine(
-            lambda p, c=c, r=r, rot=rot: ellipsoid(p, c, r, rot), c - 36, c + 36, "union", 3
+    n = np.array(direction, float)
+    n[flat_axis] = 0.0
+    n /= np.linalg.norm(n)
+    sigma = float(radius)
+    need = margin - float(field.sample(target[None])[0])
+    if need > 0:
+        field.combine(
+            lambda p: (
+                need
+                * np.exp(
+                    -((p[0] - target[0]) ** 2 + (p[1] - target[1]) ** 2 + (p[2] - target[2]) ** 2)
+                    / (2 * sigma**2)
+                )
+            ),
+            target - 3.5 * sigma,
+            target + 3.5 * sigma,
+            "add",
         )
-    skin.combine(
-        lambda p: plane(p, (0, NECK_CUT_Y_MM, 0), (0, -1, 0)),
-        skin.lo,
-        skin.lo + 1e4,
-        "intersect",
-        0,
+    c = target - radius * n
+    field.combine(
+        lambda p: ellipsoid(p, c, (radius,) * 3), c - radius - 4, c + radius + 4, "union", 1.0
     )
 
+
+def _sight_lines(name, target):
+    """Directions (skull frame, towards the camera) along which ``name`` must be seen."""
+    t10, t9 = np.tan(np.radians(10.0)), np.tan(np.radians(SIGHT_YAW_DEG))
+    if name.startswith(("zygion", "gonion")):  # frontal outline, far-side yaw included
+        sx = 1.0 if target[0] > 0 else -1.0
+        return [(-sx * a, b, 1.0) for a in (0.0, t9) for b in (-t10, 0.0, t10)]
+    if name == "subnasale":  # frontal, pitched either way
+        return [(a, b, 1.0) for a in (-t9, 0.0, t9) for b in (-t10, 0.0, t10)]
+    # Profile landmarks, seen from either side.
+    return [(sx, b, 0.0) for sx in (1.0, -1.0) for b in (-t10, 0.0, t10)]
+
+
+def _clear_sight(field, target, directions, start_mm=3.5, length_mm=32.0, sigma=3.0):
+    """Push the skin off the lines of sight from ``target`` (in place).
+
+    Every point of the segments ``target + t * d`` (``t`` from ``start_mm`` to ``length_mm``)
+    that lies inside the skin gets a Gaussian of width ``sigma`` that moves the skin just
+    behind it, so a camera along ``d`` sees the target within the visibility tolerance.
+    """
+    t = np.arange(start_mm, length_mm, 1.0)
+    for d in directions:
+        d = np.asarray(d, float) / np.linalg.norm(d)
+        pts = target + t[:, None] * d
+        f = field.sample(pts)
+        for q, fq in zip(pts, f, strict=True):
+            need = min(0.6 - float(fq), 6.0)
+            if fq >= 0.3:
+                continue
+            field.combine(
+                lambda p, q=q, need=need: (
+                    need
+                    * np.exp(
+                        -((p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2)
+                        / (2 * sigma**2)
+                    )
+                ),
+                q - 3.5 * sigma,
+                q + 3.5 * sigma,
+                "add",
+            )
+
+
+def _ear(field, porion, sx, scale):
+    """Add an external ear (auricle) lateral to ``porion`` (in place).
+
+    A shell about 60 mm tall and 34 mm wide whose rim (helix) stands 15-20 mm off the side of
+    the head, flaring backwards, with a hollow concha in front of the canal and a lobule.
+    """
+    hit = field.ray_hit([(sx * 101.0, porion[1], porion[2])], (-sx, 0, 0))[0]
+    side = hit[0] if np.isfinite(hit[0]) else porion[0] + sx * 8.0
+    # Local frame: n = outward normal of the ear plane, u = up (tilted back), w = backwards.
+    rot = rotation_xyz(-12.0, sx * -32.0, 0.0)
+    n, u, w = rot @ (sx, 0.0, 0.0), rot @ (0.0, 1.0, 0.0), rot @ (0.0, 0.0, -1.0)
+    h, b = 30.0 * scale, 17.0 * scale
+    centre = np.array([side + sx * 7.0, porion[1] + 4.0, porion[2] - 12.0])
+    frame = np.column_stack([n, u, w])
+    field.combine(
+        lambda p: ellipsoid(p, centre, (4.0, h, b), frame), centre - 40, centre + 40, "union", 4.0
+    )
+    # Helix: a rolled rim along the upper and back border.
+    phi = np.linspace(-0.35 * np.pi, 1.25 * np.pi, 12)
+    ring = (
+        centre + 1.8 * n + np.outer(0.92 * h * np.sin(phi), u) + np.outer(0.92 * b * np.cos(phi), w)
+    )
+    ring = ring[::-1]
+    for a_, b_ in zip(ring[:-1], ring[1:], strict=True):
+        field.combine(
+            lambda p, a_=a_, b_=b_: capsule(p, a_, b_, 2.6),
+            np.minimum(a_, b_) - 7,
+            np.maximum(a_, b_) + 7,
+            "union",
+            1.5,
+        )
+    # Concha: the bowl in front of the canal; the stalk joining the ear to the head.
+    cc = centre + 4.5 * n - 0.15 * h * u - 0.2 * b * w
+    field.combine(
+        lambda p: ellipsoid(p, cc, (4.0, 0.38 * h, 0.42 * b), frame),
+        cc - 20,
+        cc + 20,
+        "subtract",
+        1.5,
+    )
+    st_a = np.array([side - sx * 4.0, porion[1] - 2.0, porion[2] - 6.0])
+    st_b = centre - 2.0 * n - 0.1 * h * u
+    field.combine(
+        lambda p: capsule(p, st_a, st_b, 7.0, 6.0),
+        np.minimum(st_a, st_b) - 14,
+        np.maximum(st_a, st_b) + 14,
+        "union",
+        4.0,
+    )
+
+
+def _fit_targets(skin, names, targets):
+    """Gaussian bumps so that the skin's zero level passes through every target (in place)."""
     # Gaussian bumps so that the skin passes through every target. A target far from the
     # surface gets a wider bump (sigma >= 0.8 * its distance), so that the dent or bulge stays
     # open to the surface instead of making a cavity or an island.
@@ -804,6 +897,87 @@ def build_skin(bone, d, s, targets, depths):
                 p0 + 3.5 * si,
                 "add",
             )
+
+
+def build_skin(bone, d, s, targets, depths, cranial_of):
+    """The skin field (negative inside) passing through every facial target.
+
+    Parameters
+    ----------
+    targets : dict of facial name -> ndarray of shape (3,)
+    depths : dict of facial name -> float (mm)
+    cranial_of : dict of facial name -> ndarray of shape (3,)
+        The cranial landmark of each target (the soft-tissue direction is target - cranial).
+    """
+    sup = _support_field(bone, d, s)
+    skin = sup.copy()
+    names = list(targets)
+    anchors = [targets[n] for n in names]
+    anchor_depths = [depths[n] for n in names]
+    for sx in (1, -1):  # thin eyelids over the eyeballs
+        anchors.append(d["orbit"] * (sx, 1, 1) + (0, 0, 24.0))
+        anchor_depths.append(2.0)
+    skin.values = _distance_outside(sup) - _depth_field(skin, anchors, anchor_depths)
+
+    # Pads: the facial landmarks that lie on a silhouette (zygion and gonion on the face's
+    # lateral outline in frontal views; labiale superius, pogonion and gnathion on the profile)
+    # are made the tip of a small rounded pad whose surface normal there lies in the image
+    # plane of that view; the skin around is first pushed behind the target.
+    for nm, flat_axis, radius in PADS:
+        _pad(skin, targets[nm], targets[nm] - cranial_of[nm], flat_axis, radius)
+
+    # Nose: dorsum from the nasion to the tip, tip lobule, alae, columella. The lower border
+    # rises from the subnasale towards the tip (nasolabial angle > 90 deg), so the subnasale
+    # is seen from the front.
+    fn, fsn = targets["nasion"], targets["subnasale"]
+    proj = s.nose_projection_mm
+    rise = NOSE_RISE
+    tip = fsn + np.array([0.0, 7.0 + rise * proj, proj])
+    dorsum_a, dorsum_b = fn - (0, 5.0, 5.0), tip - (0, -3.0, 7.0)
+    skin.combine(
+        lambda p: capsule(p, dorsum_a, dorsum_b, 5.0, 6.5),
+        np.minimum(dorsum_a, dorsum_b) - 14,
+        np.maximum(dorsum_a, dorsum_b) + 14,
+        "union",
+        5.0,
+    )
+    c_tip = tip - (0, 0, 7.0)
+    skin.combine(lambda p: ellipsoid(p, c_tip, (9.5, 7.0, 7.0)), c_tip - 18, c_tip + 18, "union", 3)
+    for sx, nm in ((1, "alare_l"), (-1, "alare_r")):
+        fa = targets[nm]
+        c = fa - (sx * 6.0, -1.5, 4.0)
+        skin.combine(lambda p, c=c: ellipsoid(p, c, (7.0, 6.5, 9.0)), c - 16, c + 16, "union", 3)
+    col_a = fsn + (0.0, 2.6, 1.0)
+    col_b = fsn + (0.0, 2.6 + rise * (proj - 6.0), proj - 6.0)
+    skin.combine(lambda p: capsule(p, col_a, col_b, 2.6, 3.2), col_a - 16, col_b + 16, "union", 1.5)
+    # Lips, centred on the upper-lip target (which may lie a little off the midline).
+    fls = targets["labiale_superius"]
+    c_up = fls + (0, 1.5, -9.5)
+    skin.combine(lambda p: ellipsoid(p, c_up, (22.0, 7.0, 9.5)), c_up - 30, c_up + 30, "union", 3)
+    c_lo = fls + (0, -11.5, -11.5)
+    skin.combine(lambda p: ellipsoid(p, c_lo, (20.0, 6.5, 9.5)), c_lo - 30, c_lo + 30, "union", 3)
+    stomion_y = fls[1] - 5.0
+    m_a = np.array([fls[0] - 25.0, stomion_y, fls[2] - 8.0])
+    m_b = np.array([fls[0] + 25.0, stomion_y, fls[2] - 8.0])
+    skin.combine(lambda p: capsule(p, m_a, m_b, 1.2), m_a - 6, m_b + (0, 6, 20), "subtract", 1.0)
+    # The upper-lip tubercle: labiale superius is its most anterior point.
+    _pad(skin, fls, fls - cranial_of["labiale_superius"], 0, 4.0)
+    # Ears, lateral to porion.
+    for sx in (1, -1):
+        _ear(skin, d["canal"] * (sx, 1, 1), sx, s.ear)
+    skin.combine(
+        lambda p: plane(p, (0, NECK_CUT_Y_MM, 0), (0, -1, 0)),
+        skin.lo,
+        skin.lo + 1e4,
+        "intersect",
+        0,
+    )
+
+    for _round in range(2):
+        if _round:
+            for nm in SIGHT_NAMES:
+                _clear_sight(skin, targets[nm], _sight_lines(nm, targets[nm]))
+        _fit_targets(skin, names, targets)
     return skin, stomion_y
 
 
@@ -818,6 +992,33 @@ SKIN_FACES = 40_000
 def _mesh(field, target_faces):
     volume = Volume(-field.values, np.full(3, field.voxel), field.lo, source="synthetic volume")
     return volume_to_mesh(volume, 0.0, target_faces=target_faces)
+
+
+#: Largest distance (mm) from a facial landmark to the skin mesh; a subject whose meshing lost
+#: a landmark's piece of skin (a cavity or an island dropped as a small component) is rebuilt
+#: with new soft tissue.
+ON_SKIN_MM = 0.8
+SOFT_TISSUE_TRIES = 4
+
+
+def distance_to_mesh(vertices, faces, points, radius_mm=10.0, resolution=13):
+    """Approximate distance (mm) from each point to a triangle mesh (nearby triangles sampled
+    on a barycentric grid of ``resolution`` steps per edge; inf when none is near)."""
+    from scipy.spatial import cKDTree
+
+    tri = np.asarray(vertices, float)[np.asarray(faces)]
+    tree = cKDTree(tri.mean(axis=1))
+    a, b = np.meshgrid(np.linspace(0, 1, resolution), np.linspace(0, 1, resolution))
+    w = np.column_stack([a.ravel(), b.ravel()])
+    w = w[w.sum(axis=1) <= 1.0 + 1e-9]
+    out = np.full(len(points), np.inf)
+    for k, p in enumerate(np.atleast_2d(points)):
+        t = tri[tree.query_ball_point(p, radius_mm)]
+        if len(t):
+            q = t[:, None, 0] + w[None, :, :1] * (t[:, None, 1] - t[:, None, 0])
+            q = q + w[None, :, 1:] * (t[:, None, 2] - t[:, None, 0])
+            out[k] = np.sqrt(np.min(np.sum((q - p) ** 2, axis=2)))
+    return out
 
 
 def make_subject(subject_id, rng=None):
@@ -846,11 +1047,18 @@ def make_subject(subject_id, rng=None):
             strict=True,
         )
     )
-    depths, directions = draw_soft_tissue(cranial, normals, bone, rng)
-    targets = {facial: cranial[c] + depths[c] * directions[c] for c, facial in CORRESPONDENCES}
-    facial_depths = {facial: depths[c] for c, facial in CORRESPONDENCES}
-    skin, stomion_y = build_skin(bone, design, shape, targets, facial_depths)
-    skin_v, skin_f = _mesh(skin, SKIN_FACES)
+    cranial_of = {facial: cranial[c] for c, facial in CORRESPONDENCES}
+    for _attempt in range(SOFT_TISSUE_TRIES):
+        depths, directions = draw_soft_tissue(cranial, normals, bone, rng)
+        targets = {f: cranial[c] + depths[c] * directions[c] for c, f in CORRESPONDENCES}
+        facial_depths = {facial: depths[c] for c, facial in CORRESPONDENCES}
+        skin, stomion_y = build_skin(bone, design, shape, targets, facial_depths, cranial_of)
+        skin_v, skin_f = _mesh(skin, SKIN_FACES)
+        off = distance_to_mesh(skin_v, skin_f, np.array(list(targets.values())))
+        if np.max(off) <= ON_SKIN_MM:
+            break
+    else:
+        raise RuntimeError(f"synthetic face: landmarks {np.max(off):.1f} mm off the skin")
     facial = dict(targets)
     for sx, nm in ((1, "cheilion_l"), (-1, "cheilion_r")):
         x = sx * 21.0 * shape.fw
