@@ -30,12 +30,14 @@ e.g. the far-side zygion and gonion in a lateral view are dropped. A photo with 
 :data:`MIN_VISIBLE_LANDMARKS` visible landmarks usable for pose estimation (lateral views turned
 away from the camera hide the midline ones) is drawn again, camera and all.
 
-The face mask is the part of the render showing the head: skin triangles above a neck cut.
-In front of the gonia the cut is the plane through the facial gnathion and both facial gonia
-(the lower border of the jaw); behind the gonia it is the horizontal plane through the gonia.
-Each plane is lowered by :data:`NECK_CUT_MARGIN_MM`, and further where needed so that the whole
-skull lies above it: as in a real photo, the true skull projects inside the face mask (its
-P_skof is 0). The cut is a property of the subject, the same in every photo.
+Two cuts of the skin (see :func:`head_faces_of`): in front of the gonia a plane through the
+facial gnathion and both facial gonia (the lower border of the jaw), behind them the horizontal
+plane through the gonia. The *jaw-line cut* lowers them by :data:`NECK_CUT_MARGIN_MM`: the skin
+above it is the face's own outline, from which the chin-jaw curve of ``face_curve.json`` is taken
+(SPEC 5's mask rule applied to that outline). The *face mask* keeps the upper neck too: its cut
+lies :data:`NECK_SKULL_CLEARANCE_MM` below the whole skull, so that, as in a real photo of a head,
+the true skull projects inside the mask from every camera of the ranges (P_skof 0 at the truth).
+Both cuts are properties of the subject, the same in every photo.
 """
 
 from dataclasses import dataclass, field
@@ -63,8 +65,13 @@ IMAGE_SIZES = (
     (4000, 3000),
 )
 
-#: How far (mm) the neck cut plane is lowered below the jaw border / the gonia.
+#: How far (mm) the jaw-line cut is lowered below the jaw border / the gonia (the face outline).
 NECK_CUT_MARGIN_MM = 4.0
+
+#: How far (mm) below the skull the face mask's neck cut lies: with pitch, the skin under the
+#: jaw covers the mandible's lower border in the image, so a cut just under the bone would drop
+#: pixels the true skull projects onto.
+NECK_SKULL_CLEARANCE_MM = 20.0
 
 #: A photo is drawn again until at least this many landmarks with a cranial counterpart are
 #: visible (lateral views turned away from the camera can hide all midline landmarks).
@@ -167,6 +174,9 @@ class HeadModel:
     skin_faces : ndarray of shape (F, 3)
     head_faces : ndarray of shape (F,), bool
         Triangles above the neck cut (they make the face mask).
+    jaw_faces : ndarray of shape (F,), bool or None
+        Triangles above the jaw-line cut (the face's own outline, for the chin-jaw curve);
+        None = ``head_faces``.
     hull_points_mm : ndarray of shape (K, 3)
         Convex-hull vertices of the head part (their projection bounds the head's).
     facial_names : tuple of str
@@ -186,6 +196,7 @@ class HeadModel:
     facial_points_mm: np.ndarray
     nasion_mm: np.ndarray
     outward_wound: bool = False
+    jaw_faces: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -257,8 +268,7 @@ def head_faces_of(
         How far the cut planes are lowered at least.
     skull_vertices_mm : array_like of shape (K, 3), optional
         When given, each plane is lowered further where needed so that the whole skull lies
-        above it (plus ``margin_mm``): the true skull then projects inside the face mask, as
-        it does in a real photo.
+        at least ``margin_mm`` above it.
 
     Returns
     -------
@@ -298,13 +308,16 @@ def prepare_head(subject):
     if not facial:
         raise ValueError("the subject has no facial landmarks; a photo needs them")
     skull = getattr(subject, "skull_vertices_mm", None)
-    head = head_faces_of(vertices, faces, facial, skull_vertices_mm=skull)
+    jaw = head_faces_of(vertices, faces, facial)
+    head = jaw
+    if skull is not None:
+        head = head_faces_of(vertices, faces, facial, NECK_SKULL_CLEARANCE_MM, skull)
     head_points = vertices[np.unique(faces[head])]
     hull = head_points[ConvexHull(head_points).vertices]
     names = tuple(facial)
     points = np.array([facial[n] for n in names])
     nasion = facial["nasion"] if "nasion" in facial else points.mean(axis=0)
-    return HeadModel(vertices, faces, head, hull, names, points, nasion, outward)
+    return HeadModel(vertices, faces, head, hull, names, points, nasion, outward, jaw)
 
 
 def head_rotation(yaw_deg, pitch_deg, roll_deg):
@@ -428,7 +441,8 @@ def render_photo(head, camera):
     visible, uv = _render.visible_points(r, head.facial_points_mm, camera.skull2cam)
     landmarks_uv = {n: uv[i] for i, n in enumerate(head.facial_names)}
     visible_names = tuple(n for i, n in enumerate(head.facial_names) if visible[i])
-    curve = face_curve_from_mask(mask, camera.view, landmarks_uv)
+    jaw_lut = lut if head.jaw_faces is None else np.append(head.jaw_faces, False)
+    curve = face_curve_from_mask(jaw_lut[r.face_index], camera.view, landmarks_uv)
     return SyntheticPhoto(camera, image, mask, landmarks_uv, visible_names, curve)
 
 
