@@ -8,6 +8,8 @@ P4Pf problem). Convention as everywhere in Lilium: ``X_cam = R X + t``,
 import numpy as np
 import poselib
 
+_NONE = (np.empty((0, 3, 3)), np.empty((0, 3)), np.empty(0))
+
 
 def p4pf(uv_centred_px, points_mm):
     """All real solutions of the P4Pf problem.
@@ -31,9 +33,9 @@ def p4pf(uv_centred_px, points_mm):
         np.ascontiguousarray(points_mm, dtype=float),
         True,
     )
-    keep = [i for i, f in enumerate(focals) if f > 0 and np.isfinite(f)]
+    keep = [i for i, f in enumerate(focals) if 0 < f < np.inf]
     if not keep:
-        return np.empty((0, 3, 3)), np.empty((0, 3)), np.empty(0)
-    R = np.stack([poses[i].R for i in keep])
-    t = np.stack([poses[i].t for i in keep])
-    return R, t, np.asarray([focals[i] for i in keep], dtype=float)
+        return _NONE
+    R = np.array([poses[i].R for i in keep])
+    t = np.array([poses[i].t for i in keep])
+    return R, t, np.array([focals[i] for i in keep])

@@ -101,8 +101,9 @@ def msac(uv_centred_px, points_mm, options=RansacOptions(), rng=None):
     needed, drawn = options.max_iterations, 0
     while drawn < min(max(needed, options.min_iterations), options.max_iterations):
         Rs, ts, fs = [], [], []
-        for _ in range(options.chunk):
-            idx = rng.choice(n, size=4, replace=False)
+        # A chunk of 4-point samples without repetition, drawn in one call.
+        samples = np.argsort(rng.random((options.chunk, n)), axis=1)[:, :4]
+        for idx in samples:
             R, t, f = p4pf(uv_centred_px[idx], points_mm[idx])
             Rs.append(R)
             ts.append(t)
