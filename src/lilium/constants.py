@@ -6,6 +6,10 @@ C_INF = 1e12
 #: Largest focal length (pixels) a real lens/sensor combination is taken to reach (SPEC 4, 5).
 FOCAL_MAX_PX = 10_000.0
 
+#: Smallest focal length (pixels) taken as a camera: below one pixel the "camera" is a collapsed
+#: fit, not a lens (treated like SPEC's f <= 0 failure).
+FOCAL_MIN_PX = 1.0
+
 #: Smallest camera-frame depth (mm) for a point to count as in front of the camera.
 MIN_DEPTH_MM = 1e-6
 

@@ -17,6 +17,8 @@ COMMANDS = [
     "lilium.cli.case",
     "lilium.cli.synth",
     "lilium.cli.import_ct",
+    "lilium.cli.experiment",
+    "lilium.cli.report",
 ]
 
 

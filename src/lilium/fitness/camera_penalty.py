@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import C_INF, FOCAL_MAX_PX
+from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX
 from ..geometry.rotations import geodesic_angle_deg
 
 
@@ -132,7 +132,7 @@ def camera_penalty(
     ok = np.ones(f.shape, bool) if success is None else np.asarray(success, dtype=bool)
     if ok.shape != f.shape:
         raise ValueError(f"success has shape {ok.shape}, focal_px has shape {f.shape}")
-    fail = ~ok | ~np.isfinite(f) | (f <= 0) | (f > FOCAL_MAX_PX)
+    fail = ~ok | ~np.isfinite(f) | (f < FOCAL_MIN_PX) | (f > FOCAL_MAX_PX)
     terms = np.zeros(f.shape)
 
     def add(x, name, penalty):

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..constants import C_INF, FOCAL_MAX_PX
+from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX
 from ..fitness.camera_penalty import camera_penalty_from_priors
 from ..geometry.camera import principal_point_of
 from ..optimisation.de import DEOptions, DifferentialEvolution
@@ -191,7 +191,7 @@ class LiliumProblem:
             self.n_fallbacks += len(bad)
             Rb, tb, fb, okb = self._posest_each(facial_mm, bad)
             R[bad], t[bad], f[bad] = Rb[bad], tb[bad], np.where(okb[bad], fb[bad], np.nan)
-        ok = (f > 0) & (f <= FOCAL_MAX_PX)
+        ok = (f >= FOCAL_MIN_PX) & (f <= FOCAL_MAX_PX)
         sq = reprojection_sq_errors(self.uv_c, facial_mm, R, t, np.where(ok, f, 1.0))
         sq[~ok] = np.inf
         return R, t, f, ok, sq

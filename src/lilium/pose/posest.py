@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..constants import FOCAL_MAX_PX, MIN_CORRESPONDENCES, RANSAC_THRESHOLD_PX
+from ..constants import FOCAL_MAX_PX, FOCAL_MIN_PX, MIN_CORRESPONDENCES, RANSAC_THRESHOLD_PX
 from .ransac import RansacOptions, msac
 from .refine import RefineOptions, refine_batch
 from .residuals import reprojection_sq_errors
@@ -87,8 +87,8 @@ def failure(message, principal_point_px):
 
 def check_camera(R, t, focal_px, sq_err_px2, focal_max_px=FOCAL_MAX_PX):
     """Why a camera is unacceptable, or "" if it is fine (SPEC section 4 failures)."""
-    if not np.isfinite(focal_px) or focal_px <= 0:
-        return f"focal length {focal_px:.4g} px is not positive"
+    if not np.isfinite(focal_px) or focal_px < FOCAL_MIN_PX:
+        return f"focal length {focal_px:.4g} px is not positive (below {FOCAL_MIN_PX:g} px)"
     if focal_px > focal_max_px:
         return f"focal length {focal_px:.4g} px exceeds the {focal_max_px:.0f} px limit"
     if not np.all(np.isfinite(sq_err_px2)):

@@ -1,0 +1,320 @@
+"""Experiment configuration (a small TOML file) and the presets ``quick`` and ``paper``.
+
+A config names the dataset (an existing folder with ``dataset.json``, or one to generate), the
+experiments (A, B, C of SPEC section 7), the methods, the repetitions, the DE settings of Lilium,
+the number of local workers and the results database. Relative paths are relative to the config
+file's folder (to the current folder for a preset). Example::
+
+    preset = "quick"                 # optional: start from a preset, override below
+    name = "my-run"
+    experiments = ["A", "B", "C"]
+    methods = ["posest-sfo", "lilium:base", "lilium:pll", "lilium:skof", "lilium:skof+pll"]
+    repetitions = 5                  # Lilium runs per SFO in A and B
+    axes_sets = 5                    # Exp. C: perturbed soft-tissue axis sets
+    runs_per_axes_set = 5            # Exp. C: Lilium runs per axis set
+    seed = 0                         # Lilium run r uses the seed ``seed + r``
+    workers = 0                      # local processes; 0 = all cores
+    db = "results.sqlite"
+
+    [dataset]
+    path = "dataset"
+    generate = true                  # generate it when dataset.json is missing
+    subjects = 5
+    photos = 2                       # frontal photos per subject (as many lateral)
+    seed = 0
+
+    [de]
+    population = 10
+    generations = 10
+    max_seconds = 10.0
+
+``methods`` entries are ``"posest-sfo"``, ``"lilium:<variant>"`` (variant among ``base``,
+``pll``, ``skof``, ``skof+pll``) or ``"lilium"`` for all four variants.
+"""
+
+import hashlib
+import json
+import tomllib
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+
+#: The experiments of SPEC section 7.
+EXPERIMENTS = ("A", "B", "C")
+
+#: Lilium fitness variants (kept in step with :data:`lilium.methods.lilium.VARIANTS`).
+LILIUM_VARIANTS = ("base", "pll", "skof", "skof+pll")
+
+#: Every method of the paper's protocol, as (method, variant) pairs.
+ALL_METHODS = (("posest-sfo", ""),) + tuple(("lilium", v) for v in LILIUM_VARIANTS)
+
+
+@dataclass(frozen=True)
+class DatasetConfig:
+    """Where the dataset lies and, when it is to be generated, how.
+
+    Attributes
+    ----------
+    path : Path
+        Folder holding ``dataset.json`` (the layout of :mod:`lilium.synthetic.dataset`).
+    generate : bool
+        Generate the dataset when ``path/dataset.json`` is missing.
+    subjects : int
+    photos : int
+        Frontal photos per subject; as many lateral ones.
+    seed : int
+    """
+
+    path: Path = Path("dataset")
+    generate: bool = True
+    subjects: int = 5
+    photos: int = 2
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class DESettings:
+    """Lilium's differential-evolution budget (population, generations, wall clock per SFO)."""
+
+    population: int = 30
+    generations: int = 750
+    max_seconds: float | None = 500.0
+
+
+@dataclass(frozen=True)
+class ExperimentConfig:
+    """One run of the protocol (SPEC section 7).
+
+    Attributes
+    ----------
+    name : str
+    dataset : DatasetConfig
+    experiments : tuple of str
+        Subset of ``("A", "B", "C")``.
+    methods : tuple of (str, str)
+        ``(method, variant)``; variant ``""`` for POSEST-SFO.
+    repetitions : int
+        Lilium runs (seeds) per photo-skull pair in Exps. A and B.
+    axes_sets : int
+        Exp. C: perturbed axis sets ``axes_C1.json`` .. (POSEST-SFO runs once per set).
+    runs_per_axes_set : int
+        Exp. C: Lilium runs (seeds) per axis set.
+    seed : int
+        Lilium run ``r`` (0-based) uses the seed ``seed + r``.
+    de : DESettings
+    workers : int
+        Local processes; 0 = all cores.
+    db : Path
+        SQLite results database.
+    """
+
+    name: str = "experiment"
+    dataset: DatasetConfig = field(default_factory=DatasetConfig)
+    experiments: tuple = EXPERIMENTS
+    methods: tuple = ALL_METHODS
+    repetitions: int = 5
+    axes_sets: int = 5
+    runs_per_axes_set: int = 5
+    seed: int = 0
+    de: DESettings = field(default_factory=DESettings)
+    workers: int = 0
+    db: Path = Path("results.sqlite")
+
+    def fingerprint(self):
+        """Hash of the settings that change a result (a database holds one setting only)."""
+        key = {"de": asdict(self.de), "seed": self.seed, "dataset_seed": self.dataset.seed}
+        return hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:16]
+
+
+#: Presets. ``quick``: 5 subjects x 4 photos, all experiments and methods, reduced repetitions
+#: (2 in A and B; 2 axis sets x 2 runs in C) and a small DE budget (population 10, 10
+#: generations, 2 s per SFO at most): 3,600 SFOs, under 30 minutes on 2 cores (measured in
+#: docs/experiments.md).
+#: ``paper``: the paper's protocol (17 subjects x 60 photos, 5 repetitions, 5 x 5 runs in C,
+#: DE 750 generations or 500 s).
+PRESETS = {
+    "quick": ExperimentConfig(
+        name="quick",
+        dataset=DatasetConfig(Path("lilium-quick/dataset"), True, 5, 2, 0),
+        repetitions=2,
+        axes_sets=2,
+        runs_per_axes_set=2,
+        de=DESettings(population=10, generations=10, max_seconds=2.0),
+        db=Path("lilium-quick/results.sqlite"),
+    ),
+    "paper": ExperimentConfig(
+        name="paper",
+        dataset=DatasetConfig(Path("lilium-paper/dataset"), True, 17, 30, 0),
+        repetitions=5,
+        axes_sets=5,
+        runs_per_axes_set=5,
+        de=DESettings(population=30, generations=750, max_seconds=500.0),
+        db=Path("lilium-paper/results.sqlite"),
+    ),
+}
+
+_TOP_KEYS = {
+    "preset",
+    "name",
+    "experiments",
+    "methods",
+    "repetitions",
+    "axes_sets",
+    "runs_per_axes_set",
+    "seed",
+    "workers",
+    "db",
+    "dataset",
+    "de",
+}
+_DATASET_KEYS = {"path", "generate", "subjects", "photos", "seed"}
+_DE_KEYS = {"population", "generations", "max_seconds"}
+
+
+def parse_methods(entries, where="methods"):
+    """``["posest-sfo", "lilium:skof", "lilium"]`` -> ``(("posest-sfo", ""), ...)``."""
+    if isinstance(entries, str) or not isinstance(entries, (list, tuple)) or not entries:
+        raise ValueError(f"{where} must be a non-empty list of method names")
+    out = []
+    for entry in entries:
+        name = str(entry).strip().lower()
+        if name == "posest-sfo":
+            pairs = [("posest-sfo", "")]
+        elif name == "lilium":
+            pairs = [("lilium", v) for v in LILIUM_VARIANTS]
+        elif name.startswith("lilium:") and name[7:] in LILIUM_VARIANTS:
+            pairs = [("lilium", name[7:])]
+        else:
+            raise ValueError(
+                f"{where}: unknown method {entry!r}; use 'posest-sfo', 'lilium' or "
+                f"'lilium:<variant>' with variant among {', '.join(LILIUM_VARIANTS)}"
+            )
+        out.extend(p for p in pairs if p not in out)
+    return tuple(out)
+
+
+def method_label(method, variant):
+    """Display name: ``POSEST-SFO``, ``Lilium``, ``Lilium+P_pll``, ``Lilium+P_skof+P_pll``."""
+    if method == "posest-sfo":
+        return "POSEST-SFO"
+    if not variant or variant == "base":
+        return "Lilium"
+    return "Lilium+" + "+".join(f"P_{part}" for part in variant.split("+"))
+
+
+def _int(where, value, lo=0):
+    if isinstance(value, bool) or not isinstance(value, int) or value < lo:
+        raise ValueError(f"{where} must be an integer >= {lo}, got {value!r}")
+    return value
+
+
+def _check_keys(where, data, allowed):
+    if not isinstance(data, dict):
+        raise ValueError(f"{where} must be a table")
+    unknown = sorted(set(data) - allowed)
+    if unknown:
+        raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}; known: {sorted(allowed)}")
+
+
+def config_from_dict(data, base_dir=Path("."), where="config"):
+    """Build an :class:`ExperimentConfig` from a parsed TOML table.
+
+    Parameters
+    ----------
+    data : dict
+    base_dir : Path
+        Folder that relative paths are relative to.
+    where : str
+        Name of the source, for error messages.
+    """
+    _check_keys(where, data, _TOP_KEYS)
+    preset = data.get("preset")
+    if preset is not None and preset not in PRESETS:
+        raise ValueError(f"{where}: unknown preset {preset!r}; use one of {', '.join(PRESETS)}")
+    cfg = PRESETS[preset] if preset else ExperimentConfig()
+    base_dir = Path(base_dir)
+
+    def path(value, key):
+        if not isinstance(value, str) or not value:
+            raise ValueError(f"{where}: {key} must be a path string")
+        p = Path(value).expanduser()
+        return p if p.is_absolute() else base_dir / p
+
+    changes = {}
+    if "name" in data:
+        changes["name"] = str(data["name"])
+    if "experiments" in data:
+        exps = data["experiments"]
+        if isinstance(exps, str) or not isinstance(exps, list) or not exps:
+            raise ValueError(f"{where}: experiments must be a non-empty list of A, B, C")
+        bad = [e for e in exps if e not in EXPERIMENTS]
+        if bad:
+            raise ValueError(f"{where}: unknown experiment(s) {bad}; use A, B, C")
+        changes["experiments"] = tuple(e for e in EXPERIMENTS if e in exps)
+    if "methods" in data:
+        changes["methods"] = parse_methods(data["methods"], f"{where}: methods")
+    for key in ("repetitions", "axes_sets", "runs_per_axes_set"):
+        if key in data:
+            changes[key] = _int(f"{where}: {key}", data[key], lo=1)
+    if "seed" in data:
+        changes["seed"] = _int(f"{where}: seed", data["seed"])
+    if "workers" in data:
+        changes["workers"] = _int(f"{where}: workers", data["workers"])
+    changes["db"] = path(data["db"], "db") if "db" in data else base_dir / cfg.db
+
+    ds = data.get("dataset", {})
+    _check_keys(f"{where}: [dataset]", ds, _DATASET_KEYS)
+    ds_changes = {
+        "path": path(ds["path"], "dataset.path") if "path" in ds else base_dir / cfg.dataset.path
+    }
+    if "generate" in ds:
+        if not isinstance(ds["generate"], bool):
+            raise ValueError(f"{where}: dataset.generate must be true or false")
+        ds_changes["generate"] = ds["generate"]
+    for key in ("subjects", "photos"):
+        if key in ds:
+            ds_changes[key] = _int(f"{where}: dataset.{key}", ds[key], lo=1)
+    if "seed" in ds:
+        ds_changes["seed"] = _int(f"{where}: dataset.seed", ds["seed"])
+    changes["dataset"] = replace(cfg.dataset, **ds_changes)
+
+    de = data.get("de", {})
+    _check_keys(f"{where}: [de]", de, _DE_KEYS)
+    de_changes = {}
+    if "population" in de:
+        de_changes["population"] = _int(f"{where}: de.population", de["population"], lo=4)
+    if "generations" in de:
+        de_changes["generations"] = _int(f"{where}: de.generations", de["generations"], lo=1)
+    if "max_seconds" in de:
+        value = de["max_seconds"]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value < 0:
+            raise ValueError(f"{where}: de.max_seconds must be a number >= 0 (0 = no limit)")
+        de_changes["max_seconds"] = float(value) or None
+    changes["de"] = replace(cfg.de, **de_changes)
+    return replace(cfg, **changes)
+
+
+def load_config(source):
+    """Read a TOML config file, or return a preset by name (``"quick"``, ``"paper"``).
+
+    Parameters
+    ----------
+    source : str or Path
+        A preset name, or the path of a TOML file.
+
+    Returns
+    -------
+    ExperimentConfig
+        Paths resolved against the file's folder (the current folder for a preset).
+    """
+    if str(source) in PRESETS:
+        return config_from_dict({"preset": str(source)}, Path("."), where=f"preset {source}")
+    path = Path(source)
+    if not path.is_file():
+        raise ValueError(
+            f"{path}: config file not found; give a TOML file or a preset ({', '.join(PRESETS)})"
+        )
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{path}: not valid TOML ({exc})") from None
+    return config_from_dict(data, path.parent, where=str(path))

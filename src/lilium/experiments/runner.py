@@ -1,0 +1,572 @@
+"""Run the paper's protocol (SPEC section 7): enumerate the SFOs, run them, store each at once.
+
+Tasks: every photo x every skull x every method, for each experiment:
+
+- A, B: POSEST-SFO once (deterministic), each Lilium variant ``repetitions`` times (seeds
+  ``seed + r``), with the skull's own soft-tissue axes (``axes_set`` 0);
+- C: for each perturbed axis set ``k = 1..axes_sets`` (``axes_C<k>.json`` of the *tested*
+  skull): POSEST-SFO once, each Lilium variant ``runs_per_axes_set`` times.
+
+The worker (:func:`run_task`) reads the case (cached per process), runs the method and scores
+it: the ranking score, the BPE for positive pairs (photo of this skull's subject) and the
+projected-skull pixels outside the face mask (implausible SFOs). The parent writes each row to
+the :class:`~lilium.experiments.store.ResultStore` as it arrives, so a killed run loses only the
+SFOs in flight; a rerun skips the stored keys.
+
+Executors: a local process pool (default, all cores) or a Dask distributed cluster
+(``scheduler="tcp://host:8786"``); the dataset folder must then be readable by every worker at
+the same path (a shared file system).
+"""
+
+import functools
+import importlib.util
+import json
+import os
+import socket
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .config import DESettings
+from .store import KEY_COLUMNS, ResultStore
+
+#: Tasks in flight per worker (keeps workers busy without queueing the whole run).
+IN_FLIGHT_PER_WORKER = 3
+
+#: Cached cases per worker process (skulls are a few MB each).
+SKULL_CACHE = 48
+PHOTO_CACHE = 256
+
+#: Keys of the SFO result dictionary that are not stored (long, and not needed by the report).
+_DROPPED_RESULT_KEYS = ("history", "genes")
+
+#: Environment variables that pin numerical libraries to one thread per worker process.
+_THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+@dataclass(frozen=True)
+class Task:
+    """One SFO of the protocol (picklable; paths are absolute so Dask workers can read them).
+
+    Attributes
+    ----------
+    experiment, method, variant : str
+    axes_set : int
+        0 = the skull's own axes; ``k`` = ``axes_C<k>.json``.
+    repetition, seed : int
+    photo, subject : str
+        Photo id and tested skull (subject) id.
+    true_subject, view : str
+        The photo's subject and view.
+    subject_dir, photo_dir : str
+    axes_file : str or None
+    de : DESettings
+    """
+
+    experiment: str
+    method: str
+    variant: str
+    axes_set: int
+    repetition: int
+    seed: int
+    photo: str
+    subject: str
+    true_subject: str
+    view: str
+    subject_dir: str
+    photo_dir: str
+    axes_file: str | None
+    de: DESettings
+
+    @property
+    def key(self):
+        return tuple(getattr(self, c) for c in KEY_COLUMNS)
+
+
+# -- dataset ----------------------------------------------------------------------------------
+def load_dataset(cfg, workers=1, log=print):
+    """Read ``dataset.json`` of ``cfg.dataset.path``, generating the dataset first if allowed.
+
+    Returns
+    -------
+    root : Path
+        Absolute dataset folder.
+    index : dict
+        The dataset index (see :mod:`lilium.synthetic.dataset`).
+    """
+    from ..io.jsonio import read_json
+
+    root = Path(cfg.dataset.path).resolve()
+    index_path = root / "dataset.json"
+    if not index_path.is_file():
+        if not cfg.dataset.generate:
+            raise ValueError(
+                f"{index_path}: dataset index not found; generate the dataset (lilium synth) or "
+                "set dataset.generate = true in the config"
+            )
+        from ..synthetic.dataset import generate_dataset
+
+        log(
+            f"generating the dataset: {cfg.dataset.subjects} subjects x "
+            f"{2 * cfg.dataset.photos} photos -> {root}"
+        )
+        generate_dataset(
+            root,
+            cfg.dataset.subjects,
+            cfg.dataset.photos,
+            seed=cfg.dataset.seed,
+            experiments=("A", "B", "C"),
+            workers=max(1, min(workers, cfg.dataset.subjects)),
+        )
+    return root, read_json(index_path)
+
+
+def check_methods(methods):
+    """Fail early when a Lilium variant's fitness terms are not available."""
+    needs_terms = [v for m, v in methods if m == "lilium" and v != "base"]
+    if needs_terms and importlib.util.find_spec("lilium.methods.lilium_terms") is None:
+        raise ValueError(
+            f"the Lilium variant(s) {', '.join(needs_terms)} need lilium.methods.lilium_terms, "
+            "which this installation lacks; list only posest-sfo and lilium:base in methods"
+        )
+
+
+def enumerate_tasks(cfg, root, index):
+    """Every SFO of the protocol, ordered so that consecutive tasks share their case.
+
+    Parameters
+    ----------
+    cfg : ExperimentConfig
+    root : Path
+        Dataset folder.
+    index : dict
+        ``dataset.json``.
+
+    Returns
+    -------
+    list of Task
+    """
+    root = Path(root)
+    subjects = index["subjects"]
+    tasks = []
+    for exp in cfg.experiments:
+        for photo in index["photos"]:
+            if exp not in photo["paths"]:
+                raise ValueError(
+                    f"{root / 'dataset.json'}: photo {photo['id']} has no experiment {exp} "
+                    "folder; regenerate the dataset with all of A, B, C"
+                )
+        if exp == "C":
+            axes_sets = range(1, cfg.axes_sets + 1)
+            runs = cfg.runs_per_axes_set
+        else:
+            axes_sets, runs = (0,), cfg.repetitions
+        for k in axes_sets:
+            for photo in index["photos"]:
+                for subject in subjects:
+                    axes_file = None
+                    if k:
+                        names = subject.get("axes_C", [])
+                        if len(names) < k:
+                            raise ValueError(
+                                f"subject {subject['id']} has {len(names)} perturbed axis sets "
+                                f"but the config asks for axes_sets = {cfg.axes_sets}"
+                            )
+                        axes_file = str(root / subject["path"] / names[k - 1])
+                    for method, variant in cfg.methods:
+                        reps = [0] if method == "posest-sfo" else range(runs)
+                        for r in reps:
+                            tasks.append(
+                                Task(
+                                    experiment=exp,
+                                    method=method,
+                                    variant=variant,
+                                    axes_set=k,
+                                    repetition=r,
+                                    seed=0 if method == "posest-sfo" else cfg.seed + r,
+                                    photo=photo["id"],
+                                    subject=subject["id"],
+                                    true_subject=photo["subject"],
+                                    view=photo["view"],
+                                    subject_dir=str(root / subject["path"]),
+                                    photo_dir=str(root / photo["paths"][exp]),
+                                    axes_file=axes_file,
+                                    de=cfg.de,
+                                )
+                            )
+    return tasks
+
+
+# -- worker -------------------------------------------------------------------------------------
+@functools.lru_cache(maxsize=SKULL_CACHE)
+def _skull(subject_dir, axes_file):
+    from ..io.case import read_skull
+
+    return read_skull(subject_dir, axes_path=axes_file)
+
+
+_TOPOLOGIES = {}
+
+
+def _topology(subject_dir, skull):
+    """Edge topology of a subject's skull mesh (the same for every axis set)."""
+    from ..fitness.raster import mesh_edge_topology
+
+    if subject_dir not in _TOPOLOGIES:
+        if len(_TOPOLOGIES) >= SKULL_CACHE:
+            _TOPOLOGIES.pop(next(iter(_TOPOLOGIES)))
+        _TOPOLOGIES[subject_dir] = mesh_edge_topology(skull.faces)
+    return _TOPOLOGIES[subject_dir]
+
+
+@functools.lru_cache(maxsize=SKULL_CACHE)
+def _facial_truth(subject_dir):
+    from ..io.jsonio import read_json
+
+    path = Path(subject_dir) / "facial_landmarks.json"
+    return read_json(path)["landmarks"] if path.is_file() else None
+
+
+@functools.lru_cache(maxsize=PHOTO_CACHE)
+def _photo(photo_dir):
+    from ..io.case import read_photo
+    from ..io.jsonio import read_json
+
+    photo = read_photo(photo_dir, load_image=False)
+    truth = read_json(Path(photo_dir) / "photo.json").get("ground_truth") or {}
+    return photo, truth
+
+
+def _run_method(task, skull, photo):
+    if task.method == "posest-sfo":
+        from ..methods.posest_sfo import posest_sfo
+
+        return posest_sfo(skull, photo)
+    from ..methods.lilium import LiliumOptions, lilium_sfo
+    from ..optimisation.de import DEOptions
+
+    de = DEOptions(
+        population_size=task.de.population,
+        max_generations=task.de.generations,
+        max_seconds=task.de.max_seconds,
+    )
+    return lilium_sfo(skull, photo, LiliumOptions(variant=task.variant, de=de), seed=task.seed)
+
+
+def _finite(value):
+    return float(value) if value is not None and np.isfinite(value) else None
+
+
+def score_result(result, skull, photo, truth, facial_truth, topology=None):
+    """Evaluation columns of one SFO: BPE (positive pairs) and skull pixels outside the mask.
+
+    Parameters
+    ----------
+    result : SfoResult
+    skull : Skull
+    photo : Photo
+    truth : dict
+        ``ground_truth`` of ``photo.json`` (``landmarks_noise_free``).
+    facial_truth : dict or None
+        The subject's ``facial_landmarks.json`` landmarks; None for a negative pair.
+    topology : EdgeTopology, optional
+        Of the skull mesh (cached by the caller).
+
+    Returns
+    -------
+    dict
+        ``bpe_mm``, ``skull_px``, ``outside_px``, ``percent_outside`` (None where not defined).
+    """
+    from ..evaluation.metrics import back_projection_error_from_dicts, implausible_sfo
+    from ..fitness.skof import skull_raster
+    from ..geometry.camera import project
+
+    out = {"bpe_mm": None, "skull_px": None, "outside_px": None, "percent_outside": None}
+    if not result:
+        return out
+    noise_free = truth.get("landmarks_noise_free")
+    if facial_truth and noise_free:
+        out["bpe_mm"] = back_projection_error_from_dicts(
+            facial_truth,
+            noise_free,
+            result.skull2cam,
+            result.focal_px,
+            result.principal_point_px,
+        )
+    if photo.face_mask is not None:
+        uv = project(
+            skull.vertices_mm, result.skull2cam, result.focal_px, result.principal_point_px
+        )
+        width, height = photo.image_size_wh
+        mask = skull_raster(uv, skull.faces, (height, width), topology=topology)
+        imp = implausible_sfo(mask, photo.face_mask)
+        out.update(
+            skull_px=imp.skull_px, outside_px=imp.outside_px, percent_outside=imp.percent_outside
+        )
+    return out
+
+
+def run_task(task):
+    """Run one SFO and score it; returns the database row (a dict).
+
+    An invalid case (a ``ValueError``: too few landmarks, no face mask for P_skof, ...) is a
+    finished SFO with its ``error``; any other exception propagates (the task is not stored and
+    a rerun tries it again).
+    """
+    start = time.perf_counter()
+    row = {c: getattr(task, c) for c in KEY_COLUMNS}
+    row.update(
+        view=task.view,
+        true_subject=task.true_subject,
+        positive=int(task.subject == task.true_subject),
+        worker=f"{socket.gethostname()}:{os.getpid()}",
+    )
+    try:
+        skull = _skull(task.subject_dir, task.axes_file)
+        photo, truth = _photo(task.photo_dir)
+        result = _run_method(task, skull, photo)
+    except ValueError as exc:
+        row.update(success=0, error=str(exc), task_seconds=time.perf_counter() - start)
+        row["finished_at"] = time.time()
+        return row
+    facial_truth = _facial_truth(task.subject_dir) if row["positive"] else None
+    row.update(
+        score_result(result, skull, photo, truth, facial_truth, _topology(task.subject_dir, skull))
+    )
+    data = result.to_dict()
+    for key in _DROPPED_RESULT_KEYS:
+        data.pop(key, None)
+    row.update(
+        success=int(bool(result)),
+        score=_finite(result.fitness),
+        mse_pix=_finite(result.terms.get("mse_pix")),
+        p_cam=_finite(result.terms.get("p_cam")),
+        p_skof=_finite(result.terms.get("p_skof")),
+        p_pll=_finite(result.terms.get("p_pll")),
+        focal_px=_finite(result.focal_px) if result else None,
+        seconds=float(result.seconds),
+        generations=result.extra.get("generations"),
+        error=result.error or None,
+        result=json.dumps(data),
+        task_seconds=time.perf_counter() - start,
+        finished_at=time.time(),
+    )
+    return row
+
+
+def _init_worker():
+    import cv2
+
+    cv2.setNumThreads(1)
+
+
+# -- executors ----------------------------------------------------------------------------------
+def _local_results(tasks, workers):
+    """Yield ``(task, row or exception)`` from a local process pool (serial when workers = 1)."""
+    if workers <= 1:
+        _init_worker()
+        for task in tasks:
+            try:
+                yield task, run_task(task)
+            except Exception as exc:  # noqa: BLE001 - reported by the parent, retried on rerun
+                yield task, exc
+        return
+
+    import multiprocessing
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    saved = {v: os.environ.get(v) for v in _THREAD_VARS}
+    for v in _THREAD_VARS:  # inherited by the spawned workers
+        os.environ.setdefault(v, "1")
+    try:
+        pool = ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_init_worker,
+        )
+    finally:
+        for v, value in saved.items():
+            if value is None:
+                os.environ.pop(v, None)
+            else:
+                os.environ[v] = value
+    todo = iter(tasks)
+    pending = {}
+    try:
+
+        def fill():
+            while len(pending) < IN_FLIGHT_PER_WORKER * workers:
+                task = next(todo, None)
+                if task is None:
+                    return
+                pending[pool.submit(run_task, task)] = task
+
+        fill()
+        while pending:
+            done, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for future in done:
+                task = pending.pop(future)
+                try:
+                    outcome = future.result()
+                except Exception as exc:  # noqa: BLE001
+                    outcome = exc
+                yield task, outcome
+            fill()
+    except BaseException:
+        # Interrupted (Ctrl-C, or the consumer stopped): do not wait for long SFOs in flight.
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+
+
+def _dask_results(tasks, scheduler):
+    """Yield ``(task, row or exception)`` from a Dask distributed cluster.
+
+    ``scheduler`` is an address (``"tcp://host:8786"``) or a ``dask.distributed.Client``.
+    """
+    try:
+        from dask.distributed import Client, as_completed
+    except ImportError as exc:  # pragma: no cover - depends on the installation
+        raise ValueError(
+            "--scheduler needs dask.distributed; install it with pip install 'dask[distributed]'"
+        ) from exc
+    own = not isinstance(scheduler, Client)
+    client = Client(scheduler) if own else scheduler
+    todo = iter(tasks)
+    pending = {}
+    queue = as_completed()
+    try:
+
+        def fill():
+            threads = sum(client.nthreads().values()) or 1
+            while len(pending) < max(8, IN_FLIGHT_PER_WORKER * threads):
+                task = next(todo, None)
+                if task is None:
+                    return
+                future = client.submit(run_task, task, pure=False)
+                pending[future.key] = task
+                queue.add(future)
+
+        fill()
+        for future in queue:
+            task = pending.pop(future.key)
+            try:
+                outcome = future.result()
+            except Exception as exc:  # noqa: BLE001 - a failed or cancelled task, retried on rerun
+                outcome = exc
+            future.release()
+            yield task, outcome
+            fill()
+    finally:
+        for future in list(queue.futures):
+            future.cancel()
+        if own:
+            client.close()
+
+
+# -- driver -------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class RunSummary:
+    """What a call of :func:`run_experiment` did.
+
+    Attributes
+    ----------
+    total : int
+        SFOs of the protocol.
+    already_done : int
+        Found in the database at the start.
+    stored : int
+        Written by this call.
+    errors : list of (key, str)
+        Tasks that raised (not stored; a rerun tries them again).
+    seconds : float
+    db : Path
+    """
+
+    total: int
+    already_done: int
+    stored: int
+    errors: list
+    seconds: float
+    db: Path
+
+    @property
+    def complete(self):
+        return self.already_done + self.stored == self.total
+
+
+def run_experiment(cfg, scheduler=None, workers=None, db=None, progress=True, log=print):
+    """Run (or resume) the protocol of ``cfg``.
+
+    Parameters
+    ----------
+    cfg : ExperimentConfig
+    scheduler : str or dask.distributed.Client, optional
+        Run on this Dask cluster instead of the local process pool.
+    workers : int, optional
+        Local processes (default ``cfg.workers``; 0 = all cores).
+    db : path, optional
+        Results database (default ``cfg.db``).
+    progress : bool
+        Show a tqdm progress bar (SFOs done, rate, ETA) on stderr.
+    log : callable
+        Receives one-line messages.
+
+    Returns
+    -------
+    RunSummary
+    """
+    start = time.perf_counter()
+    check_methods(cfg.methods)
+    workers = workers if workers is not None else cfg.workers
+    workers = workers or os.cpu_count() or 1
+    root, index = load_dataset(cfg, workers=workers, log=log)
+    tasks = enumerate_tasks(cfg, root, index)
+    db = Path(db or cfg.db)
+    with ResultStore(db) as store:
+        store.check_fingerprint(cfg.fingerprint(), what="DE settings or seeds")
+        store.set_meta("config", {"name": cfg.name, "dataset": str(root), "de": vars(cfg.de)})
+        done = store.done_keys()
+        todo = [t for t in tasks if t.key not in done]
+        already = len(tasks) - len(todo)
+        where = f"Dask at {scheduler}" if scheduler is not None else f"{workers} local worker(s)"
+        log(
+            f"{cfg.name}: {len(tasks)} SFOs, {already} already in {db}, {len(todo)} to run "
+            f"on {where}"
+        )
+        results = (
+            _dask_results(todo, scheduler)
+            if scheduler is not None
+            else _local_results(todo, workers)
+        )
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(tasks), initial=already, unit="SFO", smoothing=0.05, desc=cfg.name)
+        stored, errors = 0, []
+        try:
+            for task, outcome in results:
+                if isinstance(outcome, BaseException):
+                    errors.append((task.key, f"{type(outcome).__name__}: {outcome}"))
+                    if len(errors) <= 5:
+                        log(f"SFO {task.key} raised {type(outcome).__name__}: {outcome}")
+                else:
+                    stored += store.insert(outcome)
+                if bar is not None:
+                    bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
+            close = getattr(results, "close", None)
+            if close is not None:
+                close()
+    summary = RunSummary(len(tasks), already, stored, errors, time.perf_counter() - start, db)
+    log(
+        f"{cfg.name}: stored {stored} SFOs in {summary.seconds:.1f} s; "
+        f"{already + stored}/{len(tasks)} done"
+        + (f"; {len(errors)} raised (rerun to retry)" if errors else "")
+    )
+    return summary
