@@ -57,7 +57,7 @@ class LiliumOptions:
     variant: str = "skof+pll"
     de: DEOptions = field(default_factory=DEOptions)
     refine: RefineOptions = field(
-        default_factory=lambda: RefineOptions(max_iterations=10, cost_tol=1e-8, gradient_tol=1e-8)
+        default_factory=lambda: RefineOptions(max_iterations=6, cost_tol=1e-8, gradient_tol=1e-8)
     )
     posest: PosestOptions = field(default_factory=PosestOptions)
 

@@ -4,20 +4,23 @@ Glue between an SFO case (skull, photo) and the pure fitness functions of :mod:`
 each term is prepared once per SFO (regions, facial curve, mask index, mesh topology) and then
 evaluated for a whole population of cameras ``(R (S, 3, 3), t (S, 3), focal_px (S,))``.
 
-P_skof uses the skull decimated to :data:`SKOF_FACES` faces: projecting 50k faces for every
-individual dominates the run time, and the silhouette of a decimated skull differs from the full
-one by a fraction of a percent of its pixels (measured by ``benchmarks/bench_lilium.py``).
+P_skof uses the skull decimated to :data:`SKOF_FACES` faces (quadric decimation): rasterising
+the 50k-face skull for every individual would dominate the run time (1.8 ms against 0.43 ms per
+individual). Measured against the full mesh on 480 cameras near the truth (2 deg, 10 mm, 3 %
+focal) of 16 generated photos: the outside-pixel count differs by a median of -7 px, by at most
+40 px for 90 % of the cameras and 135 px at worst (8,000 faces: -5, 26 and 70 px).
 """
 
 import numpy as np
 
+from ..constants import MIN_DEPTH_MM
 from ..fitness.curves import face_curve_from_mask
 from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_batch
 
 #: Faces of the skull used for P_skof (decimated when larger).
-SKOF_FACES = 8000
+SKOF_FACES = 5000
 
 
 def project_population(points_mm, R, t, focal_px, principal_point_px):
@@ -36,11 +39,18 @@ def project_population(points_mm, R, t, focal_px, principal_point_px):
     uv : ndarray of shape (S, K, 2)
         NaN at or behind the camera.
     """
-    X = points_mm @ np.swapaxes(R, 1, 2) + t[:, None, :]
-    z = X[..., 2:3]
-    behind = z <= 1e-6
-    uv = principal_point_px + focal_px[:, None, None] * X[..., :2] / np.where(behind, 1.0, z)
-    return np.where(behind, np.nan, uv)
+    S = len(R)
+    # One (3S, 3) x (3, K) product instead of S small ones: X[s, i, k] = (R_s p_k)_i + t_s,i.
+    X = (np.reshape(R, (3 * S, 3)) @ np.asarray(points_mm, dtype=float).T).reshape(S, 3, -1)
+    X += t[:, :, None]
+    z = X[:, 2]
+    behind = z <= MIN_DEPTH_MM
+    scale = focal_px[:, None] / np.where(behind, 1.0, z)
+    scale[behind] = np.nan
+    uv = np.empty((S, X.shape[2], 2))
+    uv[..., 0] = X[:, 0] * scale + principal_point_px[0]
+    uv[..., 1] = X[:, 1] * scale + principal_point_px[1]
+    return uv
 
 
 def decimated(vertices_mm, faces, target_faces):
@@ -62,15 +72,17 @@ class SkofTerm:
         Must have a face mask.
     centre : ndarray of shape (2,)
         Principal point (pixels).
-    target_faces : int
+    target_faces : int, optional
+        Default :data:`SKOF_FACES`.
     """
 
-    def __init__(self, skull, photo, centre, target_faces=SKOF_FACES):
+    def __init__(self, skull, photo, centre, target_faces=None):
         if photo.face_mask is None:
             raise ValueError(
                 f"photo {photo.id!r} has no face_mask.png; the skof variants need the face mask "
                 "(or use the base or pll variant)"
             )
+        target_faces = SKOF_FACES if target_faces is None else target_faces
         self.vertices_mm, faces = decimated(skull.vertices_mm, skull.faces, target_faces)
         self.context = prepare_skof(faces, photo.face_mask)
         self.centre = centre
