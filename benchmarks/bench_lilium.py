@@ -13,6 +13,7 @@ import argparse
 import statistics
 import tempfile
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -45,6 +46,41 @@ def evaluate(result, skull, photo, truth, facial_truth):
     return bpe, imp.outside_px > 0, imp.percent_outside
 
 
+def _one_thread():
+    import os
+
+    import cv2
+
+    os.environ["OMP_NUM_THREADS"] = "1"
+    cv2.setNumThreads(1)
+
+
+def run_photo(task):
+    """POSEST-SFO and each Lilium variant on one Exp. C photo and its own skull."""
+    root, entry, axes_set, variants, de = task
+    photo_dir = root / entry["paths"]["C"]
+    truth = read_json(photo_dir / "photo.json")["ground_truth"]
+    subject_dir = root / "subjects" / entry["subject"]
+    skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{axes_set}.json")
+    photo = read_photo(photo_dir)
+    facial_truth = read_json(subject_dir / "facial_landmarks.json")["landmarks"]
+    runs = [("posest-sfo", lambda: posest_sfo(skull, photo))]
+    runs += [
+        (f"lilium {v}", lambda v=v: lilium_sfo(skull, photo, LiliumOptions(v, de), seed=0))
+        for v in variants
+    ]
+    rows = []
+    for name, run in runs:
+        t0 = time.perf_counter()
+        result = run()
+        seconds = time.perf_counter() - t0
+        bpe, implausible, pct = evaluate(result, skull, photo, truth, facial_truth)
+        rows.append(
+            (name, entry["view"].split("_")[0], bpe, implausible, pct, seconds, entry["id"])
+        )
+    return rows
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--dataset", type=Path, help="existing dataset folder (default: generate)")
@@ -56,6 +92,7 @@ def main(argv=None):
     p.add_argument("--generations", type=int, default=DEOptions().max_generations)
     p.add_argument("--population", type=int, default=DEOptions().population_size)
     p.add_argument("--limit", type=int, help="use only N photos (spread over the dataset)")
+    p.add_argument("--jobs", type=int, default=1, help="photos run in parallel (one per core)")
     args = p.parse_args(argv)
 
     root = args.dataset
@@ -73,33 +110,19 @@ def main(argv=None):
         photos = [photos[i] for i in pick]
     variants = [v for v in args.variants.split(",") if v]
     de = DEOptions(args.population, max_generations=args.generations)
+    tasks = [(root, entry, args.axes_set, variants, de) for entry in photos]
     rows = []
-    for k, entry in enumerate(photos):
-        photo_dir = root / entry["paths"]["C"]
-        truth = read_json(photo_dir / "photo.json")["ground_truth"]
-        subject_dir = root / "subjects" / entry["subject"]
-        skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{args.axes_set}.json")
-        photo = read_photo(photo_dir)
-        facial_truth = read_json(subject_dir / "facial_landmarks.json")["landmarks"]
-        runs = [("posest-sfo", lambda s=skull, p=photo: posest_sfo(s, p))]
-        runs += [
-            (
-                f"lilium {v}",
-                lambda v=v, s=skull, p=photo: lilium_sfo(s, p, LiliumOptions(v, de), seed=0),
-            )
-            for v in variants
-        ]
-        for name, run in runs:
-            t0 = time.perf_counter()
-            result = run()
-            seconds = time.perf_counter() - t0
-            bpe, implausible, pct = evaluate(result, skull, photo, truth, facial_truth)
-            rows.append((name, entry["view"].split("_")[0], bpe, implausible, pct, seconds))
-            print(
-                f"[{k + 1}/{len(photos)}] {entry['id']:>8} {name:<18} BPE {bpe:6.2f} mm  "
-                f"implausible {str(implausible):5}  {seconds:7.2f} s",
-                flush=True,
-            )
+    # One photo per process; each SFO runs single-threaded, so its time is one core's.
+    with ProcessPoolExecutor(args.jobs, initializer=_one_thread) as pool:
+        for k, photo_rows in enumerate(pool.map(run_photo, tasks)):
+            for row in photo_rows:
+                name, view, bpe, implausible, _, seconds, pid = row
+                print(
+                    f"[{k + 1}/{len(photos)}] {pid:>8} {name:<18} BPE {bpe:6.2f} mm  "
+                    f"implausible {str(implausible):5}  {seconds:7.2f} s",
+                    flush=True,
+                )
+            rows += [r[:6] for r in photo_rows]
 
     print(
         f"\nExp. C positive pairs: {len(photos)} photos, DE population {de.population_size}, "

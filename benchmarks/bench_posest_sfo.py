@@ -26,14 +26,20 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("dataset", type=Path)
     p.add_argument("--experiments", default="A,B,C")
+    p.add_argument("--limit", type=int, help="use only N photos (spread over the dataset)")
     args = p.parse_args(argv)
     root = args.dataset
     index = read_json(root / "dataset.json")
     ids = [s["id"] for s in index["subjects"]]
+    photos = index["photos"]
+    if args.limit and args.limit < len(photos):
+        photos = [
+            photos[i] for i in np.linspace(0, len(photos) - 1, args.limit).round().astype(int)
+        ]
     facial = {
         i: read_json(root / "subjects" / i / "facial_landmarks.json")["landmarks"] for i in ids
     }
-    print(f"{len(ids)} subjects, {len(index['photos'])} photos per experiment")
+    print(f"{len(ids)} subjects, {len(photos)} photos per experiment")
     print(
         f"{'exp':<4}{'view':<9}{'photos':>7}{'mean rank':>10}{'BPE mean':>10}{'BPE med':>9}"
         f"{'GT BPE max':>11}{'failed':>7}{'ms/SFO med':>11}"
@@ -45,7 +51,7 @@ def main(argv=None):
         ]
         stats = {"frontal": [], "lateral": []}
         times = []
-        for entry in index["photos"]:
+        for entry in photos:
             photo_dir = root / entry["paths"][exp]
             photo = read_photo(photo_dir, load_image=False)
             truth = read_json(photo_dir / "photo.json")["ground_truth"]

@@ -49,3 +49,31 @@ def test_population_is_evaluated_at_once_and_terms_add_up(case):
 def test_unknown_variant(case):
     with pytest.raises(ValueError, match="unknown Lilium variant 'fancy'"):
         LiliumProblem(read_skull(case[0]), read_photo(case[1]), LiliumOptions("fancy"))
+
+
+@pytest.mark.slow
+def test_full_method_recovers_the_camera_on_a_generated_noise_free_photo(tmp_path):
+    """skof+pll with the default DE budget on an Exp. A photo of a generated subject."""
+    from lilium.evaluation.metrics import back_projection_error_from_dicts
+    from lilium.io.jsonio import read_json
+    from lilium.synthetic.dataset import generate_dataset
+
+    index = generate_dataset(tmp_path, 1, 1, seed=3, experiments=("A",), workers=1)
+    subject_dir = tmp_path / index["subjects"][0]["path"]
+    facial = read_json(subject_dir / "facial_landmarks.json")["landmarks"]
+    for entry in index["photos"]:
+        photo_dir = tmp_path / entry["paths"]["A"]
+        truth = read_json(photo_dir / "photo.json")["ground_truth"]
+        result = lilium_sfo(read_skull(subject_dir), read_photo(photo_dir), LiliumOptions(), seed=0)
+        assert result and result.terms["p_skof"] == 0.0
+        assert abs(result.focal_px - truth["focal_px"]) / truth["focal_px"] < 0.05
+        R_true = np.array(truth["skull2cam"])[:3, :3]
+        assert geodesic_angle_deg(result.skull2cam[:3, :3], R_true) < 5.0
+        bpe = back_projection_error_from_dicts(
+            facial,
+            truth["landmarks_noise_free"],
+            result.skull2cam,
+            result.focal_px,
+            result.principal_point_px,
+        )
+        assert bpe < 3.0

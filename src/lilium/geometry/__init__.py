@@ -7,6 +7,7 @@ from .camera import (
     principal_point_of,
     project,
     project_batch,
+    project_population,
     subject_camera_distance,
 )
 from .rotations import (
@@ -26,6 +27,7 @@ __all__ = [
     "principal_point_of",
     "project",
     "project_batch",
+    "project_population",
     "rotvec_to_matrix",
     "subject_camera_distance",
 ]

@@ -53,14 +53,13 @@ def project(points_mm, skull2cam, focal_px, principal_point_px):
         Pixel coordinates; NaN for points with camera depth <= ``MIN_DEPTH_MM``.
     """
     T = np.asarray(skull2cam, dtype=float)
-    X = np.asarray(points_mm, dtype=float) @ T[:3, :3].T + T[:3, 3]
-    z = X[:, 2:3]
-    behind = z <= MIN_DEPTH_MM
-    uv = np.asarray(principal_point_px, dtype=float) + focal_px * X[:, :2] / np.where(
-        behind, 1.0, z
-    )
-    uv[behind[:, 0]] = np.nan
-    return uv
+    return project_population(
+        points_mm,
+        T[None, :3, :3],
+        T[None, :3, 3],
+        np.array([float(focal_px)]),
+        np.asarray(principal_point_px, dtype=float),
+    )[0]
 
 
 def project_batch(points_mm, R, t, focal_px, principal_point_px):
@@ -86,6 +85,36 @@ def project_batch(points_mm, R, t, focal_px, principal_point_px):
         ..., :2
     ] / np.where(behind, 1.0, z)
     return np.where(behind, np.nan, uv)
+
+
+def project_population(points_mm, R, t, focal_px, principal_point_px):
+    """Project one point set under S cameras.
+
+    Parameters
+    ----------
+    points_mm : ndarray of shape (K, 3)
+    R : ndarray of shape (S, 3, 3)
+    t : ndarray of shape (S, 3)
+    focal_px : ndarray of shape (S,)
+    principal_point_px : ndarray of shape (2,)
+
+    Returns
+    -------
+    uv : ndarray of shape (S, K, 2)
+        NaN at or behind the camera.
+    """
+    S = len(R)
+    # One (3S, 3) x (3, K) product instead of S small ones: X[s, i, k] = (R_s p_k)_i + t_s,i.
+    X = (np.reshape(R, (3 * S, 3)) @ np.asarray(points_mm, dtype=float).T).reshape(S, 3, -1)
+    X += t[:, :, None]
+    z = X[:, 2]
+    behind = z <= MIN_DEPTH_MM
+    scale = focal_px[:, None] / np.where(behind, 1.0, z)
+    scale[behind] = np.nan
+    uv = np.empty((S, X.shape[2], 2))
+    uv[..., 0] = X[:, 0] * scale + principal_point_px[0]
+    uv[..., 1] = X[:, 1] * scale + principal_point_px[1]
+    return uv
 
 
 def backproject_rays(uv, skull2cam, focal_px, principal_point_px):

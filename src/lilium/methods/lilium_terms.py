@@ -13,44 +13,14 @@ focal) of 16 generated photos: the outside-pixel count differs by a median of -7
 
 import numpy as np
 
-from ..constants import MIN_DEPTH_MM
 from ..fitness.curves import face_curve_from_mask
 from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_batch
+from ..geometry.camera import project_population
 
 #: Faces of the skull used for P_skof (decimated when larger).
 SKOF_FACES = 5000
-
-
-def project_population(points_mm, R, t, focal_px, principal_point_px):
-    """Project one point set under S cameras.
-
-    Parameters
-    ----------
-    points_mm : ndarray of shape (K, 3)
-    R : ndarray of shape (S, 3, 3)
-    t : ndarray of shape (S, 3)
-    focal_px : ndarray of shape (S,)
-    principal_point_px : ndarray of shape (2,)
-
-    Returns
-    -------
-    uv : ndarray of shape (S, K, 2)
-        NaN at or behind the camera.
-    """
-    S = len(R)
-    # One (3S, 3) x (3, K) product instead of S small ones: X[s, i, k] = (R_s p_k)_i + t_s,i.
-    X = (np.reshape(R, (3 * S, 3)) @ np.asarray(points_mm, dtype=float).T).reshape(S, 3, -1)
-    X += t[:, :, None]
-    z = X[:, 2]
-    behind = z <= MIN_DEPTH_MM
-    scale = focal_px[:, None] / np.where(behind, 1.0, z)
-    scale[behind] = np.nan
-    uv = np.empty((S, X.shape[2], 2))
-    uv[..., 0] = X[:, 0] * scale + principal_point_px[0]
-    uv[..., 1] = X[:, 1] * scale + principal_point_px[1]
-    return uv
 
 
 def decimated(vertices_mm, faces, target_faces):
