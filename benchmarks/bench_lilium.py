@@ -57,16 +57,17 @@ def _one_thread():
 
 def run_photo(task):
     """POSEST-SFO and each Lilium variant on one Exp. C photo and its own skull."""
-    root, entry, axes_set, variants, de = task
+    root, entry, axes_set, variants, de, seed = task
     photo_dir = root / entry["paths"]["C"]
     truth = read_json(photo_dir / "photo.json")["ground_truth"]
     subject_dir = root / "subjects" / entry["subject"]
     skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{axes_set}.json")
     photo = read_photo(photo_dir)
     facial_truth = read_json(subject_dir / "facial_landmarks.json")["landmarks"]
-    runs = [("posest-sfo", lambda: posest_sfo(skull, photo))]
+    # POSEST-SFO is deterministic: run once, with the first seed.
+    runs = [("posest-sfo", lambda: posest_sfo(skull, photo))] if seed == 0 else []
     runs += [
-        (f"lilium {v}", lambda v=v: lilium_sfo(skull, photo, LiliumOptions(v, de), seed=0))
+        (f"lilium {v}", lambda v=v: lilium_sfo(skull, photo, LiliumOptions(v, de), seed=seed))
         for v in variants
     ]
     rows = []
@@ -93,6 +94,7 @@ def main(argv=None):
     p.add_argument("--population", type=int, default=DEOptions().population_size)
     p.add_argument("--limit", type=int, help="use only N photos (spread over the dataset)")
     p.add_argument("--jobs", type=int, default=1, help="photos run in parallel (one per core)")
+    p.add_argument("--seeds", type=int, default=1, help="Lilium runs per photo (seeds 0..N-1)")
     args = p.parse_args(argv)
 
     root = args.dataset
@@ -110,7 +112,11 @@ def main(argv=None):
         photos = [photos[i] for i in pick]
     variants = [v for v in args.variants.split(",") if v]
     de = DEOptions(args.population, max_generations=args.generations)
-    tasks = [(root, entry, args.axes_set, variants, de) for entry in photos]
+    tasks = [
+        (root, entry, args.axes_set, variants, de, seed)
+        for seed in range(args.seeds)
+        for entry in photos
+    ]
     rows = []
     # One photo per process; each SFO runs single-threaded, so its time is one core's.
     with ProcessPoolExecutor(args.jobs, initializer=_one_thread) as pool:
@@ -118,7 +124,7 @@ def main(argv=None):
             for row in photo_rows:
                 name, view, bpe, implausible, _, seconds, pid = row
                 print(
-                    f"[{k + 1}/{len(photos)}] {pid:>8} {name:<18} BPE {bpe:6.2f} mm  "
+                    f"[{k + 1}/{len(tasks)}] {pid:>8} {name:<18} BPE {bpe:6.2f} mm  "
                     f"implausible {str(implausible):5}  {seconds:7.2f} s",
                     flush=True,
                 )
@@ -126,7 +132,8 @@ def main(argv=None):
 
     print(
         f"\nExp. C positive pairs: {len(photos)} photos, DE population {de.population_size}, "
-        f"{de.max_generations} generations at most, axes set C{args.axes_set}"
+        f"F {de.F}, CR {de.CR}, {de.max_generations} generations at most, axes set "
+        f"C{args.axes_set}, {args.seeds} Lilium run(s) per photo"
     )
     print(
         f"{'method':<18} {'view':<8} {'n':>3} {'BPE mean':>9} {'BPE med':>8} "
