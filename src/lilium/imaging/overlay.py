@@ -10,6 +10,7 @@ import numpy as np
 SKULL_RGB = np.array([235, 225, 190], dtype=float)
 PHOTO_LANDMARK_RGB = (0, 200, 255)
 ESTIMATE_RGB = (255, 40, 40)
+OUTLINE_RGB = (255, 170, 0)
 LIGHT_DIR_CAM = np.array([-0.3, -0.4, -1.0]) / np.linalg.norm([-0.3, -0.4, -1.0])
 
 
@@ -111,6 +112,11 @@ def draw_overlay(
     out = (1 - alpha) * out + alpha * skull_rgb
     out = np.clip(out, 0, 255).astype(np.uint8)
     scale = max(1, round(max(width, height) / 800))
+    # The skull's silhouette, so its outline can be judged against the face's.
+    contours, _ = cv2.findContours(
+        covered.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE
+    )
+    cv2.drawContours(out, contours, -1, OUTLINE_RGB, scale, cv2.LINE_AA)
     for curve, colour in curves or []:
         pts = np.round(np.asarray(curve)).astype(np.int32).reshape(-1, 1, 2)
         cv2.polylines(out, [pts], False, colour, scale, cv2.LINE_AA)
