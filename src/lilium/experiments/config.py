@@ -38,6 +38,10 @@ import tomllib
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
+from ..optimisation.de import DEOptions
+
+_DE_DEFAULTS = DEOptions()
+
 #: The experiments of SPEC section 7.
 EXPERIMENTS = ("A", "B", "C")
 
@@ -73,11 +77,12 @@ class DatasetConfig:
 
 @dataclass(frozen=True)
 class DESettings:
-    """Lilium's differential-evolution budget (population, generations, wall clock per SFO)."""
+    """Lilium's differential-evolution budget (population, generations, wall clock per SFO);
+    the defaults are :class:`lilium.optimisation.DEOptions`'s."""
 
-    population: int = 30
-    generations: int = 750
-    max_seconds: float | None = 500.0
+    population: int = _DE_DEFAULTS.population_size
+    generations: int = _DE_DEFAULTS.max_generations
+    max_seconds: float | None = _DE_DEFAULTS.max_seconds
 
 
 @dataclass(frozen=True)
@@ -147,7 +152,7 @@ PRESETS = {
         repetitions=5,
         axes_sets=5,
         runs_per_axes_set=5,
-        de=DESettings(population=30, generations=750, max_seconds=500.0),
+        de=DESettings(),
         db=Path("lilium-paper/results.sqlite"),
     ),
 }
