@@ -158,3 +158,19 @@ def test_user_depth_table(tmp_path):
     path.write_text("landmark,mean,sd,min,max\nnasion,seven,1,4,11\n")
     with pytest.raises(ValueError, match="line 2: mean, sd, min and max must be numbers"):
         read_depth_table(path)
+
+
+def test_exif_orientation_is_applied(tmp_path):
+    """A JPEG stored landscape with 'rotate 90 CW' in EXIF is read upright (portrait)."""
+    from PIL import Image
+
+    from lilium.io.case import read_image
+
+    stored = Image.new("RGB", (40, 20), (200, 10, 10))
+    stored.paste((10, 10, 200), (0, 0, 10, 20))  # blue band on the stored image's left
+    exif = Image.Exif()
+    exif[0x0112] = 6  # Orientation: rotate 90 CW to display
+    stored.save(tmp_path / "phone.jpg", exif=exif, quality=95)
+    upright = read_image(tmp_path / "phone.jpg")
+    assert upright.shape == (40, 20, 3)
+    assert upright[2, 10, 2] > 150 and upright[-3, 10, 0] > 150  # blue band now on top

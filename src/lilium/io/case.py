@@ -195,12 +195,16 @@ def parse_priors(path, priors):
 
 
 def read_image(path):
-    """Read an RGB image as ``(H, W, 3)`` uint8; a corrupt file is a ``ValueError``."""
-    from PIL import Image, UnidentifiedImageError
+    """Read an RGB image as ``(H, W, 3)`` uint8, upright; a corrupt file is a ``ValueError``.
+
+    The EXIF Orientation tag is applied (as image viewers do), so landmarks marked on a
+    phone photo stored sideways match the pixels read here.
+    """
+    from PIL import Image, ImageOps, UnidentifiedImageError
 
     try:
         with Image.open(path) as im:
-            return np.asarray(im.convert("RGB"))
+            return np.asarray(ImageOps.exif_transpose(im).convert("RGB"))
     except (UnidentifiedImageError, OSError, SyntaxError) as exc:
         raise ValueError(f"{path}: cannot read the image ({exc}); save it as PNG or JPEG") from exc
 
