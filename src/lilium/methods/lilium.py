@@ -131,29 +131,19 @@ class LiliumProblem:
         """Facial 3D landmarks ``(S, N, 3)`` of a population ``(S, 3N)``."""
         return self.corr.cranial_mm + decode(np.atleast_2d(genes), self.cones)
 
-    def _posest_each(self, facial_mm, indices):
-        S = len(facial_mm)
-        R, t, f = np.tile(np.eye(3), (S, 1, 1)), np.zeros((S, 3)), np.full(S, np.nan)
-        ok = np.zeros(S, bool)
-        for i in indices:
-            pose = posest(
-                self.corr.uv_px, facial_mm[i], self.centre, self.options.posest, rng=self.rng
-            )
-            if pose:
-                R[i], t[i], f[i], ok[i] = (
-                    pose.skull2cam[:3, :3],
-                    pose.skull2cam[:3, 3],
-                    pose.focal_px,
-                    True,
-                )
-        return R, t, f, ok
+    def _posest(self, facial_mm):
+        """Full POSEST for one member's facial landmarks: ``(R, t, focal_px)`` or None."""
+        pose = posest(self.corr.uv_px, facial_mm, self.centre, self.options.posest, rng=self.rng)
+        if not pose:
+            return None
+        return pose.skull2cam[:3, :3], pose.skull2cam[:3, 3], pose.focal_px
 
     def _initial_camera(self, facial_mm):
         """Camera of the first member whose POSEST succeeds (a 1 m guess if none does)."""
         for points in facial_mm:
-            pose = posest(self.corr.uv_px, points, self.centre, self.options.posest, rng=self.rng)
-            if pose:
-                return pose.skull2cam[:3, :3], pose.skull2cam[:3, 3], pose.focal_px
+            camera = self._posest(points)
+            if camera is not None:
+                return camera
         return np.eye(3), np.array([0.0, 0.0, 1000.0]), 1000.0
 
     def cameras(self, facial_mm, parents):
@@ -186,11 +176,10 @@ class LiliumProblem:
         # out of range is a real failure of that soft tissue (the fit runs off towards a weak
         # perspective): P_cam's C_INF, no fallback.
         broken = ~np.isfinite(ref.cost) | ~np.all(np.isfinite(ref.sq_err_px2), axis=1)
-        if broken.any():
-            bad = np.flatnonzero(broken)
-            self.n_fallbacks += len(bad)
-            Rb, tb, fb, okb = self._posest_each(facial_mm, bad)
-            R[bad], t[bad], f[bad] = Rb[bad], tb[bad], np.where(okb[bad], fb[bad], np.nan)
+        for i in np.flatnonzero(broken):
+            self.n_fallbacks += 1
+            camera = self._posest(facial_mm[i])
+            R[i], t[i], f[i] = camera if camera is not None else (R[i], t[i], np.nan)
         ok = (f >= FOCAL_MIN_PX) & (f <= FOCAL_MAX_PX)
         sq = reprojection_sq_errors(self.uv_c, facial_mm, R, t, np.where(ok, f, 1.0))
         sq[~ok] = np.inf
