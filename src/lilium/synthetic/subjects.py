@@ -762,21 +762,28 @@ def _pad(field, target, direction, flat_axis, radius, margin=1.0):
     sigma = float(radius)
     need = margin - float(field.sample(target[None])[0])
     if need > 0:
-        field.combine(
-            lambda p: (
-                need
-                * np.exp(
-                    -((p[0] - target[0]) ** 2 + (p[1] - target[1]) ** 2 + (p[2] - target[2]) ** 2)
-                    / (2 * sigma**2)
-                )
-            ),
-            target - 3.5 * sigma,
-            target + 3.5 * sigma,
-            "add",
-        )
+        _add_gaussian(field, target, need, sigma)
     c = target - radius * n
     field.combine(
         lambda p: ellipsoid(p, c, (radius,) * 3), c - radius - 4, c + radius + 4, "union", 1.0
+    )
+
+
+def _add_gaussian(field, centre, height, sigma):
+    """Add ``height * exp(-|p - centre|^2 / (2 sigma^2))`` to ``field`` (in place), evaluated
+    within 3.5 sigma of ``centre``."""
+    centre = np.asarray(centre, dtype=float)
+    field.combine(
+        lambda p: (
+            height
+            * np.exp(
+                -((p[0] - centre[0]) ** 2 + (p[1] - centre[1]) ** 2 + (p[2] - centre[2]) ** 2)
+                / (2 * sigma**2)
+            )
+        ),
+        centre - 3.5 * sigma,
+        centre + 3.5 * sigma,
+        "add",
     )
 
 
@@ -808,18 +815,7 @@ def _clear_sight(field, target, directions, start_mm=3.5, length_mm=32.0, sigma=
             need = min(0.6 - float(fq), 6.0)
             if fq >= 0.3:
                 continue
-            field.combine(
-                lambda p, q=q, need=need: (
-                    need
-                    * np.exp(
-                        -((p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2)
-                        / (2 * sigma**2)
-                    )
-                ),
-                q - 3.5 * sigma,
-                q + 3.5 * sigma,
-                "add",
-            )
+            _add_gaussian(field, q, need, sigma)
 
 
 def _ear(field, porion, sx, scale):
@@ -885,18 +881,7 @@ def _fit_targets(skin, names, targets):
     for _ in range(3):
         coef = np.linalg.solve(W, skin.sample(pts))
         for p0, ci, si in zip(pts, coef, sigma, strict=True):
-            skin.combine(
-                lambda p, p0=p0, ci=ci, si=si: (
-                    -ci
-                    * np.exp(
-                        -((p[0] - p0[0]) ** 2 + (p[1] - p0[1]) ** 2 + (p[2] - p0[2]) ** 2)
-                        / (2 * si**2)
-                    )
-                ),
-                p0 - 3.5 * si,
-                p0 + 3.5 * si,
-                "add",
-            )
+            _add_gaussian(skin, p0, -ci, si)
 
 
 def build_skin(bone, d, s, targets, depths, cranial_of):
