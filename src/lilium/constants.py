@@ -13,6 +13,9 @@ FOCAL_MIN_PX = 1.0
 #: Smallest camera-frame depth (mm) for a point to count as in front of the camera.
 MIN_DEPTH_MM = 1e-6
 
+#: Photo views (SPEC section 8): lateral_left = the face points towards the image's left edge.
+VIEWS = ("frontal", "lateral_left", "lateral_right")
+
 #: Fewest 2D-3D correspondences POSEST accepts (a P4Pf sample).
 MIN_CORRESPONDENCES = 4
 

@@ -19,6 +19,7 @@ import shlex
 from dataclasses import replace
 from pathlib import Path
 
+from ..constants import VIEWS
 from ..io.case import (
     IMAGE_NAMES,
     photo_from_files,
@@ -30,7 +31,7 @@ from ..io.case import (
 from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
 from ..io.results import write_result
-from ..methods.case import VIEWS, correspondences
+from ..methods.case import correspondences
 from ..methods.lilium import VARIANTS, lilium_sfo
 from ..methods.overlay import result_overlay
 from ..methods.posest_sfo import posest_sfo

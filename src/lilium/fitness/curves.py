@@ -18,15 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..constants import VIEWS
 from .raster import mesh_edge_topology, scan_crossings, winding_intervals
-
-VIEWS = ("frontal", "lateral_left", "lateral_right")
 
 #: Largest side (pixels) of the window a region is rasterised in; beyond, it is clipped.
 MAX_WINDOW_PX = 8192
 
 
 def check_view(view):
+    """Return ``view`` if it is one of :data:`lilium.constants.VIEWS`, else raise ValueError."""
     if view not in VIEWS:
         raise ValueError(f"view must be one of {VIEWS}, got {view!r}")
     return view

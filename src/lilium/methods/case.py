@@ -11,9 +11,6 @@ from ..constants import MIN_CORRESPONDENCES
 from ..fitness.camera_penalty import CameraPriors
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 
-VIEWS = ("frontal", "lateral_left", "lateral_right")
-
-
 #: A-priori camera information of a photo (focal and SCD intervals, head orientation and
 #: tolerance; each optional): the same object P_cam takes.
 Priors = CameraPriors

@@ -44,13 +44,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..constants import VIEWS
 from ..fitness import curves as _curves
+from ..fitness.curves import check_view
 from ..geometry.camera import principal_point_of, subject_camera_distance
 from ..geometry.rotations import rotvec_to_matrix
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
 from . import render as _render
-
-VIEWS = ("frontal", "lateral_left", "lateral_right")
 
 #: Common camera image sizes (width, height), landscape.
 IMAGE_SIZES = (
@@ -127,12 +127,6 @@ class CameraRanges:
 PRIOR_FOCAL_FRACTION = 0.05
 PRIOR_SCD_FRACTION = 0.10
 PRIOR_HEAD_TOLERANCE_DEG = 10.0
-
-
-def check_view(view):
-    if view not in VIEWS:
-        raise ValueError(f"view must be one of {VIEWS}, got {view!r}")
-    return view
 
 
 @dataclass(frozen=True)
