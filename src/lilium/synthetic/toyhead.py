@@ -1,18 +1,17 @@
 """A tiny stand-in subject: an ellipsoidal head with a nose, a chin and a neck.
 
 Used by the photo, dataset and metric tests (and while developing them) so that they do not
-depend on the full procedural subject generator. It carries the same fields as
+need to run the full procedural subject generator. It is a
 ``lilium.synthetic.subjects.SyntheticSubject``: skull and skin meshes (mm), cranial and facial
 landmarks (dicts name -> (3,)) and soft-tissue axes (dict cranial name -> unit (3,)).
 
 Skull frame: mm, x = the subject's left, y = up, z = anterior.
 """
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from ..softtissue.landmarks import CORRESPONDENCES, EXTRA_CRANIAL, EXTRA_FACIAL
+from .subjects import SyntheticSubject
 
 #: Facial landmark directions from the head centre: (azimuth towards the subject's left from
 #: anterior, elevation), degrees. Bilateral ones are given for the left side and mirrored.
@@ -42,20 +41,6 @@ _EXTRA_CRANIAL_DIRECTIONS_DEG = {
 
 _SKIN_SEMI_AXES_MM = np.array([74.0, 108.0, 96.0])
 _SOFT_TISSUE_MM = 7.0
-
-
-@dataclass(frozen=True)
-class ToySubject:
-    """Same fields as the procedural generator's ``SyntheticSubject``."""
-
-    subject_id: str
-    skull_vertices_mm: np.ndarray
-    skull_faces: np.ndarray
-    skin_vertices_mm: np.ndarray
-    skin_faces: np.ndarray
-    cranial_landmarks: dict = field(default_factory=dict)
-    facial_landmarks: dict = field(default_factory=dict)
-    soft_tissue_axes: dict = field(default_factory=dict)
 
 
 def _direction(az_deg, el_deg):
@@ -92,7 +77,8 @@ def make_toy_subject(subject_id="toy", rng=None, subdivisions=4):
 
     Returns
     -------
-    ToySubject
+    SyntheticSubject
+        With the fields the photo renderer needs (no ``shape``, depths or bone normals).
     """
     import trimesh
 
@@ -131,7 +117,7 @@ def make_toy_subject(subject_id="toy", rng=None, subdivisions=4):
     for cranial_name, facial_name in CORRESPONDENCES:
         v = facial[facial_name] - cranial[cranial_name]
         axes[cranial_name] = v / np.linalg.norm(v)
-    return ToySubject(
+    return SyntheticSubject(
         subject_id=str(subject_id),
         skull_vertices_mm=skull,
         skull_faces=faces.copy(),
