@@ -20,7 +20,6 @@ import numpy as np
 
 from lilium.evaluation.metrics import back_projection_error_from_dicts, implausible_sfo
 from lilium.fitness.skof import skull_raster
-from lilium.geometry.camera import project
 from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 from lilium.methods.lilium import VARIANTS, LiliumOptions, lilium_sfo
@@ -35,11 +34,9 @@ def evaluate(result, skull, photo, truth, facial_truth):
     bpe = back_projection_error_from_dicts(
         facial_truth,
         truth["landmarks_noise_free"],
-        result.skull2cam,
-        result.focal_px,
-        result.principal_point_px,
+        result.camera,
     )
-    uv = project(skull.vertices_mm, result.skull2cam, result.focal_px, result.principal_point_px)
+    uv = result.camera.project(skull.vertices_mm)
     w, h = photo.image_size_wh
     raster = skull_raster(uv, skull.faces, (h, w))
     imp = implausible_sfo(raster, photo.face_mask)

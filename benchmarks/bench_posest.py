@@ -44,7 +44,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from lilium.constants import FOCAL_MAX_PX, RANSAC_THRESHOLD_PX
-from lilium.geometry import geodesic_angle_deg, principal_point_of, project
+from lilium.geometry import Camera, geodesic_angle_deg, principal_point_of
 from lilium.pose import posest, refine_batch
 
 try:
@@ -103,9 +103,7 @@ def make_problem(rng, noise_px):
         if visible.sum() < n:
             continue
         points = points[np.flatnonzero(visible)[:n]]
-        T = np.eye(4)
-        T[:3, :3], T[:3, 3] = R, t
-        uv = project(points, T, focal, c)
+        uv = Camera.from_rt(R, t, focal, c).project(points)
         inside = np.all((uv >= 0) & (uv <= np.array(IMAGE_WH) - 1))
         if not inside:
             continue
@@ -115,9 +113,7 @@ def make_problem(rng, noise_px):
 
 def rms_px(problem, R, t, focal_px):
     """Reprojection RMS over all points (pixels)."""
-    T = np.eye(4)
-    T[:3, :3], T[:3, 3] = R, t
-    uv = project(problem.points_mm, T, focal_px, principal_point_of(IMAGE_WH))
+    uv = Camera.from_rt(R, t, focal_px, principal_point_of(IMAGE_WH)).project(problem.points_mm)
     return float(np.sqrt(np.mean(np.sum((uv - problem.uv_px) ** 2, axis=1))))
 
 
@@ -125,7 +121,7 @@ def run_posest(problem):
     result = posest(problem.uv_px, problem.points_mm, principal_point_of(IMAGE_WH))
     if not result:
         return None
-    return result.skull2cam[:3, :3], result.skull2cam[:3, 3], result.focal_px
+    return result.camera.R, result.camera.t, result.camera.focal_px
 
 
 def run_pycolmap(problem, seed):

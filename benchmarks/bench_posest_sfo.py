@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from lilium.evaluation.metrics import back_projection_error_from_dicts, rank_of_true
+from lilium.geometry.camera import Camera
 from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 from lilium.methods.posest_sfo import posest_sfo
@@ -66,9 +67,7 @@ def main(argv=None):
                         back_projection_error_from_dicts(
                             facial[skull.id],
                             truth["landmarks_noise_free"],
-                            result.skull2cam,
-                            result.focal_px,
-                            result.principal_point_px,
+                            result.camera,
                         )
                         if result
                         else np.nan
@@ -76,9 +75,7 @@ def main(argv=None):
                     gt_bpe = back_projection_error_from_dicts(
                         facial[skull.id],
                         truth["landmarks_noise_free"],
-                        truth["skull2cam"],
-                        truth["focal_px"],
-                        truth["principal_point_px"],
+                        Camera.from_dict(truth),
                     )
             rank = rank_of_true(scores, ids.index(truth["subject"]))
             stats[entry["view"].split("_")[0]].append((rank, bpe, gt_bpe))

@@ -30,7 +30,7 @@ from lilium.fitness.skof import (
     skull_raster_cv2,
     skull_raster_per_triangle,
 )
-from lilium.geometry.camera import project
+from lilium.geometry.camera import Camera
 
 HEIGHT, WIDTH = 1600, 2400
 FOCAL_PX = 2500.0
@@ -101,7 +101,7 @@ def bench_skof():
         topo = mesh_edge_topology(faces)
         poses = [skull2cam(25, 10), skull2cam(-40, -5), skull2cam(90, 0)]
         for T in poses:
-            uv = project(verts, T, FOCAL_PX, PRINCIPAL)
+            uv = Camera(T, FOCAL_PX, PRINCIPAL).project(verts)
             count = skull_outside_pixels(uv, topology=topo, mask_index=index)
             raster = skull_raster(uv, topology=topo, shape=(HEIGHT, WIDTH))
             exact = skull_raster_per_triangle(uv, faces, (HEIGHT, WIDTH))
@@ -126,7 +126,7 @@ def bench_skof():
             if not np.array_equal(raster, exact):
                 print(f"{'':>7} raster differs from the exact union at {(raster ^ exact).sum()} px")
         # A well-fitted individual: the skull inside a larger mask (most triangles culled).
-        uv = project(verts, poses[0], FOCAL_PX, PRINCIPAL)
+        uv = Camera(poses[0], FOCAL_PX, PRINCIPAL).project(verts)
         count = skull_outside_pixels(uv, topology=topo, mask_index=inside_index)
         call = partial(skull_outside_pixels, uv, topology=topo, mask_index=inside_index)
         t_in = timeit(call, 20)
@@ -143,7 +143,7 @@ def bench_pll():
     region = submesh((verts[:, 1] < -75) & (np.abs(verts[:, 0]) < 25), faces)
     sub_faces = region.faces
     T = skull2cam(10, 180)  # upside down so the cap is the lower part of the image
-    uv = project(region.vertices_of(verts), T, FOCAL_PX, PRINCIPAL)
+    uv = Camera(T, FOCAL_PX, PRINCIPAL).project(region.vertices_of(verts))
     shape = (HEIGHT, WIDTH)
     # Face mask: the region grown by a 12-px band.
     face_mask = ndimage.binary_dilation(skull_raster(uv, sub_faces, shape), iterations=12)

@@ -25,9 +25,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from lilium.fitness.skof import prepare_skof, skull_outside_pixels_batch
-from lilium.geometry.camera import principal_point_of
+from lilium.geometry.camera import Cameras, principal_point_of
 from lilium.io.case import read_photo, read_skull
-from lilium.methods.lilium_terms import PllTerm, SkofTerm, project_population
+from lilium.methods.lilium_terms import PllTerm, SkofTerm
 
 POPULATION = 30
 REPEAT = 5
@@ -73,10 +73,10 @@ def bench_case(name, skull, photo, truth):
     full = prepare_skof(skull.faces, photo.face_mask)
     for label, spread in SPREADS.items():
         R, t, f = cameras_around(truth["skull2cam"], truth["focal_px"], spread)
-        uv = project_population(pll.region_vertices_mm, R, t, f, centre)
+        uv = Cameras(R, t, f, centre).project(pll.region_vertices_mm)
         span_v = None
         if pll.span_mm is not None:
-            span_v = project_population(pll.span_mm, R, t, f, centre)[..., 1]
+            span_v = Cameras(R, t, f, centre).project(pll.span_mm)[..., 1]
         ctx = pll.context
 
         def reference(uv=uv, span_v=span_v, ctx=ctx):
@@ -90,14 +90,14 @@ def bench_case(name, skull, photo, truth):
         t_ref, ref = best_time(reference)
         t_new, new = best_time(lambda uv=uv, span_v=span_v, ctx=ctx: ctx.evaluate_batch(uv, span_v))
         diff = np.max(np.abs(ref - new))
-        t_skof, dec = best_time(lambda R=R, t=t, f=f: skof.outside_pixels(R, t, f))
-        uv_full = project_population(skull.vertices_mm, R, t, f, centre)
+        t_skof, dec = best_time(lambda R=R, t=t, f=f: skof.outside_pixels(Cameras(R, t, f, centre)))
+        uv_full = Cameras(R, t, f, centre).project(skull.vertices_mm)
         exact = skull_outside_pixels_batch(
             uv_full, topology=full.topology, mask_index=full.mask_index
         )
         t_full, _ = best_time(
             lambda R=R, t=t, f=f: skull_outside_pixels_batch(
-                project_population(skull.vertices_mm, R, t, f, centre),
+                Cameras(R, t, f, centre).project(skull.vertices_mm),
                 topology=full.topology,
                 mask_index=full.mask_index,
             ),

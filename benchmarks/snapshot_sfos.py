@@ -96,7 +96,16 @@ def main(argv=None):
         diffs = list(differences(before, records, args.rtol))
         for where, b, a in diffs[:60]:
             print(f"{where}: {b!r} -> {a!r}")
-        print(f"{len(records)} SFOs compared, {len(diffs)} field(s) differ (rtol {args.rtol:g})")
+        rel = [
+            abs(b - a) / max(abs(b), abs(a), 1e-12)
+            for _, b, a in diffs
+            if isinstance(b, (int, float)) and isinstance(a, (int, float))
+        ]
+        print(
+            f"{len(records)} SFOs compared, {len(diffs)} field(s) differ (rtol {args.rtol:g})"
+            + (f", largest relative difference {max(rel):.2g}" if rel else "")
+            + (f", {len(diffs) - len(rel)} non-numeric" if len(rel) < len(diffs) else "")
+        )
         return 1 if diffs else 0
     return 0
 

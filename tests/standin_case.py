@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lilium.geometry.camera import principal_point_of, project
+from lilium.geometry.camera import Camera, principal_point_of
 from lilium.geometry.rotations import rotvec_to_matrix
 from lilium.imaging.overlay import render_mesh_shaded
 from lilium.io.jsonio import write_json
@@ -98,13 +98,13 @@ def make_standin_case(folder, seed=0):
     skull2cam = np.eye(4)
     skull2cam[:3, :3] = R
     skull2cam[:3, 3] = np.array([0.0, 0.0, scd_mm]) - R @ facial["nasion"]
-    centre = principal_point_of(size_wh)
-    shade, covered = render_mesh_shaded(skin_v, skin_f, skull2cam, focal_px, centre, size_wh)
+    camera = Camera(skull2cam, focal_px, principal_point_of(size_wh))
+    shade, covered = render_mesh_shaded(skin_v, skin_f, camera, size_wh)
     image = np.full(size_wh[::-1] + (3,), 40, dtype=np.uint8)
     skin_rgb = np.array([224, 172, 140])
     image[covered] = (shade[covered, None] * skin_rgb).astype(np.uint8)
     names = list(facial)
-    uv = project(np.array([facial[n] for n in names]), skull2cam, focal_px, centre)
+    uv = camera.project(np.array([facial[n] for n in names]))
     write_png(photo_dir / "image.png", image)
     write_png(photo_dir / "face_mask.png", np.repeat(covered[..., None] * 255, 3, axis=2))
     write_json(

@@ -5,17 +5,15 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from lilium.geometry import (
-    backproject_rays,
+    Camera,
+    Cameras,
     check_rotation,
     check_skull2cam,
     geodesic_angle_deg,
     matrix_to_rotvec,
     point_ray_distance,
     principal_point_of,
-    project,
-    project_batch,
     rotvec_to_matrix,
-    subject_camera_distance,
 )
 
 PRINCIPAL_POINT_PX = np.array([1999.5, 1499.5])
@@ -36,17 +34,16 @@ def test_project_then_backproject_gives_rays_through_the_points():
     rng = np.random.default_rng(0)
     skull2cam = a_camera(rng)
     points = rng.normal(scale=80.0, size=(30, 3))
-    uv = project(points, skull2cam, 3000.0, PRINCIPAL_POINT_PX)
-    origin, directions = backproject_rays(uv, skull2cam, 3000.0, PRINCIPAL_POINT_PX)
+    camera = Camera(skull2cam, 3000.0, PRINCIPAL_POINT_PX)
+    uv = camera.project(points)
+    origin, directions = camera.rays(uv)
     np.testing.assert_allclose(np.linalg.norm(directions, axis=1), 1.0, atol=1e-12)
     np.testing.assert_allclose(point_ray_distance(points, origin, directions), 0.0, atol=1e-9)
     # The origin is the camera centre: it projects nowhere (depth 0) and maps to 0 in the camera.
     np.testing.assert_allclose(skull2cam[:3, :3] @ origin + skull2cam[:3, 3], 0.0, atol=1e-9)
     # Points along a ray project to the same pixel.
     further = origin + 1.5 * (points - origin)
-    np.testing.assert_allclose(
-        project(further, skull2cam, 3000.0, PRINCIPAL_POINT_PX), uv, atol=1e-8
-    )
+    np.testing.assert_allclose(camera.project(further), uv, atol=1e-8)
 
 
 def test_point_ray_distance_of_an_offset_point():
@@ -56,46 +53,65 @@ def test_point_ray_distance_of_an_offset_point():
 
 def test_points_behind_the_camera_are_nan_and_rows_keep_their_order():
     points = np.array([[0.0, 0.0, 100.0], [10.0, 0.0, -50.0], [0.0, 20.0, 200.0], [0, 0, 0.0]])
-    uv = project(points, np.eye(4), 1000.0, [0.0, 0.0])
+    uv = Camera(np.eye(4), 1000.0, [0.0, 0.0]).project(points)
     assert uv.shape == (4, 2)
     assert np.isnan(uv[1]).all() and np.isnan(uv[3]).all()
     np.testing.assert_allclose(uv[0], [0.0, 0.0])
     np.testing.assert_allclose(uv[2], [0.0, 100.0])
 
 
-def test_project_batch_matches_project():
+def test_cameras_project_like_each_camera_shared_and_per_member_points():
     rng = np.random.default_rng(1)
     cams = [a_camera(rng) for _ in range(3)]
     points = rng.normal(scale=60.0, size=(3, 10, 3))
     points[1, 4] = [0.0, 0.0, -5000.0]  # far behind camera 1 whatever its rotation
     cams[1][:3, :3] = np.eye(3)
     focal = np.array([1000.0, 2000.0, 3000.0])
-    uv = project_batch(
-        points,
+    cameras = Cameras(
         np.stack([c[:3, :3] for c in cams]),
         np.stack([c[:3, 3] for c in cams]),
         focal,
         PRINCIPAL_POINT_PX,
     )
+    uv = cameras.project(points)
+    shared = cameras.project(points[0])
     for s in range(3):
-        np.testing.assert_allclose(
-            uv[s], project(points[s], cams[s], focal[s], PRINCIPAL_POINT_PX), equal_nan=True
-        )
+        single = Camera(cams[s], focal[s], PRINCIPAL_POINT_PX)
+        np.testing.assert_allclose(uv[s], single.project(points[s]), equal_nan=True)
+        np.testing.assert_allclose(shared[s], single.project(points[0]), rtol=1e-12)
+        np.testing.assert_array_equal(cameras[s].skull2cam, cams[s])
     assert np.isnan(uv[1, 4]).all()
+    assert len(cameras.take(np.array([True, False, True]))) == 2
+
+
+def test_camera_dict_round_trip_and_crop():
+    camera = Camera(a_camera(np.random.default_rng(3)), 2500.0, [639.5, 479.5])
+    back = Camera.from_dict(camera.to_dict())
+    np.testing.assert_array_equal(back.skull2cam, camera.skull2cam)
+    assert back.focal_px == camera.focal_px
+    with pytest.raises(ValueError, match="focal_px must be > 0"):
+        Camera.from_dict({**camera.to_dict(), "focal_px": -1.0})
+    # A crop scaled by 2 sees the same points at twice the distance from the crop's origin.
+    points = np.random.default_rng(4).normal(scale=50.0, size=(6, 3))
+    crop = camera.cropped((100.0, 50.0), 2.0)
+    np.testing.assert_allclose(
+        crop.project(points) + 0.5, 2.0 * (camera.project(points) - [100.0, 50.0] + 0.5)
+    )
 
 
 def test_subject_camera_distance():
     skull2cam = np.eye(4)
     skull2cam[:3, 3] = [30.0, 40.0, 1200.0]
     np.testing.assert_allclose(
-        subject_camera_distance([0.0, 0.0, 0.0], skull2cam), 1201.0412, rtol=1e-7
+        Camera(skull2cam, 1.0, [0.0, 0.0]).distance_mm([0.0, 0.0, 0.0]), 1201.0412, rtol=1e-7
     )
     rng = np.random.default_rng(2)
     skull2cam = a_camera(rng)
     points = rng.normal(size=(5, 3))
     centre = -skull2cam[:3, :3].T @ skull2cam[:3, 3]
     np.testing.assert_allclose(
-        subject_camera_distance(points, skull2cam), np.linalg.norm(points - centre, axis=1)
+        Camera(skull2cam, 1.0, [0.0, 0.0]).distance_mm(points),
+        np.linalg.norm(points - centre, axis=1),
     )
 
 

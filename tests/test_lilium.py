@@ -20,9 +20,9 @@ def test_recovers_the_ground_truth_camera_on_a_noise_free_case(case):
         read_skull(subject_dir), read_photo(photo_dir), _opts(generations=600), seed=0
     )
     assert result and result.terms["p_cam"] == 0.0
-    assert abs(result.focal_px - truth["focal_px"]) / truth["focal_px"] < 0.08
+    assert abs(result.camera.focal_px - truth["focal_px"]) / truth["focal_px"] < 0.08
     R_true = np.array(truth["skull2cam"])[:3, :3]
-    assert geodesic_angle_deg(result.skull2cam[:3, :3], R_true) < 2.0
+    assert geodesic_angle_deg(result.camera.R, R_true) < 2.0
     # The true soft tissue lies in the cones: the fit gets within a few pixels.
     assert result.terms["mse_pix"] < 2.0
     history = result.extra["history"]
@@ -34,7 +34,7 @@ def test_same_seed_same_result(case):
     a = lilium_sfo(skull, photo, _opts(generations=15, population=10), seed=3)
     b = lilium_sfo(skull, photo, _opts(generations=15, population=10), seed=3)
     assert a.fitness == b.fitness and a.extra["genes"] == b.extra["genes"]
-    np.testing.assert_array_equal(a.skull2cam, b.skull2cam)
+    np.testing.assert_array_equal(a.camera.skull2cam, b.camera.skull2cam)
 
 
 def test_population_is_evaluated_at_once_and_terms_add_up(case):
@@ -72,14 +72,12 @@ def test_full_method_recovers_the_camera_on_a_generated_noise_free_photo(tmp_pat
         truth = read_json(photo_dir / "photo.json")["ground_truth"]
         result = lilium_sfo(read_skull(subject_dir), read_photo(photo_dir), LiliumOptions(), seed=0)
         assert result and result.terms["p_skof"] == 0.0
-        assert abs(result.focal_px - truth["focal_px"]) / truth["focal_px"] < 0.05
+        assert abs(result.camera.focal_px - truth["focal_px"]) / truth["focal_px"] < 0.05
         R_true = np.array(truth["skull2cam"])[:3, :3]
-        assert geodesic_angle_deg(result.skull2cam[:3, :3], R_true) < 5.0
+        assert geodesic_angle_deg(result.camera.R, R_true) < 5.0
         bpe = back_projection_error_from_dicts(
             facial,
             truth["landmarks_noise_free"],
-            result.skull2cam,
-            result.focal_px,
-            result.principal_point_px,
+            result.camera,
         )
         assert bpe < 3.0

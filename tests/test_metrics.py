@@ -8,7 +8,7 @@ from lilium.evaluation.metrics import (
     implausible_sfo,
     rank_of_true,
 )
-from lilium.geometry.camera import principal_point_of, project
+from lilium.geometry.camera import Camera, principal_point_of
 from lilium.geometry.rotations import rotvec_to_matrix
 
 
@@ -26,40 +26,40 @@ def _points(seed=0):
 def test_bpe_of_the_true_camera_is_zero():
     T, f, c = _camera()
     F = _points()
-    uv = project(F, T, f, c)
-    assert back_projection_error(F, uv, T, f, c) == pytest.approx(0.0, abs=1e-9)
+    uv = Camera(T, f, c).project(F)
+    assert back_projection_error(F, uv, Camera(T, f, c)) == pytest.approx(0.0, abs=1e-9)
     names = [f"p{i}" for i in range(len(F))]
     points, image = dict(zip(names, F, strict=True)), dict(zip(names, uv, strict=True))
-    bpe = back_projection_error_from_dicts(points, image, T, f, c)
+    bpe = back_projection_error_from_dicts(points, image, Camera(T, f, c))
     assert bpe == pytest.approx(0.0, abs=1e-9)
 
 
 def test_bpe_grows_with_the_camera_error():
     T, f, c = _camera()
     F = _points(1)
-    uv = project(F, T, f, c)
+    uv = Camera(T, f, c).project(F)
     previous = 0.0
     for shift_mm in (1.0, 5.0, 20.0):
         Te = T.copy()
         Te[:3, 3] += [shift_mm, 0.0, 0.0]
-        bpe = back_projection_error(F, uv, Te, f, c)
+        bpe = back_projection_error(F, uv, Camera(Te, f, c))
         assert bpe > previous
         previous = bpe
     # A pure lateral shift of s mm moves every ray by about s mm near the subject.
     assert previous == pytest.approx(20.0, rel=0.05)
     # A wrong focal length also shows.
-    assert back_projection_error(F, uv, T, 1.2 * f, c) > 1.0
-    assert back_projection_errors(F, uv, T, f, c).shape == (20,)
+    assert back_projection_error(F, uv, Camera(T, 1.2 * f, c)) > 1.0
+    assert back_projection_errors(F, uv, Camera(T, f, c)).shape == (20,)
 
 
 def test_bpe_rejects_bad_input():
     T, f, c = _camera()
     with pytest.raises(ValueError, match="one image point per 3D landmark"):
-        back_projection_errors(_points(), np.zeros((3, 2)), T, f, c)
+        back_projection_errors(_points(), np.zeros((3, 2)), Camera(T, f, c))
     with pytest.raises(ValueError, match="focal_px must be positive"):
-        back_projection_errors(_points(), np.zeros((20, 2)), T, 0.0, c)
+        back_projection_errors(_points(), np.zeros((20, 2)), Camera(T, 0.0, c))
     with pytest.raises(ValueError, match="share no landmark"):
-        back_projection_error_from_dicts({"a": [0, 0, 0]}, {"b": [0, 0]}, T, f, c)
+        back_projection_error_from_dicts({"a": [0, 0, 0]}, {"b": [0, 0]}, Camera(T, f, c))
 
 
 def test_rank_with_ties():

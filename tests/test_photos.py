@@ -2,7 +2,6 @@ import cv2
 import numpy as np
 import pytest
 
-from lilium.geometry.camera import project, subject_camera_distance
 from lilium.synthetic.photos import (
     MIN_VISIBLE_LANDMARKS,
     VIEWS,
@@ -44,20 +43,15 @@ def _fixed(view, yaw):
 def test_camera_is_seeded_and_within_ranges(head, view):
     a = sample_camera(head, view, 11, SMALL)
     b = sample_camera(head, view, 11, SMALL)
-    np.testing.assert_array_equal(a.skull2cam, b.skull2cam)
-    assert a.focal_px == b.focal_px and a.image_size_wh == b.image_size_wh
+    np.testing.assert_array_equal(a.camera.skull2cam, b.camera.skull2cam)
+    assert a.camera.focal_px == b.camera.focal_px and a.image_size_wh == b.image_size_wh
     lo, hi = SMALL.yaw_range_deg(view)
     assert lo <= a.yaw_deg <= hi
     assert SMALL.pitch_deg[0] <= a.pitch_deg <= SMALL.pitch_deg[1]
-    assert SMALL.focal_px[0] <= a.focal_px <= SMALL.focal_px[1]
+    assert SMALL.focal_px[0] <= a.camera.focal_px <= SMALL.focal_px[1]
     assert SMALL.scd_mm[0] <= a.scd_mm <= SMALL.scd_mm[1]
-    assert a.scd_mm == pytest.approx(subject_camera_distance(head.nasion_mm, a.skull2cam))
-    uv = project(
-        head.skin_vertices_mm[np.unique(head.skin_faces[head.head_faces])],
-        a.skull2cam,
-        a.focal_px,
-        a.principal_point_px,
-    )
+    assert a.scd_mm == pytest.approx(a.camera.distance_mm(head.nasion_mm))
+    uv = a.camera.project(head.skin_vertices_mm[np.unique(head.skin_faces[head.head_faces])])
     w, h = a.image_size_wh
     assert uv.min() >= 0 and uv[:, 0].max() <= w - 1 and uv[:, 1].max() <= h - 1
     assert np.ptp(uv[:, 0]) >= SMALL.min_head_width_px
@@ -143,10 +137,10 @@ def test_photo_record_has_spec_fields(head):
     assert rec["view"] == "lateral_right"
     assert set(rec["landmarks"]) == set(photo.visible)
     pri = rec["priors"]
-    f, d = photo.camera.focal_px, photo.camera.scd_mm
+    f, d = photo.camera.camera.focal_px, photo.camera.scd_mm
     assert pri["focal_px"] == pytest.approx([0.95 * f, 1.05 * f])
     assert pri["scd_mm"] == pytest.approx([0.9 * d, 1.1 * d])
-    np.testing.assert_allclose(pri["head_rotation_skull2cam"], photo.camera.skull2cam[:3, :3])
+    np.testing.assert_allclose(pri["head_rotation_skull2cam"], photo.camera.camera.R)
     assert pri["head_tolerance_deg"] == 10
     gt = rec["ground_truth"]
     assert {
@@ -168,8 +162,7 @@ def test_union_mask_matches_render_silhouette(subject):
     args = (
         subject.skull_vertices_mm,
         subject.skull_faces,
-        cam.skull2cam,
-        cam.focal_px,
+        cam.camera,
         cam.image_size_wh,
     )
     union = triangle_union_mask(*args)
@@ -191,8 +184,7 @@ def test_procedural_subject_skull_stays_inside_the_face_mask():
         skull = triangle_union_mask(
             subject.skull_vertices_mm,
             subject.skull_faces,
-            cam.skull2cam,
-            cam.focal_px,
+            cam.camera,
             cam.image_size_wh,
         )
         assert implausible_sfo(skull, photo.face_mask).percent_outside < 0.05, view
@@ -203,7 +195,6 @@ def test_procedural_subject_skull_stays_inside_the_face_mask():
 def test_true_skull_projects_inside_the_face_mask():
     """The neck cut never cuts the skull: at the true camera P_skof is 0 (as in a real photo)."""
     from lilium.fitness.skof import skull_outside_pixels
-    from lilium.geometry.camera import principal_point_of, project
     from lilium.synthetic.photos import make_photo, prepare_head
     from lilium.synthetic.subjects import make_subject
 
@@ -213,6 +204,5 @@ def test_true_skull_projects_inside_the_face_mask():
     for view in ("frontal", "lateral_left", "lateral_right") * 4:
         photo = make_photo(head, view, rng)
         cam = photo.camera
-        centre = principal_point_of(cam.image_size_wh)
-        uv = project(subject.skull_vertices_mm, cam.skull2cam, cam.focal_px, centre)
+        uv = cam.camera.project(subject.skull_vertices_mm)
         assert skull_outside_pixels(uv, subject.skull_faces, photo.face_mask) == 0

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from lilium.geometry import geodesic_angle_deg, project
+from lilium.geometry import Camera, geodesic_angle_deg
 from lilium.pose import (
     PosestOptions,
     RansacOptions,
@@ -38,7 +38,7 @@ def head_scene(rng, n=20, focal_px=None, depth_mm=None, yaw_deg=None):
         "YXZ", [-yaw, rng.uniform(-15, 15), rng.uniform(-10, 10)], degrees=True
     ).as_matrix()
     skull2cam[:3, 3] = [rng.uniform(-50, 50), rng.uniform(-50, 50), depth]
-    return points, skull2cam, focal, project(points, skull2cam, focal, PRINCIPAL_POINT_PX)
+    return points, skull2cam, focal, Camera(skull2cam, focal, PRINCIPAL_POINT_PX).project(points)
 
 
 @pytest.mark.parametrize("seed", range(8))
@@ -47,11 +47,11 @@ def test_noise_free_round_trip_is_exact(seed):
     result = posest(uv, points, PRINCIPAL_POINT_PX)
     assert result, result.message
     assert result.message == ""
-    assert abs(result.focal_px - focal) / focal < EXACT_FOCAL_REL
+    assert abs(result.camera.focal_px - focal) / focal < EXACT_FOCAL_REL
     assert result.rms_px < EXACT_RMS_PX
-    assert geodesic_angle_deg(result.skull2cam[:3, :3], skull2cam[:3, :3]) < 1e-6
-    np.testing.assert_allclose(result.skull2cam[:3, 3], skull2cam[:3, 3], rtol=1e-6)
-    np.testing.assert_array_equal(result.skull2cam[3], [0, 0, 0, 1])
+    assert geodesic_angle_deg(result.camera.R, skull2cam[:3, :3]) < 1e-6
+    np.testing.assert_allclose(result.camera.t, skull2cam[:3, 3], rtol=1e-6)
+    np.testing.assert_array_equal(result.camera.skull2cam[3], [0, 0, 0, 1])
     assert result.inliers.all()
 
 
@@ -62,8 +62,8 @@ def test_noisy_round_trip(seed):
     noisy = uv + rng.normal(scale=1.0, size=uv.shape)
     result = posest(noisy, points, PRINCIPAL_POINT_PX)
     assert result, result.message
-    assert abs(result.focal_px - focal) / focal < 0.05
-    assert geodesic_angle_deg(result.skull2cam[:3, :3], skull2cam[:3, :3]) < 2.0
+    assert abs(result.camera.focal_px - focal) / focal < 0.05
+    assert geodesic_angle_deg(result.camera.R, skull2cam[:3, :3]) < 2.0
     # Least squares: better than the true camera on the noisy points, about the noise level.
     true_rms = np.sqrt(np.mean(np.sum((uv - noisy) ** 2, axis=1)))
     assert result.rms_px <= true_rms + 1e-9
@@ -89,14 +89,14 @@ def test_msac_recovers_with_30_percent_gross_outliers():
     corrupted[bad] += rng.uniform(60.0, 400.0, (9, 2)) * rng.choice([-1.0, 1.0], (9, 2))
     result = posest(corrupted, points, PRINCIPAL_POINT_PX, rng=3)
     assert result, result.message
-    assert abs(result.focal_px - focal) / focal < EXACT_FOCAL_REL
+    assert abs(result.camera.focal_px - focal) / focal < EXACT_FOCAL_REL
     expected = np.ones(30, bool)
     expected[bad] = False
     np.testing.assert_array_equal(result.inliers, expected)
     np.testing.assert_allclose(result.errors_px[expected], 0.0, atol=EXACT_RMS_PX)
     # Plain least squares on every point is dragged off by the outliers (or fails).
     on_all = posest(corrupted, points, PRINCIPAL_POINT_PX, PosestOptions(refine_on="all"))
-    assert not on_all or abs(on_all.focal_px - focal) / focal > 1e-3
+    assert not on_all or abs(on_all.camera.focal_px - focal) / focal > 1e-3
 
 
 def test_same_seed_same_result():
@@ -105,8 +105,8 @@ def test_same_seed_same_result():
     noisy = uv + rng.normal(scale=2.0, size=uv.shape)
     a = posest(noisy, points, PRINCIPAL_POINT_PX, rng=5)
     b = posest(noisy, points, PRINCIPAL_POINT_PX, rng=np.random.default_rng(5))
-    assert a.focal_px == b.focal_px
-    np.testing.assert_array_equal(a.skull2cam, b.skull2cam)
+    assert a.camera.focal_px == b.camera.focal_px
+    np.testing.assert_array_equal(a.camera.skull2cam, b.camera.skull2cam)
 
 
 def test_msac_keeps_ranked_candidates():
@@ -192,7 +192,7 @@ def test_too_few_points_is_a_falsy_result():
     points, _, _, uv = head_scene(np.random.default_rng(30), n=3)
     result = posest(uv, points, PRINCIPAL_POINT_PX)
     assert not result
-    assert result.skull2cam is None and np.isnan(result.focal_px)
+    assert result.camera is None
     assert "3 correspondences, POSEST needs at least 4" in result.message
 
 
@@ -200,7 +200,7 @@ def test_collinear_points_are_a_falsy_result():
     points = np.outer(np.linspace(-80.0, 80.0, 12), [1.0, 0.5, 0.3])
     skull2cam = np.eye(4)
     skull2cam[2, 3] = 1000.0
-    uv = project(points, skull2cam, 3000.0, PRINCIPAL_POINT_PX)
+    uv = Camera(skull2cam, 3000.0, PRINCIPAL_POINT_PX).project(points)
     result = posest(uv, points, PRINCIPAL_POINT_PX)
     assert not result
     assert result.message == "no 4-point sample gave a real camera"
@@ -214,7 +214,7 @@ def test_focal_length_beyond_the_limit_is_a_falsy_result():
     assert "exceeds the 10000 px limit" in result.message
     # The same scene is fine once the limit allows it.
     relaxed = posest(uv, points, PRINCIPAL_POINT_PX, PosestOptions(focal_max_px=30_000.0))
-    assert relaxed and abs(relaxed.focal_px - 20_000.0) / 20_000.0 < EXACT_FOCAL_REL
+    assert relaxed and abs(relaxed.camera.focal_px - 20_000.0) / 20_000.0 < EXACT_FOCAL_REL
 
 
 def test_unknown_refine_on_is_a_value_error():

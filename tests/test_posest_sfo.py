@@ -3,7 +3,7 @@ import json
 import numpy as np
 
 from lilium.cli.main import main
-from lilium.geometry import geodesic_angle_deg, project
+from lilium.geometry import Camera, geodesic_angle_deg
 from lilium.io.case import read_photo, read_skull
 from lilium.methods.case import Photo, correspondences
 from lilium.methods.posest_sfo import mean_depth_landmarks, posest_sfo
@@ -17,24 +17,24 @@ def test_recovers_the_camera_when_soft_tissue_is_the_mean(case):
     skull2cam, focal = np.array(truth["skull2cam"]), truth["focal_px"]
     corr = correspondences(skull, photo)
     facial = mean_depth_landmarks(corr)
-    uv = project(facial, skull2cam, focal, [599.5, 449.5])
+    uv = Camera(skull2cam, focal, [599.5, 449.5]).project(facial)
     exact = Photo(
         "exact", photo.image_size_wh, "frontal", dict(zip(corr.facial_names, uv, strict=True))
     )
     result = posest_sfo(skull, exact)
     assert result
-    assert abs(result.focal_px - focal) / focal < 1e-6
+    assert abs(result.camera.focal_px - focal) / focal < 1e-6
     assert result.fitness < 1e-6
-    assert geodesic_angle_deg(result.skull2cam[:3, :3], skull2cam[:3, :3]) < 1e-6
+    assert geodesic_angle_deg(result.camera.R, skull2cam[:3, :3]) < 1e-6
 
 
 def test_is_deterministic_and_close_on_the_standin(case):
     skull, photo = read_skull(case[0]), read_photo(case[1])
     a, b = posest_sfo(skull, photo), posest_sfo(skull, photo)
-    np.testing.assert_array_equal(a.skull2cam, b.skull2cam)
+    np.testing.assert_array_equal(a.camera.skull2cam, b.camera.skull2cam)
     # The stand-in's true depths are the means +- 0.5 mm: the camera is close, not exact.
     assert a.fitness < 3.0
-    assert abs(a.focal_px - 2600) / 2600 < 0.15
+    assert abs(a.camera.focal_px - 2600) / 2600 < 0.15
 
 
 def test_failure_is_a_value(case):

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from lilium.constants import CONE_MAX_POLAR_DEG
+from lilium.geometry.camera import Camera, principal_point_of
 from lilium.softtissue.depths import BUILTIN_DEPTHS
 from lilium.softtissue.landmarks import (
     CORRESPONDENCES,
@@ -151,7 +152,8 @@ def test_silhouette_landmarks_are_seen_in_frontal_and_profile_views(subjects):
             T = np.eye(4)
             T[:3, :3], T[:3, 3] = R, np.array([0.0, 0.0, 1500.0]) - R @ head.nasion_mm
             view = "frontal" if yaw == 0 else ("lateral_right" if yaw > 0 else "lateral_left")
-            cam = P.PhotoCamera(view, T, 3000.0, (1280, 960), 1500.0, yaw, 0.0, 0.0)
+            camera = Camera(T, 3000.0, principal_point_of((1280, 960)))
+            cam = P.PhotoCamera(view, camera, (1280, 960), 1500.0, yaw, 0.0, 0.0)
             photo = P.render_photo(head, cam)
             for n in names:
                 assert n in photo.visible, (s.subject_id, yaw, n)

@@ -10,6 +10,7 @@ method's back-projection error (BPE, mm).
 from pathlib import Path
 
 from .evaluation.metrics import back_projection_error_from_dicts
+from .geometry.camera import Camera
 from .io.jsonio import read_json
 
 #: Subjects and photos per view of the demo dataset.
@@ -45,11 +46,6 @@ def ground_truth_bpe(result_path, subject_dir, photo_dir):
         return float("nan")
     truth = read_json(Path(photo_dir) / "photo.json")["ground_truth"]
     facial = read_json(Path(subject_dir) / "facial_landmarks.json")["landmarks"]
-    camera = result["camera"]
     return back_projection_error_from_dicts(
-        facial,
-        truth["landmarks_noise_free"],
-        camera["skull2cam"],
-        camera["focal_px"],
-        camera["principal_point_px"],
+        facial, truth["landmarks_noise_free"], Camera.from_dict(result["camera"])
     )

@@ -344,7 +344,7 @@ def run_case(args):
                 outputs["overlay.png"] = f"{rel.as_posix()}/overlay.png"
             name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
             status = (
-                f"focal {result.focal_px:.0f} px, score {result.fitness:.4g}"
+                f"focal {result.camera.focal_px:.0f} px, score {result.fitness:.4g}"
                 if result
                 else f"FAILED ({result.error})"
             )

@@ -113,7 +113,7 @@ def run(args):
         return 1
     name = result.method + (f" {result.variant}" if result.variant else "")
     print(
-        f"{name}: focal {result.focal_px:.0f} px, score {result.fitness:.3f}, "
+        f"{name}: focal {result.camera.focal_px:.0f} px, score {result.fitness:.3f}, "
         f"{result.seconds:.2f} s -> {args.out}"
     )
     return 0

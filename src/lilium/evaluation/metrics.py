@@ -13,10 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.camera import backproject_rays, point_ray_distance
+from ..geometry.camera import point_ray_distance
 
 
-def back_projection_errors(facial_points_mm, uv_true, skull2cam, focal_px, principal_point_px):
+def back_projection_errors(facial_points_mm, uv_true, camera):
     """Per-landmark back-projection errors (mm).
 
     Parameters
@@ -25,11 +25,8 @@ def back_projection_errors(facial_points_mm, uv_true, skull2cam, focal_px, princ
         Ground-truth 3D facial landmarks ``F_i`` (skull frame).
     uv_true : array_like of shape (N, 2)
         Their noise-free ground-truth image points (pixels).
-    skull2cam : array_like of shape (4, 4)
-        The *estimated* camera pose.
-    focal_px : float
-        The estimated focal length.
-    principal_point_px : array_like of shape (2,)
+    camera : Camera
+        The *estimated* camera.
 
     Returns
     -------
@@ -42,25 +39,21 @@ def back_projection_errors(facial_points_mm, uv_true, skull2cam, focal_px, princ
             f"facial_points_mm has {len(points)} points but uv_true {len(uv)}; "
             "give one image point per 3D landmark, in the same order"
         )
-    if not focal_px > 0:
-        raise ValueError(f"focal_px must be positive, got {focal_px}")
-    origin, directions = backproject_rays(uv, skull2cam, focal_px, principal_point_px)
+    if not camera.focal_px > 0:
+        raise ValueError(f"focal_px must be positive, got {camera.focal_px}")
+    origin, directions = camera.rays(uv)
     return point_ray_distance(points, origin, directions)
 
 
-def back_projection_error(facial_points_mm, uv_true, skull2cam, focal_px, principal_point_px):
+def back_projection_error(facial_points_mm, uv_true, camera):
     """BPE (mm): the mean of :func:`back_projection_errors` over all landmarks."""
-    errors = back_projection_errors(
-        facial_points_mm, uv_true, skull2cam, focal_px, principal_point_px
-    )
+    errors = back_projection_errors(facial_points_mm, uv_true, camera)
     if len(errors) == 0:
         raise ValueError("no landmarks: BPE needs at least one ground-truth facial landmark")
     return float(np.mean(errors))
 
 
-def back_projection_error_from_dicts(
-    facial_landmarks_mm, landmarks_noise_free, skull2cam, focal_px, principal_point_px
-):
+def back_projection_error_from_dicts(facial_landmarks_mm, landmarks_noise_free, camera):
     """BPE over the landmark names present in both dicts (``facial_landmarks.json`` and the
     ``ground_truth.landmarks_noise_free`` of ``photo.json``)."""
     names = sorted(set(facial_landmarks_mm) & set(landmarks_noise_free))
@@ -69,9 +62,7 @@ def back_projection_error_from_dicts(
     return back_projection_error(
         [facial_landmarks_mm[n] for n in names],
         [landmarks_noise_free[n] for n in names],
-        skull2cam,
-        focal_px,
-        principal_point_px,
+        camera,
     )
 
 

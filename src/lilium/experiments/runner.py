@@ -281,24 +281,15 @@ def score_result(result, skull, photo, truth, facial_truth, topology=None):
     """
     from ..evaluation.metrics import back_projection_error_from_dicts, implausible_sfo
     from ..fitness.skof import skull_raster
-    from ..geometry.camera import project
 
     out = {"bpe_mm": None, "skull_px": None, "outside_px": None, "percent_outside": None}
     if not result:
         return out
     noise_free = truth.get("landmarks_noise_free")
     if facial_truth and noise_free:
-        out["bpe_mm"] = back_projection_error_from_dicts(
-            facial_truth,
-            noise_free,
-            result.skull2cam,
-            result.focal_px,
-            result.principal_point_px,
-        )
+        out["bpe_mm"] = back_projection_error_from_dicts(facial_truth, noise_free, result.camera)
     if photo.face_mask is not None:
-        uv = project(
-            skull.vertices_mm, result.skull2cam, result.focal_px, result.principal_point_px
-        )
+        uv = result.camera.project(skull.vertices_mm)
         width, height = photo.image_size_wh
         mask = skull_raster(uv, skull.faces, (height, width), topology=topology)
         imp = implausible_sfo(mask, photo.face_mask)
@@ -345,7 +336,7 @@ def run_task(task):
         p_cam=_finite(result.terms.get("p_cam")),
         p_skof=_finite(result.terms.get("p_skof")),
         p_pll=_finite(result.terms.get("p_pll")),
-        focal_px=_finite(result.focal_px) if result else None,
+        focal_px=_finite(result.camera.focal_px) if result else None,
         seconds=float(result.seconds),
         generations=result.extra.get("generations"),
         error=result.error or None,

@@ -1,14 +1,14 @@
-"""Rotations and the pinhole camera of SPEC section 8."""
+"""Rotations and the pinhole camera of SPEC section 8 (:class:`Camera`, :class:`Cameras`)."""
 
 from .camera import (
-    backproject_rays,
+    Camera,
+    Cameras,
     check_skull2cam,
     point_ray_distance,
     principal_point_of,
-    project,
-    project_batch,
-    project_population,
-    subject_camera_distance,
+    project_points,
+    rigid,
+    to_camera_frame,
 )
 from .rotations import (
     check_rotation,
@@ -18,16 +18,16 @@ from .rotations import (
 )
 
 __all__ = [
-    "backproject_rays",
+    "Camera",
+    "Cameras",
     "check_rotation",
     "check_skull2cam",
     "geodesic_angle_deg",
     "matrix_to_rotvec",
     "point_ray_distance",
     "principal_point_of",
-    "project",
-    "project_batch",
-    "project_population",
+    "project_points",
+    "rigid",
     "rotvec_to_matrix",
-    "subject_camera_distance",
+    "to_camera_frame",
 ]

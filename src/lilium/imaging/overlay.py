@@ -14,16 +14,14 @@ OUTLINE_RGB = (255, 170, 0)
 LIGHT_DIR_CAM = np.array([-0.3, -0.4, -1.0]) / np.linalg.norm([-0.3, -0.4, -1.0])
 
 
-def render_mesh_shaded(vertices_mm, faces, skull2cam, focal_px, principal_point_px, image_size_wh):
+def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh):
     """Lambert-shaded render of a mesh by the painter's algorithm.
 
     Parameters
     ----------
     vertices_mm : ndarray of shape (V, 3)
     faces : ndarray of shape (F, 3)
-    skull2cam : ndarray of shape (4, 4)
-    focal_px : float
-    principal_point_px : array_like of shape (2,)
+    camera : Camera
     image_size_wh : tuple (width, height)
 
     Returns
@@ -34,13 +32,12 @@ def render_mesh_shaded(vertices_mm, faces, skull2cam, focal_px, principal_point_
         The union of the projected triangles.
     """
     width, height = image_size_wh
-    T = np.asarray(skull2cam, dtype=float)
-    X = vertices_mm @ T[:3, :3].T + T[:3, 3]
+    X = camera.to_camera_frame(vertices_mm)
+    uv_vertices = camera.project(vertices_mm)
     tri = X[faces]
-    z = tri[..., 2]
-    keep = np.all(z > 1e-6, axis=1)
+    keep = np.all(np.isfinite(uv_vertices[faces]), axis=(1, 2))
     tri, faces = tri[keep], faces[keep]
-    uv = principal_point_px + focal_px * tri[..., :2] / tri[..., 2:3]
+    uv = uv_vertices[faces]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
     # Two-sided lighting: a skull mesh may be wound either way.
@@ -70,9 +67,7 @@ def draw_overlay(
     image,
     skull_vertices_mm,
     skull_faces,
-    skull2cam,
-    focal_px,
-    principal_point_px,
+    camera,
     photo_landmarks_uv=None,
     estimated_uv=None,
     opacity=0.55,
@@ -85,9 +80,7 @@ def draw_overlay(
     image : ndarray of shape (H, W, 3), uint8
     skull_vertices_mm : ndarray of shape (V, 3)
     skull_faces : ndarray of shape (F, 3)
-    skull2cam : ndarray of shape (4, 4)
-    focal_px : float
-    principal_point_px : array_like of shape (2,)
+    camera : Camera
     photo_landmarks_uv : ndarray of shape (N, 2), optional
         Facial landmarks marked in the photo, drawn as circles.
     estimated_uv : ndarray of shape (N, 2), optional
@@ -103,9 +96,7 @@ def draw_overlay(
     ndarray of shape (H, W, 3), uint8
     """
     height, width = image.shape[:2]
-    shade, covered = render_mesh_shaded(
-        skull_vertices_mm, skull_faces, skull2cam, focal_px, principal_point_px, (width, height)
-    )
+    shade, covered = render_mesh_shaded(skull_vertices_mm, skull_faces, camera, (width, height))
     out = image.astype(float)
     skull_rgb = shade[..., None] * SKULL_RGB
     alpha = opacity * covered[..., None]

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX
 from ..fitness.camera_penalty import camera_penalty_from_priors
-from ..geometry.camera import principal_point_of
+from ..geometry.camera import Camera, Cameras, principal_point_of
 from ..optimisation.de import DEOptions, DifferentialEvolution
 from ..pose.posest import PosestOptions, posest
 from ..pose.refine import RefineOptions, refine_batch
@@ -136,7 +136,7 @@ class LiliumProblem:
         pose = posest(self.corr.uv_px, facial_mm, self.centre, self.options.posest, rng=self.rng)
         if not pose:
             return None
-        return pose.skull2cam[:3, :3], pose.skull2cam[:3, 3], pose.focal_px
+        return pose.camera.R, pose.camera.t, pose.camera.focal_px
 
     def _initial_camera(self, facial_mm):
         """Camera of the first member whose POSEST succeeds (a 1 m guess if none does)."""
@@ -224,7 +224,7 @@ class LiliumProblem:
                 continue
             todo = ok & (fitness <= bound)
             if todo.any():
-                values[name][todo] = term(R[todo], t[todo], f[todo])
+                values[name][todo] = term(Cameras(R[todo], t[todo], f[todo], self.centre))
                 fitness[todo] += values[name][todo]
             values[name][~ok] = 0.0
         return {
@@ -283,10 +283,9 @@ def lilium_sfo(skull, photo, options=LiliumOptions(), seed=0, depth_table=None, 
     best = problem.evaluate(de.x[None], parents=None)
     ok = bool(best["success"][0])
     facial = problem.facial_landmarks(de.x)[0]
-    skull2cam = None
+    camera = None
     if ok:
-        skull2cam = np.eye(4)
-        skull2cam[:3, :3], skull2cam[:3, 3] = best["R"][0], best["t"][0]
+        camera = Camera.from_rt(best["R"][0], best["t"][0], best["focal_px"][0], problem.centre)
     terms = {
         k: (None if np.isnan(best[k][0]) else float(best[k][0]))
         for k in ("mse_pix", "p_cam", "p_skof", "p_pll")
@@ -297,9 +296,7 @@ def lilium_sfo(skull, photo, options=LiliumOptions(), seed=0, depth_table=None, 
         seed=seed,
         skull_id=skull.id,
         photo_id=photo.id,
-        skull2cam=skull2cam,
-        focal_px=float(best["focal_px"][0]) if ok else np.nan,
-        principal_point_px=problem.centre,
+        camera=camera,
         fitness=float(best["fitness"][0]),
         terms=terms,
         facial_landmarks_mm=dict(zip(problem.corr.facial_names, facial, strict=True)),

@@ -17,7 +17,6 @@ from ..fitness.curves import face_curve_from_mask
 from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_batch
-from ..geometry.camera import project_population
 
 #: Faces of the skull used for P_skof (decimated when larger).
 SKOF_FACES = 5000
@@ -57,9 +56,9 @@ class SkofTerm:
         self.context = prepare_skof(faces, photo.face_mask)
         self.centre = centre
 
-    def outside_pixels(self, R, t, focal_px):
-        """Skull pixels outside the face mask, ``(S,)`` int."""
-        uv = project_population(self.vertices_mm, R, t, focal_px, self.centre)
+    def outside_pixels(self, cameras):
+        """Skull pixels outside the face mask under ``cameras`` (:class:`Cameras`), ``(S,)`` int."""
+        uv = cameras.project(self.vertices_mm)
         # No culling: exact either way, and at ~8k faces culling costs 5-30 % more than it saves
         # (the culled interior leaves open borders, i.e. more contour edges to scan;
         # benchmarks/bench_terms.py cases).
@@ -67,8 +66,8 @@ class SkofTerm:
             uv, topology=self.context.topology, mask_index=self.context.mask_index, cull=False
         )
 
-    def __call__(self, R, t, focal_px):
-        return skof_penalty(self.outside_pixels(R, t, focal_px)).astype(float)
+    def __call__(self, cameras):
+        return skof_penalty(self.outside_pixels(cameras)).astype(float)
 
 
 class PllTerm:
@@ -125,21 +124,14 @@ class PllTerm:
         self.span_mm = None if view == "frontal" else np.array([lm["glabella"], lm["metopion"]])
         self.centre = centre
 
-    def __call__(self, R, t, focal_px):
-        uv = project_population(self.region_vertices_mm, R, t, focal_px, self.centre)
-        span_v = None
-        if self.span_mm is not None:
-            span_v = project_population(self.span_mm, R, t, focal_px, self.centre)[..., 1]
+    def __call__(self, cameras):
+        """P_pll under ``cameras`` (:class:`Cameras`), ``(S,)``."""
+        uv = cameras.project(self.region_vertices_mm)
+        span_v = None if self.span_mm is None else cameras.project(self.span_mm)[..., 1]
         return self.context.evaluate_batch(uv, span_v)
 
-    def curves(self, R, t, focal_px):
-        """Skull and face curves ``(K, 2)``, ``(M, 2)`` of one camera (for overlays)."""
-        uv = project_population(
-            self.region_vertices_mm, R[None], t[None], np.array([focal_px]), self.centre
-        )[0]
-        span_v = None
-        if self.span_mm is not None:
-            span_v = project_population(
-                self.span_mm, R[None], t[None], np.array([focal_px]), self.centre
-            )[0, :, 1]
+    def curves(self, camera):
+        """Skull and face curves ``(K, 2)``, ``(M, 2)`` under one :class:`Camera` (overlays)."""
+        uv = camera.project(self.region_vertices_mm)
+        span_v = None if self.span_mm is None else camera.project(self.span_mm)[:, 1]
         return self.context.skull_curve(uv, span_v), self.context.face_curve

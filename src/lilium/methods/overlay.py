@@ -2,7 +2,6 @@
 
 import numpy as np
 
-from ..geometry.camera import project
 from ..imaging.overlay import draw_overlay
 
 #: Colours (RGB) of the skull's and the face's chin-jaw / forehead curves.
@@ -17,11 +16,10 @@ def region_curves(result, skull, photo):
     from .lilium_terms import PllTerm
 
     try:
-        term = PllTerm(skull, photo, result.principal_point_px)
+        term = PllTerm(skull, photo, result.camera.principal_point_px)
     except ValueError:
         return []
-    T = np.asarray(result.skull2cam)
-    skull_curve, face_curve = term.curves(T[:3, :3], T[:3, 3], result.focal_px)
+    skull_curve, face_curve = term.curves(result.camera)
     return [(face_curve, FACE_CURVE_RGB), (skull_curve, SKULL_CURVE_RGB)]
 
 
@@ -44,15 +42,13 @@ def result_overlay(result, skull, photo, opacity=0.55, curves=None):
         curves = region_curves(result, skull, photo)
     names = list(result.facial_landmarks_mm)
     est3d = np.array([result.facial_landmarks_mm[n] for n in names])
-    est_uv = project(est3d, result.skull2cam, result.focal_px, result.principal_point_px)
+    est_uv = result.camera.project(est3d)
     photo_uv = np.array([photo.landmarks_uv[n] for n in names])
     return draw_overlay(
         photo.image,
         skull.vertices_mm,
         skull.faces,
-        result.skull2cam,
-        result.focal_px,
-        result.principal_point_px,
+        result.camera,
         photo_landmarks_uv=photo_uv,
         estimated_uv=est_uv,
         opacity=opacity,

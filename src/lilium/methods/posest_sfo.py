@@ -69,13 +69,11 @@ def posest_sfo(skull, photo, depth_table=None, options=PosestOptions(), seed=0):
         seed=None,
         skull_id=skull.id,
         photo_id=photo.id,
-        principal_point_px=centre,
         facial_landmarks_mm=landmarks,
     )
     if not pose:
         return SfoResult(
-            skull2cam=None,
-            focal_px=np.nan,
+            camera=None,
             fitness=np.inf,
             terms={"mse_pix": None, "p_cam": None, "p_skof": None, "p_pll": None},
             seconds=time.perf_counter() - start,
@@ -83,8 +81,7 @@ def posest_sfo(skull, photo, depth_table=None, options=PosestOptions(), seed=0):
             **common,
         )
     return SfoResult(
-        skull2cam=pose.skull2cam,
-        focal_px=pose.focal_px,
+        camera=pose.camera,
         fitness=pose.mean_error_px,
         terms={
             "mse_pix": float(np.mean(pose.errors_px**2)),

@@ -4,6 +4,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..geometry.camera import Camera
+
 
 @dataclass(frozen=True)
 class SfoResult:
@@ -15,9 +17,8 @@ class SfoResult:
     variant : str or None
     seed : int or None
     skull_id, photo_id : str
-    skull2cam : ndarray of shape (4, 4) or None
-    focal_px : float
-    principal_point_px : ndarray of shape (2,)
+    camera : Camera or None
+        The estimated camera; None when the SFO failed.
     fitness : float
         The method's score (lower is better): mean pixel error for POSEST-SFO, the fitness for
         Lilium.
@@ -37,9 +38,7 @@ class SfoResult:
     seed: int | None
     skull_id: str
     photo_id: str
-    skull2cam: np.ndarray | None
-    focal_px: float
-    principal_point_px: np.ndarray
+    camera: Camera | None
     fitness: float
     terms: dict
     facial_landmarks_mm: dict
@@ -48,17 +47,11 @@ class SfoResult:
     extra: dict = field(default_factory=dict)
 
     def __bool__(self):
-        return self.skull2cam is not None
+        return self.camera is not None
 
     def to_dict(self):
         """The ``result.json`` dictionary of SPEC section 8."""
-        camera = None
-        if self:
-            camera = {
-                "focal_px": float(self.focal_px),
-                "principal_point_px": [float(x) for x in self.principal_point_px],
-                "skull2cam": np.asarray(self.skull2cam).tolist(),
-            }
+        camera = self.camera.to_dict() if self else None
         out = {
             "method": self.method,
             "variant": self.variant,

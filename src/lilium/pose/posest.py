@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..constants import FOCAL_MAX_PX, FOCAL_MIN_PX, MIN_CORRESPONDENCES, RANSAC_THRESHOLD_PX
+from ..geometry.camera import Camera
 from .ransac import RansacOptions, msac
 from .refine import RefineOptions, refine_batch
 from .residuals import reprojection_sq_errors
@@ -48,10 +49,8 @@ class PoseResult:
 
     Attributes
     ----------
-    skull2cam : ndarray of shape (4, 4) or None
-        World (skull) to camera rigid transform, mm.
-    focal_px : float
-    principal_point_px : ndarray of shape (2,)
+    camera : Camera or None
+        Skull-to-camera transform, focal length and principal point; None on failure.
     errors_px : ndarray of shape (N,)
         Reprojection error of every input point (pixels); ``inf`` behind the camera.
     inliers : ndarray of shape (N,), bool
@@ -59,15 +58,13 @@ class PoseResult:
         Why it failed, or "" on success.
     """
 
-    skull2cam: np.ndarray | None
-    focal_px: float
-    principal_point_px: np.ndarray
+    camera: Camera | None
     errors_px: np.ndarray | None = None
     inliers: np.ndarray | None = None
     message: str = ""
 
     def __bool__(self):
-        return self.skull2cam is not None
+        return self.camera is not None
 
     @property
     def rms_px(self):
@@ -80,9 +77,9 @@ class PoseResult:
         return float(np.mean(self.errors_px))
 
 
-def failure(message, principal_point_px):
+def failure(message):
     """A falsy :class:`PoseResult` with ``message``."""
-    return PoseResult(None, np.nan, np.asarray(principal_point_px, float), message=message)
+    return PoseResult(None, message=message)
 
 
 def check_camera(R, t, focal_px, sq_err_px2, focal_max_px=FOCAL_MAX_PX):
@@ -119,26 +116,25 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0)
     Examples
     --------
     >>> import numpy as np
-    >>> from lilium.geometry import project
+    >>> from lilium.geometry import Camera
     >>> rng = np.random.default_rng(0)
     >>> X = rng.normal(scale=60.0, size=(12, 3))
-    >>> skull2cam = np.eye(4); skull2cam[2, 3] = 1000.0
-    >>> uv = project(X, skull2cam, 2500.0, [320.0, 240.0])
-    >>> result = posest(uv, X, [320.0, 240.0])
-    >>> round(result.focal_px, 6)
+    >>> truth = Camera.from_rt(np.eye(3), [0.0, 0.0, 1000.0], 2500.0, [320.0, 240.0])
+    >>> result = posest(truth.project(X), X, [320.0, 240.0])
+    >>> round(result.camera.focal_px, 6)
     2500.0
     """
     uv = np.asarray(uv_px, dtype=float)
     X = np.asarray(points_mm, dtype=float)
     c = np.asarray(principal_point_px, dtype=float)
     if len(uv) < MIN_CORRESPONDENCES:
-        return failure(f"{len(uv)} correspondences, POSEST needs at least 4", c)
+        return failure(f"{len(uv)} correspondences, POSEST needs at least 4")
     if options.refine_on not in ("inliers", "all"):
         raise ValueError(f"refine_on must be 'inliers' or 'all', got {options.refine_on!r}")
     uv_c = uv - c
     hyp = msac(uv_c, X, options.ransac, rng)
     if not hyp:
-        return failure(hyp.message, c)
+        return failure(hyp.message)
     R, t, f, _ = hyp.candidates
     tau_sq = options.ransac.threshold_px**2
     sq = reprojection_sq_errors(uv_c, X, R, t, f)
@@ -164,12 +160,11 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0)
     why = [check_camera(R[k], t[k], f[k], sq[k], options.focal_max_px) for k in range(len(f))]
     valid = np.array([not w for w in why])
     if not valid.any():
-        return failure(why[int(np.argmin(score))], c)
+        return failure(why[int(np.argmin(score))])
     k = int(np.argmin(np.where(valid, score, np.inf)))
-    skull2cam = np.eye(4)
-    skull2cam[:3, :3], skull2cam[:3, 3] = R[k], t[k]
     errors = np.sqrt(sq[k])
-    return PoseResult(skull2cam, float(f[k]), c, errors, errors < options.ransac.threshold_px)
+    camera = Camera.from_rt(R[k], t[k], f[k], c)
+    return PoseResult(camera, errors, errors < options.ransac.threshold_px)
 
 
 def _used_points(sq_err_px2, tau_sq):

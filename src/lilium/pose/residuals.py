@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..constants import MIN_DEPTH_MM
+from ..geometry.camera import project_points
 
 
 def reprojection_sq_errors(uv_centred_px, points_mm, R, t, focal_px):
@@ -22,9 +22,6 @@ def reprojection_sq_errors(uv_centred_px, points_mm, R, t, focal_px):
     sq_err_px2 : ndarray of shape (K, N)
         ``inf`` where a point is at or behind the camera.
     """
-    X = np.asarray(points_mm) @ np.swapaxes(R, -1, -2) + t[:, None, :]
-    z = X[..., 2]
-    behind = z <= MIN_DEPTH_MM
-    uv = focal_px[:, None, None] * X[..., :2] / np.where(behind, 1.0, z)[..., None]
+    uv = project_points(points_mm, R, t, focal_px)  # centred: principal point (0, 0)
     sq = np.sum((uv - uv_centred_px) ** 2, axis=-1)
-    return np.where(behind, np.inf, sq)
+    return np.where(np.isnan(sq), np.inf, sq)

@@ -28,7 +28,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry.camera import project, subject_camera_distance
 from ..geometry.rotations import geodesic_angle_deg, matrix_to_rotvec
 from ..imaging.overlay import SKULL_RGB, render_mesh_shaded
 
@@ -113,16 +112,8 @@ def skull_layer_rgba(result, skull, box, scale=1.0):
 
     u0, v0, u1, v1 = box
     w, h = max(1, round(scale * (u1 - u0))), max(1, round(scale * (v1 - v0)))
-    principal = np.asarray(result.principal_point_px, dtype=float) - (u0, v0)
-    # Pixel centres at integers: u' + 0.5 = scale * (u + 0.5).
-    shade, covered = render_mesh_shaded(
-        skull.vertices_mm,
-        skull.faces,
-        result.skull2cam,
-        result.focal_px * scale,
-        (principal + 0.5) * scale - 0.5,
-        (w, h),
-    )
+    camera = result.camera.cropped((u0, v0), scale)
+    shade, covered = render_mesh_shaded(skull.vertices_mm, skull.faces, camera, (w, h))
     rgba = np.zeros(covered.shape + (4,), dtype=np.uint8)
     rgba[..., :3] = np.clip(shade[..., None] * SKULL_RGB, 0, 255).astype(np.uint8)
     rgba[..., 3] = np.where(covered, 255, 0)
@@ -198,7 +189,7 @@ def landmark_rows(result, photo):
     photo_uv = np.array([photo.landmarks_uv[n] for n in names]).reshape(-1, 2)
     if result and names:
         est3d = np.array([result.facial_landmarks_mm[n] for n in names])
-        est_uv = project(est3d, result.skull2cam, result.focal_px, result.principal_point_px)
+        est_uv = result.camera.project(est3d)
     else:
         est_uv = np.full_like(photo_uv, np.nan)
     errors = np.linalg.norm(est_uv - photo_uv, axis=1)
@@ -212,17 +203,17 @@ def camera_facts(result, photo):
     """Camera parameters of a successful SFO, for the report (degrees, mm, pixels)."""
     from scipy.spatial.transform import Rotation
 
-    T = np.asarray(result.skull2cam, dtype=float)
-    R = T[:3, :3]
+    camera = result.camera
+    T, R = camera.skull2cam, camera.R
     rotvec = matrix_to_rotvec(R)
     angle = float(np.degrees(np.linalg.norm(rotvec)))
     axis = rotvec / np.linalg.norm(rotvec) if angle > 0 else np.array([0.0, 0.0, 1.0])
     lms = result.facial_landmarks_mm
     centre = lms["nasion"] if "nasion" in lms else np.mean(list(lms.values()), axis=0)
     facts = {
-        "focal_px": float(result.focal_px),
-        "principal_point_px": [float(x) for x in result.principal_point_px],
-        "scd_mm": float(subject_camera_distance(centre, T)),
+        "focal_px": camera.focal_px,
+        "principal_point_px": [float(x) for x in camera.principal_point_px],
+        "scd_mm": float(camera.distance_mm(centre)),
         "scd_point": "facial nasion" if "nasion" in lms else "centroid of the facial landmarks",
         "rotation_angle_deg": angle,
         "rotation_axis": axis,
@@ -352,7 +343,7 @@ def _summary(entry, rows, outside):
     scd = camera_facts(result, photo)["scd_mm"] if result else None
     return {
         "status": "ok" if result else f"failed: {result.error}",
-        "focal_px": float(result.focal_px) if result else None,
+        "focal_px": result.camera.focal_px if result else None,
         "scd_mm": scd,
         "mean_error_px": mean_err,
         "fitness": result.fitness,
@@ -688,12 +679,7 @@ def build_report(entries, title=None, command=None, date=None):
         layer, covered_full = None, None
         if result:
             _, covered_full = render_mesh_shaded(
-                entry.skull.vertices_mm,
-                entry.skull.faces,
-                result.skull2cam,
-                result.focal_px,
-                result.principal_point_px,
-                photo.image_size_wh,
+                entry.skull.vertices_mm, entry.skull.faces, result.camera, photo.image_size_wh
             )
         points = [r["photo_uv"] for r in rows] + [r["estimate_uv"] for r in rows]
         box = view_box(photo.image_size_wh, covered_full, photo.face_mask, points)

@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 
 from ..evaluation.metrics import implausible_sfo
+from ..geometry.camera import Camera, principal_point_of
 from ..io.jsonio import read_json
 from . import render as _render
 
@@ -61,10 +62,9 @@ def overlay_tile(
         For the ground-truth camera.
     """
     gt = record["ground_truth"]
-    T = np.asarray(gt["skull2cam"], dtype=float)
-    focal = float(gt["focal_px"])
     height, width = image.shape[:2]
-    skull = _render.render_mesh(skull_vertices_mm, skull_faces, T, focal, (width, height))
+    camera = Camera(gt["skull2cam"], gt["focal_px"], principal_point_of((width, height)))
+    skull = _render.render_mesh(skull_vertices_mm, skull_faces, camera, (width, height))
     bone = _render.shade(skull, albedo_rgb=BONE_RGB, smooth_px=1.0)
     skull_mask = skull.mask
     out = image.astype(np.float32)

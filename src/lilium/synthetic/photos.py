@@ -47,7 +47,7 @@ import numpy as np
 from ..constants import VIEWS
 from ..fitness import curves as _curves
 from ..fitness.curves import check_view
-from ..geometry.camera import principal_point_of, subject_camera_distance
+from ..geometry.camera import Camera, principal_point_of
 from ..geometry.rotations import rotvec_to_matrix
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
 from . import render as _render
@@ -136,8 +136,8 @@ class PhotoCamera:
     Attributes
     ----------
     view : str
-    skull2cam : ndarray of shape (4, 4)
-    focal_px : float
+    camera : Camera
+        Skull-to-camera transform, focal length, principal point (the image centre).
     image_size_wh : (int, int)
     scd_mm : float
         Camera centre to the facial nasion.
@@ -145,17 +145,12 @@ class PhotoCamera:
     """
 
     view: str
-    skull2cam: np.ndarray
-    focal_px: float
+    camera: Camera
     image_size_wh: tuple
     scd_mm: float
     yaw_deg: float
     pitch_deg: float
     roll_deg: float
-
-    @property
-    def principal_point_px(self):
-        return principal_point_of(self.image_size_wh)
 
 
 @dataclass(frozen=True)
@@ -360,24 +355,21 @@ def sample_camera(head, view, rng, ranges=CameraRanges()):
         R = head_rotation(yaw, pitch, roll)
         ray = np.array([offset[0] * width / focal, offset[1] * height / focal, 1.0])
         t = scd * ray / np.linalg.norm(ray) - R @ head.nasion_mm
-        X = head.hull_points_mm @ R.T + t
-        if np.any(X[:, 2] <= 1.0):
+        camera = Camera.from_rt(R, t, focal, principal_point_of((width, height)))
+        if np.any(camera.to_camera_frame(head.hull_points_mm)[:, 2] <= 1.0):
             continue
-        uv = focal * X[:, :2] / X[:, 2:3] + principal_point_of((width, height))
+        uv = camera.project(head.hull_points_mm)
         lo, hi = uv.min(axis=0), uv.max(axis=0)
         b = ranges.border_px
         if hi[0] - lo[0] < ranges.min_head_width_px:
             continue
         if lo[0] < b or lo[1] < b or hi[0] > width - 1 - b or hi[1] > height - 1 - b:
             continue
-        T = np.eye(4)
-        T[:3, :3], T[:3, 3] = R, t
         return PhotoCamera(
             view=view,
-            skull2cam=T,
-            focal_px=float(focal),
+            camera=camera,
             image_size_wh=(int(width), int(height)),
-            scd_mm=float(subject_camera_distance(head.nasion_mm, T)),
+            scd_mm=float(camera.distance_mm(head.nasion_mm)),
             yaw_deg=float(yaw),
             pitch_deg=float(pitch),
             roll_deg=float(roll),
@@ -424,15 +416,14 @@ def render_photo(head, camera):
     r = _render.render_mesh(
         head.skin_vertices_mm,
         head.skin_faces,
-        camera.skull2cam,
-        camera.focal_px,
+        camera.camera,
         camera.image_size_wh,
         cull_back_faces=head.outward_wound,
     )
     image = _render.shade(r)
     lut = np.append(head.head_faces, False)
     mask = lut[r.face_index]
-    visible, uv = _render.visible_points(r, head.facial_points_mm, camera.skull2cam)
+    visible, uv = _render.visible_points(r, head.facial_points_mm, camera.camera)
     landmarks_uv = {n: uv[i] for i, n in enumerate(head.facial_names)}
     visible_names = tuple(n for i, n in enumerate(head.facial_names) if visible[i])
     jaw_lut = lut if head.jaw_faces is None else np.append(head.jaw_faces, False)
@@ -469,11 +460,11 @@ def photo_views(n_photos, rng=None):
 
 def priors_of(camera):
     """Priors of the paper's protocol from the true camera (module constants ``PRIOR_*``)."""
-    f, d = camera.focal_px, camera.scd_mm
+    f, d = camera.camera.focal_px, camera.scd_mm
     return {
         "focal_px": [f * (1 - PRIOR_FOCAL_FRACTION), f * (1 + PRIOR_FOCAL_FRACTION)],
         "scd_mm": [d * (1 - PRIOR_SCD_FRACTION), d * (1 + PRIOR_SCD_FRACTION)],
-        "head_rotation_skull2cam": np.asarray(camera.skull2cam)[:3, :3],
+        "head_rotation_skull2cam": camera.camera.R,
         "head_tolerance_deg": PRIOR_HEAD_TOLERANCE_DEG,
     }
 
@@ -504,9 +495,9 @@ def photo_record(photo, subject_id, noise="A", landmarks_uv=None, extra=None):
         "priors": priors_of(cam),
         "ground_truth": {
             "subject": subject_id,
-            "skull2cam": np.asarray(cam.skull2cam),
-            "focal_px": cam.focal_px,
-            "principal_point_px": cam.principal_point_px,
+            "skull2cam": cam.camera.skull2cam,
+            "focal_px": cam.camera.focal_px,
+            "principal_point_px": cam.camera.principal_point_px,
             "scd_mm": cam.scd_mm,
             "noise": noise,
             "landmarks_noise_free": photo.landmarks_uv,

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..geometry.camera import principal_point_of
+from ..geometry.camera import Camera, principal_point_of
 
 #: Fixed-point bits of the sub-pixel vertex positions given to OpenCV's polygon fill.
 _SHIFT_BITS = 4
@@ -53,15 +53,13 @@ class MeshRender:
     vertices_cam_mm : ndarray of shape (V, 3)
         Mesh vertices in the camera frame.
     faces : ndarray of shape (F, 3), int
-    focal_px : float
-    principal_point_px : ndarray of shape (2,)
+    camera : Camera
     """
 
     face_index: np.ndarray
     vertices_cam_mm: np.ndarray
     faces: np.ndarray
-    focal_px: float
-    principal_point_px: np.ndarray
+    camera: Camera
 
     @property
     def image_size_wh(self):
@@ -71,12 +69,6 @@ class MeshRender:
     def mask(self):
         """Pixels covered by the mesh, ndarray of shape (H, W), bool."""
         return self.face_index >= 0
-
-
-def to_camera(vertices_mm, skull2cam):
-    """Skull-frame points ``(N, 3)`` in the camera frame ``(N, 3)``."""
-    T = np.asarray(skull2cam, dtype=float)
-    return np.asarray(vertices_mm, dtype=float) @ T[:3, :3].T + T[:3, 3]
 
 
 def _fixed_point_triangles(vertices_cam_mm, faces, focal_px, principal_point_px):
@@ -147,7 +139,7 @@ def rasterize_face_index(
     return buffer
 
 
-def render_mesh(vertices_mm, faces, skull2cam, focal_px, image_size_wh, cull_back_faces=False):
+def render_mesh(vertices_mm, faces, camera, image_size_wh, cull_back_faces=False):
     """Rasterise a mesh seen by a camera; see :class:`MeshRender`.
 
     Parameters
@@ -155,8 +147,7 @@ def render_mesh(vertices_mm, faces, skull2cam, focal_px, image_size_wh, cull_bac
     vertices_mm : array_like of shape (V, 3)
         Skull-frame vertices (mm).
     faces : array_like of shape (F, 3), int
-    skull2cam : array_like of shape (4, 4)
-    focal_px : float
+    camera : Camera
     image_size_wh : (int, int)
     cull_back_faces : bool
         See :func:`rasterize_face_index`.
@@ -165,13 +156,17 @@ def render_mesh(vertices_mm, faces, skull2cam, focal_px, image_size_wh, cull_bac
     -------
     MeshRender
     """
-    vertices_cam = to_camera(vertices_mm, skull2cam)
+    vertices_cam = camera.to_camera_frame(vertices_mm)
     faces = np.asarray(faces, dtype=np.int64)
-    pp = principal_point_of(image_size_wh)
     face_index = rasterize_face_index(
-        vertices_cam, faces, focal_px, image_size_wh, pp, cull_back_faces
+        vertices_cam,
+        faces,
+        camera.focal_px,
+        image_size_wh,
+        camera.principal_point_px,
+        cull_back_faces,
     )
-    return MeshRender(face_index, vertices_cam, faces, float(focal_px), pp)
+    return MeshRender(face_index, vertices_cam, faces, camera)
 
 
 def face_normals(vertices, faces):
@@ -246,7 +241,7 @@ def surface_depth_along_rays(render, uv):
     pixel[ok] = np.rint(uv[ok]).astype(np.int64)
     cols, rows = pixel[:, 0], pixel[:, 1]
     rays = np.column_stack(
-        [(uv - render.principal_point_px) / render.focal_px, np.ones(len(uv))]
+        [(uv - render.camera.principal_point_px) / render.camera.focal_px, np.ones(len(uv))]
     )  # X = s * ray, s = depth
     n = face_normals(render.vertices_cam_mm, render.faces)
     v0 = render.vertices_cam_mm[render.faces[:, 0]]
@@ -273,14 +268,14 @@ def surface_depth_along_rays(render, uv):
     return out
 
 
-def visible_points(render, points_mm, skull2cam, tolerance_mm=VISIBILITY_TOLERANCE_MM):
+def visible_points(render, points_mm, camera, tolerance_mm=VISIBILITY_TOLERANCE_MM):
     """Which skull-frame points are seen by the camera (not hidden by the mesh itself).
 
     Parameters
     ----------
     render : MeshRender
     points_mm : array_like of shape (N, 3)
-    skull2cam : array_like of shape (4, 4)
+    camera : Camera
     tolerance_mm : float
         Largest depth (mm) a point may lie behind the visible surface.
 
@@ -290,11 +285,8 @@ def visible_points(render, points_mm, skull2cam, tolerance_mm=VISIBILITY_TOLERAN
     uv : ndarray of shape (N, 2)
         The projections (NaN behind the camera).
     """
-    X = to_camera(points_mm, skull2cam)
-    z = X[:, 2]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        uv = render.principal_point_px + render.focal_px * X[:, :2] / z[:, None]
-    uv[z <= 1e-6] = np.nan
+    z = camera.to_camera_frame(points_mm)[:, 2]
+    uv = camera.project(points_mm)
     width, height = render.image_size_wh
     inside = (
         np.all(np.isfinite(uv), axis=1)
@@ -308,15 +300,14 @@ def visible_points(render, points_mm, skull2cam, tolerance_mm=VISIBILITY_TOLERAN
     return visible, uv
 
 
-def triangle_union_mask(vertices_mm, faces, skull2cam, focal_px, image_size_wh):
+def triangle_union_mask(vertices_mm, faces, camera, image_size_wh):
     """Pixels covered by the union of a mesh's projected triangles (each filled on its own).
 
     Parameters
     ----------
     vertices_mm : array_like of shape (V, 3)
     faces : array_like of shape (F, 3), int
-    skull2cam : array_like of shape (4, 4)
-    focal_px : float
+    camera : Camera
     image_size_wh : (int, int)
 
     Returns
@@ -324,12 +315,11 @@ def triangle_union_mask(vertices_mm, faces, skull2cam, focal_px, image_size_wh):
     mask : ndarray of shape (H, W), bool
     """
     width, height = (int(s) for s in image_size_wh)
-    vertices_cam = to_camera(vertices_mm, skull2cam)
     pts, keep, _ = _fixed_point_triangles(
-        vertices_cam,
+        camera.to_camera_frame(vertices_mm),
         np.asarray(faces, dtype=np.int64),
-        focal_px,
-        principal_point_of((width, height)),
+        camera.focal_px,
+        camera.principal_point_px,
     )
     mask = np.zeros((height, width), dtype=np.uint8)
     fill = cv2.fillConvexPoly
