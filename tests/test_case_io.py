@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
+from lilium.inputs import correspondences
 from lilium.io.case import read_depth_table, read_photo, read_skull
 from lilium.io.mesh import write_mesh
-from lilium.methods.case import correspondences
 
 
 def _edit_json(path, change):

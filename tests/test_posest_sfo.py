@@ -4,8 +4,8 @@ import numpy as np
 
 from lilium.cli.main import main
 from lilium.geometry import Camera, geodesic_angle_deg
+from lilium.inputs import Photo, correspondences
 from lilium.io.case import read_photo, read_skull
-from lilium.methods.case import Photo, correspondences
 from lilium.methods.posest_sfo import mean_depth_landmarks, posest_sfo
 
 

@@ -20,6 +20,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..constants import VIEWS
+from ..inputs import correspondences
 from ..io.case import (
     IMAGE_NAMES,
     photo_from_files,
@@ -31,7 +32,6 @@ from ..io.case import (
 from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
 from ..io.results import write_result
-from ..methods.case import correspondences
 from ..methods.lilium import VARIANTS, lilium_sfo
 from ..methods.overlay import result_overlay
 from ..methods.posest_sfo import posest_sfo

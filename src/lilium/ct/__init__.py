@@ -1,7 +1,7 @@
 """CT volumes: readers (DICOM, NRRD, NIfTI, MetaImage, raw) and the volume -> mesh pipeline."""
 
 from .importer import import_ct, read_landmark_file
-from .mesh import decimate, keep_largest_component, volume_to_mesh
+from .mesh import volume_to_mesh
 from .readers import (
     read_dicom,
     read_metaimage,
@@ -14,9 +14,7 @@ from .volume import Volume
 
 __all__ = [
     "Volume",
-    "decimate",
     "import_ct",
-    "keep_largest_component",
     "read_dicom",
     "read_landmark_file",
     "read_metaimage",

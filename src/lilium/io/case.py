@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..constants import VIEWS
-from ..methods.case import Photo, Priors, Skull
+from ..inputs import Photo, Priors, Skull
 from ..softtissue.depths import DepthStats, check_depth_table
 from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL, FACIAL_NAMES
 from ..softtissue.normals import surface_normals_at

@@ -22,13 +22,13 @@ import numpy as np
 from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX
 from ..fitness.camera_penalty import camera_penalty_from_priors
 from ..geometry.camera import Camera, Cameras, principal_point_of
+from ..inputs import correspondences
 from ..optimisation.de import DEOptions, DifferentialEvolution
 from ..pose.posest import PosestOptions, posest
 from ..pose.refine import RefineOptions, refine_batch
 from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
-from .case import correspondences
 from .result import SfoResult
 
 #: Variants: which optional penalties are on, (P_skof, P_pll).

@@ -17,6 +17,7 @@ from ..fitness.curves import face_curve_from_mask
 from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_batch
+from ..geometry.mesh import decimate
 
 #: Faces of the skull used for P_skof (decimated when larger).
 SKOF_FACES = 5000
@@ -26,8 +27,6 @@ def decimated(vertices_mm, faces, target_faces):
     """The mesh with at most about ``target_faces`` faces (quadric decimation)."""
     if len(faces) <= target_faces:
         return vertices_mm, faces
-    from ..ct.mesh import decimate
-
     return decimate(vertices_mm, faces, target_faces)
 
 

@@ -11,9 +11,9 @@ import time
 import numpy as np
 
 from ..geometry.camera import principal_point_of
+from ..inputs import correspondences
 from ..pose.posest import PosestOptions, posest
 from ..softtissue.depths import depth_stats
-from .case import correspondences
 from .result import SfoResult
 
 
@@ -39,8 +39,8 @@ def posest_sfo(skull, photo, depth_table=None, options=PosestOptions(), seed=0):
 
     Parameters
     ----------
-    skull : lilium.methods.case.Skull
-    photo : lilium.methods.case.Photo
+    skull : lilium.inputs.Skull
+    photo : lilium.inputs.Photo
     depth_table : dict, optional
     options : PosestOptions
     seed : int

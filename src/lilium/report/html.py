@@ -62,8 +62,8 @@ class ReportEntry:
 
     Attributes
     ----------
-    skull : lilium.methods.case.Skull
-    photo : lilium.methods.case.Photo
+    skull : lilium.inputs.Skull
+    photo : lilium.inputs.Photo
         Read with its image.
     result : lilium.methods.result.SfoResult
     inputs : dict of str -> Path

@@ -7,9 +7,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..constants import MIN_CORRESPONDENCES
-from ..fitness.camera_penalty import CameraPriors
-from ..softtissue.landmarks import CRANIAL_TO_FACIAL
+from .constants import MIN_CORRESPONDENCES
+from .fitness.camera_penalty import CameraPriors
+from .softtissue.landmarks import CRANIAL_TO_FACIAL
 
 #: A-priori camera information of a photo (focal and SCD intervals, head orientation and
 #: tolerance; each optional): the same object P_cam takes.
