@@ -22,9 +22,10 @@ from lilium.evaluation.metrics import back_projection_error_from_dicts, implausi
 from lilium.fitness.skof import skull_raster
 from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
-from lilium.methods.lilium import VARIANTS, LiliumOptions, lilium_sfo
-from lilium.methods.posest_sfo import posest_sfo
+from lilium.methods import METHODS, SfoOptions, run_sfo
 from lilium.optimisation import DEOptions
+
+VARIANTS = METHODS["lilium"].variants
 
 
 def evaluate(result, skull, photo, truth, facial_truth):
@@ -62,9 +63,9 @@ def run_photo(task):
     photo = read_photo(photo_dir)
     facial_truth = read_json(subject_dir / "facial_landmarks.json")["landmarks"]
     # POSEST-SFO is deterministic: run once, with the first seed.
-    runs = [("posest-sfo", lambda: posest_sfo(skull, photo))] if seed == 0 else []
+    runs = [("posest-sfo", lambda: run_sfo("posest-sfo", skull, photo))] if seed == 0 else []
     runs += [
-        (f"lilium {v}", lambda v=v: lilium_sfo(skull, photo, LiliumOptions(v, de), seed=seed))
+        (f"lilium {v}", lambda v=v: run_sfo("lilium", skull, photo, SfoOptions(v, de), seed))
         for v in variants
     ]
     rows = []

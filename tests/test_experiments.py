@@ -98,7 +98,7 @@ def test_presets_and_methods():
     assert (quick.dataset.subjects, 2 * quick.dataset.photos) == (5, 4)
     assert (paper.dataset.subjects, 2 * paper.dataset.photos) == (17, 60)
     assert (paper.repetitions, paper.axes_sets, paper.runs_per_axes_set) == (5, 5, 5)
-    assert (paper.de.population, paper.de.generations, paper.de.max_seconds) == (30, 750, 500)
+    assert (paper.de.population_size, paper.de.max_generations, paper.de.max_seconds) == (30, 750, 500)
     assert load_config("quick") == PRESETS["quick"]
     assert parse_methods(["lilium"]) == ALL_METHODS[1:]
     assert parse_methods(["lilium:skof+pll", "posest-sfo"]) == (
@@ -118,8 +118,8 @@ def test_toml_overrides_and_errors(tmp_path):
     )
     cfg = load_config(path)
     assert cfg.repetitions == 3 and cfg.axes_sets == PRESETS["quick"].axes_sets
-    assert cfg.de.generations == 7 and cfg.de.max_seconds is None
-    assert cfg.de.population == PRESETS["quick"].de.population
+    assert cfg.de.max_generations == 7 and cfg.de.max_seconds is None
+    assert cfg.de.population_size == PRESETS["quick"].de.population_size
     assert cfg.db == tmp_path / "x.sqlite" and cfg.dataset.path == tmp_path / "data"
     with pytest.raises(ValueError, match="unknown key"):
         config_from_dict({"repetition": 2})

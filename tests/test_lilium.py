@@ -5,12 +5,13 @@ import pytest
 
 from lilium.geometry import geodesic_angle_deg
 from lilium.io.case import read_photo, read_skull
-from lilium.methods.lilium import LiliumOptions, LiliumProblem, lilium_sfo
+from lilium.methods import SfoOptions
+from lilium.methods.lilium import LiliumProblem, lilium_sfo
 from lilium.optimisation import DEOptions
 
 
 def _opts(variant="base", generations=250, population=30):
-    return LiliumOptions(variant, DEOptions(population, max_generations=generations))
+    return SfoOptions(variant, DEOptions(population, max_generations=generations))
 
 
 def test_recovers_the_ground_truth_camera_on_a_noise_free_case(case):
@@ -37,6 +38,22 @@ def test_same_seed_same_result(case):
     np.testing.assert_array_equal(a.camera.skull2cam, b.camera.skull2cam)
 
 
+@pytest.mark.parametrize("variant", ["base", "skof"])
+def test_result_is_the_member_de_ranked(case, variant):
+    """The reported camera and fitness are DE's best member's, not a re-solve of its genes."""
+    skull, photo = read_skull(case[0]), read_photo(case[1])
+    result = lilium_sfo(skull, photo, _opts(variant, generations=12, population=10), seed=5)
+    assert result.fitness == result.extra["history"][-1]
+    terms = [v for v in result.terms.values() if v is not None]
+    assert result.fitness == pytest.approx(sum(terms), rel=1e-12)
+    # Re-scoring the reported camera gives the reported MSE.
+    problem = LiliumProblem(skull, photo, _opts(variant))
+    facial = problem.facial_landmarks(np.array(result.extra["genes"]))[0]
+    uv = result.camera.project(facial)
+    mse = np.mean(np.sum((uv - problem.corr.uv_px) ** 2, axis=1))
+    assert mse == pytest.approx(result.terms["mse_pix"], rel=1e-9)
+
+
 def test_population_is_evaluated_at_once_and_terms_add_up(case):
     problem = LiliumProblem(read_skull(case[0]), read_photo(case[1]), _opts())
     genes = np.random.default_rng(0).random((12, problem.cones.n_genes))
@@ -48,7 +65,7 @@ def test_population_is_evaluated_at_once_and_terms_add_up(case):
 
 def test_unknown_variant(case):
     with pytest.raises(ValueError, match="unknown Lilium variant 'fancy'"):
-        LiliumProblem(read_skull(case[0]), read_photo(case[1]), LiliumOptions("fancy"))
+        LiliumProblem(read_skull(case[0]), read_photo(case[1]), SfoOptions("fancy"))
 
 
 @pytest.mark.slow
@@ -70,7 +87,7 @@ def test_full_method_recovers_the_camera_on_a_generated_noise_free_photo(tmp_pat
     for entry in [e for e in index["photos"] if e["view"] == "frontal"]:
         photo_dir = tmp_path / entry["paths"]["A"]
         truth = read_json(photo_dir / "photo.json")["ground_truth"]
-        result = lilium_sfo(read_skull(subject_dir), read_photo(photo_dir), LiliumOptions(), seed=0)
+        result = lilium_sfo(read_skull(subject_dir), read_photo(photo_dir), SfoOptions(), seed=0)
         assert result and result.terms["p_skof"] == 0.0
         assert abs(result.camera.focal_px - truth["focal_px"]) / truth["focal_px"] < 0.05
         R_true = np.array(truth["skull2cam"])[:3, :3]

@@ -16,29 +16,13 @@ Writes ``DIR/report.html`` and, per photo, ``DIR/<photo>/result.json`` and ``ove
 """
 
 import shlex
-from dataclasses import replace
 from pathlib import Path
 
+from ..casework.case import run_case
 from ..constants import VIEWS
-from ..inputs import correspondences
-from ..io.case import (
-    IMAGE_NAMES,
-    photo_from_files,
-    read_depth_table,
-    read_photo,
-    read_skull,
-    skull_from_files,
-)
-from ..io.formats import find_landmark_file
-from ..io.mesh import MESH_SUFFIXES
-from ..io.results import write_result
-from ..methods.lilium import VARIANTS, lilium_sfo
-from ..methods.overlay import result_overlay
-from ..methods.posest_sfo import posest_sfo
+from ..methods import METHODS
 from ..optimisation.de import DEOptions
-from .sfo import METHODS, lilium_options
-
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
+from .sfo import VARIANTS, options_from
 
 
 def register(subparsers):
@@ -97,7 +81,7 @@ def register(subparsers):
     p.add_argument(
         "--method",
         action="append",
-        choices=METHODS,
+        choices=list(METHODS),
         default=[],
         help="method; repeat to run several (default lilium)",
     )
@@ -116,247 +100,6 @@ def register(subparsers):
     p.add_argument("--depth-table", type=Path, help="CSV: landmark,mean,sd,min,max (mm)")
     p.add_argument("--title", help="report title")
     p.set_defaults(func=run)
-
-
-# --------------------------------------------------------------------------------------------
-# Reading
-
-
-def _first_file(folder, names):
-    return next((folder / n for n in names if (folder / n).is_file()), None)
-
-
-def load_skull(skull_path, landmarks=None, axes=None):
-    """Read the skull from a subject folder or a mesh file.
-
-    Returns
-    -------
-    skull : Skull
-    inputs : dict of str -> Path
-        The files used, labelled, for the provenance.
-    """
-    skull_path = Path(skull_path)
-    if skull_path.is_dir():
-        mesh = _first_file(skull_path, [f"skull{s}" for s in MESH_SUFFIXES])
-        if landmarks is None:
-            skull = read_skull(skull_path, axes_path=axes)
-            landmarks = _first_file(skull_path, ["cranial_landmarks.json"]) or find_landmark_file(
-                skull_path, ["cranial_landmarks", "skull"]
-            )
-        else:
-            if mesh is None:
-                read_skull(skull_path)  # raises its "no skull mesh" message
-            axes = axes or skull_path / "soft_tissue_axes.json"
-            skull = skull_from_files(mesh, landmarks, axes, skull_id=skull_path.name)
-        axes = Path(axes) if axes else skull_path / "soft_tissue_axes.json"
-    elif skull_path.is_file():
-        mesh = skull_path
-        if skull_path.suffix.lower() not in MESH_SUFFIXES:
-            raise ValueError(
-                f"{skull_path}: --skull must be a subject folder or a PLY/OBJ/STL mesh; convert "
-                "the skull to one of those"
-            )
-        if landmarks is None:
-            landmarks = find_landmark_file(
-                skull_path.parent, [skull_path.stem, f"{skull_path.stem}_landmarks"]
-            )
-            if landmarks is None:
-                raise ValueError(
-                    f"{skull_path}: no cranial landmark file next to the mesh; give it with "
-                    "--landmarks FILE (.mrk.json, .fcsv, .pp, .csv or .json)"
-                )
-        skull = skull_from_files(mesh, landmarks, axes)
-    else:
-        raise ValueError(
-            f"{skull_path}: --skull not found; give a subject folder or a skull mesh file"
-        )
-    inputs = {"skull mesh": mesh, "cranial landmarks": landmarks}
-    if axes is not None and Path(axes).is_file():
-        inputs["soft-tissue axes"] = Path(axes)
-    return skull, inputs
-
-
-def _per_photo(values, n, option, allow_one=False):
-    if not values:
-        return [None] * n
-    if allow_one and len(values) == 1:
-        return values * n
-    if len(values) != n:
-        raise ValueError(
-            f"command line: {option} given {len(values)} times for {n} photo image(s); give it "
-            "once per --photo image (not folder), in the same order"
-        )
-    return list(values)
-
-
-def _sibling(image_path, stems, suffixes):
-    for stem in stems:
-        for suffix in suffixes:
-            candidate = image_path.with_name(stem + suffix)
-            if candidate.is_file() and candidate != image_path:
-                return candidate
-    return None
-
-
-def _check_interval(values, option):
-    if values is None:
-        return None
-    lo, hi = values
-    if not (0 < lo <= hi) or not all(map(_finite, values)):
-        raise ValueError(
-            f"command line: {option} must be LO HI with 0 < LO <= HI, got {lo:g} {hi:g}"
-        )
-    return float(lo), float(hi)
-
-
-def _finite(x):
-    return x == x and abs(x) != float("inf")
-
-
-def load_photos(args):
-    """Read every ``--photo`` (folders and image files) with priors; returns photo records.
-
-    Returns
-    -------
-    list of (Photo, dict inputs, dict notes)
-    """
-    photos = [Path(p) for p in args.photo]
-    image_files = [p for p in photos if not p.is_dir()]
-    lm_files = _per_photo(args.photo_landmarks, len(image_files), "--photo-landmarks")
-    masks = _per_photo(args.mask, len(image_files), "--mask")
-    views = _per_photo(args.view, len(image_files), "--view", allow_one=True)
-    focal_cli = _check_interval(args.focal_px, "--focal-px")
-    scd_cli = _check_interval(args.scd_mm, "--scd-mm")
-    records, k_file = [], 0
-    for path in photos:
-        inputs, notes = {}, {}
-        if path.is_dir():
-            photo = read_photo(path)
-            image = _first_file(path, IMAGE_NAMES)
-            inputs["photo"] = image
-            inputs["photo.json"] = path / "photo.json"
-            lm_file = find_landmark_file(path, ["facial_landmarks", "landmarks"])
-            if lm_file is not None and "landmarks" not in _json_keys(path / "photo.json"):
-                inputs["facial landmarks"] = lm_file
-            for name, label in (("face_mask.png", "face mask"), ("face_curve.json", "face curve")):
-                if (path / name).is_file():
-                    inputs[label] = path / name
-        else:
-            if not path.is_file():
-                raise ValueError(f"{path}: --photo not found; give a photo folder or an image")
-            if path.suffix.lower() not in IMAGE_SUFFIXES:
-                raise ValueError(f"{path}: --photo must be a folder or a PNG/JPEG image")
-            image = path
-            lm_file = lm_files[k_file] or _sibling(
-                path,
-                [path.stem, f"{path.stem}_landmarks", f"{path.stem}.landmarks"],
-                (".csv", ".json", ".tsv", ".txt"),
-            )
-            if lm_file is None:
-                raise ValueError(
-                    f"{path}: no facial landmark file for this photo; give it with "
-                    "--photo-landmarks FILE (CSV name,u,v or JSON), once per --photo image"
-                )
-            mask = masks[k_file] or _sibling(
-                path, [f"{path.stem}_mask", f"{path.stem}.mask"], (".png",)
-            )
-            view = views[k_file] or "frontal"
-            k_file += 1
-            photo = photo_from_files(path, lm_file, view, mask)
-            inputs["photo"] = path
-            inputs["facial landmarks"] = lm_file
-            if mask is not None:
-                inputs["face mask"] = mask
-        priors = photo.priors
-        if focal_cli is not None:
-            priors = replace(priors, focal_px=focal_cli)
-            notes["focal prior"] = "command line --focal-px"
-        elif priors.focal_px is not None:
-            notes["focal prior"] = "photo.json"
-        elif not args.no_exif:
-            from ..io.exif import focal_prior_from_exif
-
-            exif = focal_prior_from_exif(image, sensor_width_mm=args.sensor_width_mm)
-            if exif is not None:
-                priors = replace(priors, focal_px=exif.focal_px)
-                notes["focal prior"] = exif.source
-        if scd_cli is not None:
-            priors = replace(priors, scd_mm=scd_cli)
-            notes["SCD prior"] = "command line --scd-mm"
-        elif priors.scd_mm is not None:
-            notes["SCD prior"] = "photo.json"
-        for key, value in (("focal prior", priors.focal_px), ("SCD prior", priors.scd_mm)):
-            if value is not None:
-                unit = "px" if key == "focal prior" else "mm"
-                notes[key] = f"{value[0]:.0f}-{value[1]:.0f} {unit} ({notes[key]})"
-            else:
-                notes[key] = "none (penalty off)"
-        records.append((replace(photo, priors=priors), inputs, notes))
-    seen = {}
-    for i, (photo, inputs, notes) in enumerate(records):  # unique photo ids for the outputs
-        n = seen.get(photo.id, 0)
-        seen[photo.id] = n + 1
-        if n:
-            records[i] = (replace(photo, id=f"{photo.id}_{n + 1}"), inputs, notes)
-    return records
-
-
-def _json_keys(path):
-    from ..io.jsonio import read_json
-
-    data = read_json(path)
-    return data.keys() if isinstance(data, dict) else ()
-
-
-# --------------------------------------------------------------------------------------------
-# Running
-
-
-def run_case(args):
-    """Read, check, run every SFO, write the outputs; returns the report entries."""
-    from ..report.html import ReportEntry, write_report
-
-    skull, skull_inputs = load_skull(args.skull, args.landmarks, args.axes)
-    records = load_photos(args)
-    table = read_depth_table(args.depth_table) if args.depth_table else None
-    for photo, inputs, _ in records:  # every problem before any long run
-        try:
-            correspondences(skull, photo)
-        except ValueError as exc:
-            where = inputs.get("facial landmarks") or inputs.get("photo.json")
-            raise ValueError(f"{where}: {exc}") from None
-    methods = list(dict.fromkeys(args.method)) or ["lilium"]
-    options = lilium_options(args.variant, args.generations, args.population, args.max_seconds)
-    out = Path(args.out)
-    entries = []
-    for photo, inputs, notes in records:
-        for method in methods:
-            if method == "posest-sfo":
-                result = posest_sfo(skull, photo, depth_table=table)
-            else:
-                result = lilium_sfo(skull, photo, options, seed=args.seed, depth_table=table)
-            tag = method if method == "posest-sfo" else f"lilium-{args.variant}"
-            folder = out / photo.id / tag if len(methods) > 1 else out / photo.id
-            write_result(folder, result, result_overlay(result, skull, photo))
-            rel = folder.relative_to(out)
-            outputs = {"result.json": f"{rel.as_posix()}/result.json"}
-            if (folder / "overlay.png").is_file():
-                outputs["overlay.png"] = f"{rel.as_posix()}/overlay.png"
-            name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
-            status = (
-                f"focal {result.camera.focal_px:.0f} px, score {result.fitness:.4g}"
-                if result
-                else f"FAILED ({result.error})"
-            )
-            print(f"{photo.id}: {name}: {status}, {result.seconds:.2f} s -> {folder}")
-            entries.append(
-                ReportEntry(skull, photo, result, {**skull_inputs, **inputs}, notes, outputs)
-            )
-    report = write_report(
-        out / "report.html", entries, title=args.title, command=command_line(args, methods)
-    )
-    print(f"report: {report}")
-    return entries
 
 
 def command_line(args, methods):
@@ -389,5 +132,25 @@ def command_line(args, methods):
 
 
 def run(args):
-    entries = run_case(args)
+    methods = list(dict.fromkeys(args.method)) or ["lilium"]
+    entries = run_case(
+        args.skull,
+        args.photo,
+        args.out,
+        landmarks=args.landmarks,
+        axes=args.axes,
+        methods=methods,
+        options=options_from(args),
+        seed=args.seed,
+        depth_table=args.depth_table,
+        title=args.title,
+        command=command_line(args, methods),
+        photo_landmarks=args.photo_landmarks,
+        masks=args.mask,
+        views=args.view,
+        focal_px=args.focal_px,
+        scd_mm=args.scd_mm,
+        use_exif=not args.no_exif,
+        sensor_width_mm=args.sensor_width_mm,
+    )
     return 0 if all(e.result for e in entries) else 1

@@ -1,17 +1,13 @@
 """``lilium sfo``: one skull-face overlay from a subject folder and a photo folder."""
 
 import sys
-from dataclasses import replace
 from pathlib import Path
 
-from ..io.case import read_depth_table, read_photo, read_skull
-from ..io.results import write_result
-from ..methods.lilium import VARIANTS, LiliumOptions, lilium_sfo
-from ..methods.overlay import result_overlay
-from ..methods.posest_sfo import posest_sfo
+from ..casework.folders import sfo_on_folders
+from ..methods import METHODS, SfoOptions
 from ..optimisation.de import DEOptions
 
-METHODS = ("posest-sfo", "lilium")
+VARIANTS = METHODS["lilium"].variants
 
 
 def register(subparsers):
@@ -23,7 +19,7 @@ def register(subparsers):
     p.add_argument("--skull", required=True, type=Path, help="subject folder (SPEC section 8)")
     p.add_argument("--photo", required=True, type=Path, help="photo folder (SPEC section 8)")
     p.add_argument("--out", required=True, type=Path, help="output folder")
-    p.add_argument("--method", default="posest-sfo", choices=METHODS)
+    p.add_argument("--method", default="posest-sfo", choices=list(METHODS))
     p.add_argument(
         "--variant",
         default="skof+pll",
@@ -56,55 +52,26 @@ def register(subparsers):
     p.set_defaults(func=run)
 
 
-def lilium_options(variant="skof+pll", generations=None, population=None, max_seconds=None):
-    """:class:`LiliumOptions` with the given DE settings (None keeps the default)."""
-    de = DEOptions()
-    changes = {
-        "max_generations": generations,
-        "population_size": population,
-        "max_seconds": max_seconds,
-    }
-    de = replace(de, **{k: v for k, v in changes.items() if v is not None})
-    return LiliumOptions(variant=variant, de=de)
-
-
-def run_sfo(
-    skull_dir,
-    photo_dir,
-    out_dir,
-    method="posest-sfo",
-    axes=None,
-    depth_table=None,
-    overlay=True,
-    options=None,
-    seed=0,
-):
-    """Read the case, run the method, write the outputs; returns the :class:`SfoResult`."""
-    skull = read_skull(skull_dir, axes_path=axes)
-    photo = read_photo(photo_dir, load_image=overlay)
-    table = read_depth_table(depth_table) if depth_table else None
-    if method == "posest-sfo":
-        result = posest_sfo(skull, photo, depth_table=table)
-    elif method == "lilium":
-        result = lilium_sfo(skull, photo, options or LiliumOptions(), seed=seed, depth_table=table)
-    else:
-        raise ValueError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
-    write_result(out_dir, result, result_overlay(result, skull, photo) if overlay else None)
-    return result
+def options_from(args):
+    """The :class:`SfoOptions` of the command-line arguments (DE settings, variant)."""
+    return SfoOptions(variant=args.variant).with_de(
+        max_generations=args.generations,
+        population_size=args.population,
+        max_seconds=args.max_seconds,
+    )
 
 
 def run(args):
-    options = lilium_options(args.variant, args.generations, args.population, args.max_seconds)
-    result = run_sfo(
+    result = sfo_on_folders(
         args.skull,
         args.photo,
         args.out,
-        args.method,
-        args.axes,
-        args.depth_table,
-        not args.no_overlay,
-        options,
-        args.seed,
+        method=args.method,
+        options=options_from(args),
+        seed=args.seed,
+        axes=args.axes,
+        depth_table=args.depth_table,
+        overlay=not args.no_overlay,
     )
     if not result:
         print(

@@ -35,18 +35,17 @@ file's folder (to the current folder for a preset). Example::
 import hashlib
 import json
 import tomllib
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ..methods.registry import METHODS
 from ..optimisation.de import DEOptions
-
-_DE_DEFAULTS = DEOptions()
 
 #: The experiments of SPEC section 7.
 EXPERIMENTS = ("A", "B", "C")
 
-#: Lilium fitness variants (kept in step with :data:`lilium.methods.lilium.VARIANTS`).
-LILIUM_VARIANTS = ("base", "pll", "skof", "skof+pll")
+#: Lilium fitness variants (from the method registry).
+LILIUM_VARIANTS = METHODS["lilium"].variants
 
 #: Every method of the paper's protocol, as (method, variant) pairs.
 ALL_METHODS = (("posest-sfo", ""),) + tuple(("lilium", v) for v in LILIUM_VARIANTS)
@@ -75,14 +74,12 @@ class DatasetConfig:
     seed: int = 0
 
 
-@dataclass(frozen=True)
-class DESettings:
-    """Lilium's differential-evolution budget (population, generations, wall clock per SFO);
-    the defaults are :class:`lilium.optimisation.DEOptions`'s."""
-
-    population: int = _DE_DEFAULTS.population_size
-    generations: int = _DE_DEFAULTS.max_generations
-    max_seconds: float | None = _DE_DEFAULTS.max_seconds
+#: Keys of a config's ``[de]`` table and the :class:`DEOptions` fields they set.
+DE_KEYS = {
+    "population": "population_size",
+    "generations": "max_generations",
+    "max_seconds": "max_seconds",
+}
 
 
 @dataclass(frozen=True)
@@ -105,7 +102,9 @@ class ExperimentConfig:
         Exp. C: Lilium runs (seeds) per axis set.
     seed : int
         Lilium run ``r`` (0-based) uses the seed ``seed + r``.
-    de : DESettings
+    de : DEOptions
+        Lilium's differential evolution (the ``[de]`` table sets population, generations and
+        max_seconds; see :data:`DE_KEYS`).
     workers : int
         Local processes; 0 = all cores.
     db : Path
@@ -120,13 +119,14 @@ class ExperimentConfig:
     axes_sets: int = 5
     runs_per_axes_set: int = 5
     seed: int = 0
-    de: DESettings = field(default_factory=DESettings)
+    de: DEOptions = field(default_factory=DEOptions)
     workers: int = 0
     db: Path = Path("results.sqlite")
 
     def fingerprint(self):
         """Hash of the settings that change a result (a database holds one setting only)."""
-        key = {"de": asdict(self.de), "seed": self.seed, "dataset_seed": self.dataset.seed}
+        de = {key: getattr(self.de, name) for key, name in DE_KEYS.items()}
+        key = {"de": de, "seed": self.seed, "dataset_seed": self.dataset.seed}
         return hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:16]
 
 
@@ -143,7 +143,7 @@ PRESETS = {
         repetitions=2,
         axes_sets=2,
         runs_per_axes_set=2,
-        de=DESettings(population=10, generations=10, max_seconds=2.0),
+        de=DEOptions(population_size=10, max_generations=10, max_seconds=2.0),
         db=Path("lilium-quick/results.sqlite"),
     ),
     "paper": ExperimentConfig(
@@ -152,7 +152,7 @@ PRESETS = {
         repetitions=5,
         axes_sets=5,
         runs_per_axes_set=5,
-        de=DESettings(),
+        de=DEOptions(),
         db=Path("lilium-paper/results.sqlite"),
     ),
 }
@@ -286,9 +286,9 @@ def config_from_dict(data, base_dir=Path("."), where="config"):
     _check_keys(f"{where}: [de]", de, _DE_KEYS)
     de_changes = {}
     if "population" in de:
-        de_changes["population"] = _int(f"{where}: de.population", de["population"], lo=4)
+        de_changes["population_size"] = _int(f"{where}: de.population", de["population"], lo=4)
     if "generations" in de:
-        de_changes["generations"] = _int(f"{where}: de.generations", de["generations"], lo=1)
+        de_changes["max_generations"] = _int(f"{where}: de.generations", de["generations"], lo=1)
     if "max_seconds" in de:
         value = de["max_seconds"]
         if isinstance(value, bool) or not isinstance(value, (int, float)) or value < 0:

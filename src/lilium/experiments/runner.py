@@ -19,7 +19,6 @@ the same path (a shared file system).
 """
 
 import functools
-import importlib.util
 import json
 import os
 import socket
@@ -29,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .config import DESettings
+from ..optimisation.de import DEOptions
 from .store import KEY_COLUMNS, ResultStore
 
 #: Tasks in flight per worker (keeps workers busy without queueing the whole run).
@@ -62,7 +61,7 @@ class Task:
         The photo's subject and view.
     subject_dir, photo_dir : str
     axes_file : str or None
-    de : DESettings
+    de : DEOptions
     """
 
     experiment: str
@@ -78,7 +77,7 @@ class Task:
     subject_dir: str
     photo_dir: str
     axes_file: str | None
-    de: DESettings
+    de: DEOptions
 
     @property
     def key(self):
@@ -121,16 +120,6 @@ def load_dataset(cfg, workers=1, log=print):
             workers=max(1, min(workers, cfg.dataset.subjects)),
         )
     return root, read_json(index_path)
-
-
-def check_methods(methods):
-    """Fail early when a Lilium variant's fitness terms are not available."""
-    needs_terms = [v for m, v in methods if m == "lilium" and v != "base"]
-    if needs_terms and importlib.util.find_spec("lilium.methods.lilium_terms") is None:
-        raise ValueError(
-            f"the Lilium variant(s) {', '.join(needs_terms)} need lilium.methods.lilium_terms, "
-            "which this installation lacks; list only posest-sfo and lilium:base in methods"
-        )
 
 
 def enumerate_tasks(cfg, root, index):
@@ -240,19 +229,10 @@ def _photo(photo_dir):
 
 
 def _run_method(task, skull, photo):
-    if task.method == "posest-sfo":
-        from ..methods.posest_sfo import posest_sfo
+    from ..methods import SfoOptions, run_sfo
 
-        return posest_sfo(skull, photo)
-    from ..methods.lilium import LiliumOptions, lilium_sfo
-    from ..optimisation.de import DEOptions
-
-    de = DEOptions(
-        population_size=task.de.population,
-        max_generations=task.de.generations,
-        max_seconds=task.de.max_seconds,
-    )
-    return lilium_sfo(skull, photo, LiliumOptions(variant=task.variant, de=de), seed=task.seed)
+    options = SfoOptions(variant=task.variant or None, de=task.de)
+    return run_sfo(task.method, skull, photo, options, task.seed)
 
 
 def _finite(value):
@@ -510,7 +490,6 @@ def run_experiment(cfg, scheduler=None, workers=None, db=None, progress=True, lo
     RunSummary
     """
     start = time.perf_counter()
-    check_methods(cfg.methods)
     workers = workers if workers is not None else cfg.workers
     workers = workers or os.cpu_count() or 1
     root, index = load_dataset(cfg, workers=workers, log=log)

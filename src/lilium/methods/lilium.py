@@ -15,7 +15,6 @@ The whole population is evaluated at once (batched LM, batched projections).
 """
 
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -23,12 +22,14 @@ from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX
 from ..fitness.camera_penalty import camera_penalty_from_priors
 from ..geometry.camera import Camera, Cameras, principal_point_of
 from ..inputs import correspondences
-from ..optimisation.de import DEOptions, DifferentialEvolution
-from ..pose.posest import PosestOptions, posest
-from ..pose.refine import RefineOptions, refine_batch
+from ..optimisation.de import DifferentialEvolution
+from ..pose.posest import posest
+from ..pose.refine import refine_batch
 from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
+from .lilium_terms import PllTerm, SkofTerm
+from .options import SfoOptions
 from .result import SfoResult
 
 #: Variants: which optional penalties are on, (P_skof, P_pll).
@@ -38,28 +39,6 @@ VARIANTS = {
     "skof": (True, False),
     "skof+pll": (True, True),
 }
-
-
-@dataclass(frozen=True)
-class LiliumOptions:
-    """Options of :func:`lilium_sfo`.
-
-    Attributes
-    ----------
-    variant : {"base", "pll", "skof", "skof+pll"}
-    de : DEOptions
-    refine : RefineOptions
-        The warm-started inner Levenberg-Marquardt (few iterations: it starts near the optimum).
-    posest : PosestOptions
-        Initial population and fallback.
-    """
-
-    variant: str = "skof+pll"
-    de: DEOptions = field(default_factory=DEOptions)
-    refine: RefineOptions = field(
-        default_factory=lambda: RefineOptions(max_iterations=6, cost_tol=1e-8, gradient_tol=1e-8)
-    )
-    posest: PosestOptions = field(default_factory=PosestOptions)
 
 
 def build_cones(skull, corr, depth_table=None):
@@ -76,22 +55,21 @@ def build_cones(skull, corr, depth_table=None):
 
 
 class LiliumProblem:
-    """Fitness of a population of genotypes for one skull and one photo.
+    """Fitness of a population of genotypes for one skull and one photo (``(S, D) -> (S,)``).
 
-    Keeps the camera of every population member for warm starts; the DE solver tells it which
-    trials were accepted (:meth:`on_selection`).
+    Stateless between calls apart from its RANSAC generator: the cameras of the population
+    members travel with DE as their payload (:mod:`lilium.optimisation.de`).
 
     Parameters
     ----------
     skull : Skull
     photo : Photo
-    options : LiliumOptions
-    depth_table : dict, optional
+    options : SfoOptions
     rng : seed or numpy Generator
         For the RANSAC of initial and fallback POSEST runs.
     """
 
-    def __init__(self, skull, photo, options=LiliumOptions(), depth_table=None, rng=0):
+    def __init__(self, skull, photo, options=SfoOptions(), rng=0):
         if options.variant not in VARIANTS:
             raise ValueError(
                 f"unknown Lilium variant {options.variant!r}; use one of {', '.join(VARIANTS)}"
@@ -99,7 +77,7 @@ class LiliumProblem:
         self.skull, self.photo, self.options = skull, photo, options
         self.use_skof, self.use_pll = VARIANTS[options.variant]
         self.corr = correspondences(skull, photo)
-        self.cones = build_cones(skull, self.corr, depth_table)
+        self.cones = build_cones(skull, self.corr, options.depth_table)
         self.centre = principal_point_of(photo.image_size_wh)
         self.uv_c = self.corr.uv_px - self.centre
         names = self.corr.facial_names
@@ -108,23 +86,10 @@ class LiliumProblem:
         self.periodic = np.tile([False, False, True], len(self.corr.cranial_names))
         self.skof = self.pll = None
         if self.use_skof:
-            self.skof = self._prepare_skof()
+            self.skof = SkofTerm(self.skull, self.photo, self.centre)
         if self.use_pll:
-            self.pll = self._prepare_pll()
-        self.R = self.t = self.focal = self.ok = None  # cameras of the population members
-        self._trial = None
-        self.n_fallbacks = 0
-
-    # -- optional penalties ---------------------------------------------------------------
-    def _prepare_skof(self):
-        from .lilium_terms import SkofTerm
-
-        return SkofTerm(self.skull, self.photo, self.centre)
-
-    def _prepare_pll(self):
-        from .lilium_terms import PllTerm
-
-        return PllTerm(self.skull, self.photo, self.centre)
+            self.pll = PllTerm(self.skull, self.photo, self.centre)
+        self.n_fallbacks = 0  # statistics only
 
     # -- evaluation -------------------------------------------------------------------------
     def facial_landmarks(self, genes):
@@ -146,15 +111,22 @@ class LiliumProblem:
                 return camera
         return np.eye(3), np.array([0.0, 0.0, 1000.0]), 1000.0
 
-    def cameras(self, facial_mm, parents):
+    def cameras(self, facial_mm, members=None):
         """Cameras of a population: warm-started LM, POSEST where that fails.
+
+        Parameters
+        ----------
+        facial_mm : ndarray of shape (S, N, 3)
+        members : dict or None
+            Payload of the members the trials compete with (``R``, ``t``, ``focal_px``,
+            ``success``): each trial starts from its member's camera. None = initial population.
 
         Returns
         -------
         R (S, 3, 3), t (S, 3), focal_px (S,), success (S,) bool, sq_err_px2 (S, N)
         """
         S = len(facial_mm)
-        if parents is None:
+        if members is None:
             # One POSEST, then every member refines from that camera (members it does not suit
             # fall back to their own POSEST below).
             R1, t1, f1 = self._initial_camera(facial_mm)
@@ -164,12 +136,12 @@ class LiliumProblem:
                 np.full(S, f1),
             )
         else:
-            R0, t0, f0 = self.R[parents], self.t[parents], self.focal[parents]
+            R0, t0, f0 = (np.array(members[k]) for k in ("R", "t", "focal_px"))
+            ok = members["success"]
             # A member without a valid camera lends none: start from a valid member's.
-            invalid = ~self.ok[parents]
-            if invalid.any() and self.ok.any():
-                j = np.flatnonzero(self.ok)[0]
-                R0[invalid], t0[invalid], f0[invalid] = self.R[j], self.t[j], self.focal[j]
+            if (~ok).any() and ok.any():
+                j = np.flatnonzero(ok)[0]
+                R0[~ok], t0[~ok], f0[~ok] = R0[j], t0[j], f0[j]
         ref = refine_batch(self.uv_c, facial_mm, R0, t0, f0, options=self.options.refine)
         R, t, f = ref.R, ref.t, ref.focal_px
         # Numerical failure (a point behind the camera): fall back to full POSEST. A focal length
@@ -185,34 +157,35 @@ class LiliumProblem:
         sq[~ok] = np.inf
         return R, t, f, ok, sq
 
-    def evaluate(self, genes, parents=None, thresholds=None):
+    def evaluate(self, genes, members=None, thresholds=None):
         """All fitness terms of a population.
 
         Parameters
         ----------
         genes : ndarray of shape (S, 3N)
-        parents : ndarray of shape (S,), int, or None
-            Population member each trial competes with (warm start); None = initial population.
+        members : dict or None
+            Payload of the members the trials compete with (warm start); None = initial
+            population.
         thresholds : ndarray of shape (S,), optional
             Fitness each trial must reach to win. The image penalties (the expensive terms) are
             skipped for a trial whose cheaper terms already exceed its threshold; its fitness is
-            then that lower bound and the skipped terms are NaN.
+            then that lower bound and the skipped terms are NaN (the trial loses either way).
 
         Returns
         -------
-        dict of str -> ndarray of shape (S,)
+        dict of str -> ndarray of shape (S, ...)
             ``fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (NaN when off or
             skipped), ``success`` and the cameras ``R``, ``t``, ``focal_px``.
         """
         facial = self.facial_landmarks(genes)
-        R, t, f, ok, sq = self.cameras(facial, parents)
+        R, t, f, ok, sq = self.cameras(facial, members)
         S = len(R)
         mse = np.where(ok, np.mean(sq, axis=1), C_INF)
         mse = np.where(np.isfinite(mse), mse, C_INF)
-        cam = facial[:, self.scd_index].mean(axis=1)
+        centre = facial[:, self.scd_index].mean(axis=1)
         # Cameras that ran off (huge focal and depth) overflow here; P_cam gives them C_INF.
         with np.errstate(over="ignore", invalid="ignore"):
-            scd = np.linalg.norm(np.einsum("sij,sj->si", R, cam) + t, axis=1)
+            scd = np.linalg.norm(np.einsum("sij,sj->si", R, centre) + t, axis=1)
             p_cam = camera_penalty_from_priors(f, scd, R, ok, self.photo.priors)
         fitness = mse + p_cam
         bound = np.full(S, np.inf) if thresholds is None else np.asarray(thresholds, float)
@@ -238,58 +211,51 @@ class LiliumProblem:
             "success": ok,
         }
 
-    def __call__(self, genes, parents, thresholds=None):
-        terms = self.evaluate(genes, parents, thresholds)
-        cameras = (terms["R"], terms["t"], terms["focal_px"], terms["success"])
-        if parents is None:
-            self.R, self.t, self.focal, self.ok = cameras
-        else:
-            self._trial = cameras
-        return terms["fitness"]
-
-    def on_selection(self, accepted):
-        """Adopt the cameras of the accepted trials."""
-        for mine, trial in zip((self.R, self.t, self.focal, self.ok), self._trial, strict=True):
-            mine[accepted] = trial[accepted]
+    def __call__(self, genes, members=None, thresholds=None):
+        """DE's objective: ``(fitness (S,), payload)``, the payload being :meth:`evaluate`'s
+        dictionary (each member's camera and terms)."""
+        terms = self.evaluate(genes, members, thresholds)
+        return terms["fitness"], terms
 
 
-def lilium_sfo(skull, photo, options=LiliumOptions(), seed=0, depth_table=None, callback=None):
+def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     """Run Lilium on one skull and one photo.
 
     Parameters
     ----------
     skull : Skull
     photo : Photo
-    options : LiliumOptions
+    options : SfoOptions
     seed : int
         Seeds DE and the RANSAC of POSEST calls: the same seed gives the same result.
-    depth_table : dict, optional
     callback : callable, optional
         ``callback(solver) -> bool`` after every generation (progress; True stops).
 
     Returns
     -------
     SfoResult
-        ``extra`` holds ``history`` (best fitness per generation), ``generations``,
-        ``evaluations``, ``stop`` and ``genes``.
+        The best member DE ranked: its camera, fitness and terms as DE evaluated them
+        (``fitness`` equals the last value of ``history``). ``extra`` holds ``history`` (best
+        fitness per generation), ``generations``, ``evaluations``, ``stop``, ``genes`` and
+        ``fallbacks``.
     """
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
-    problem = LiliumProblem(skull, photo, options, depth_table, rng=rng)
+    problem = LiliumProblem(skull, photo, options, rng=rng)
     solver = DifferentialEvolution(
         problem, problem.cones.n_genes, problem.periodic, options.de, rng=rng, callback=callback
     )
     de = solver.solve()
-    best = problem.evaluate(de.x[None], parents=None)
-    ok = bool(best["success"][0])
-    facial = problem.facial_landmarks(de.x)[0]
+    best = de.payload
+    ok = bool(best["success"])
     camera = None
     if ok:
-        camera = Camera.from_rt(best["R"][0], best["t"][0], best["focal_px"][0], problem.centre)
+        camera = Camera.from_rt(best["R"], best["t"], best["focal_px"], problem.centre)
     terms = {
-        k: (None if np.isnan(best[k][0]) else float(best[k][0]))
+        k: (None if np.isnan(best[k]) else float(best[k]))
         for k in ("mse_pix", "p_cam", "p_skof", "p_pll")
     }
+    facial = problem.facial_landmarks(de.x)[0]
     return SfoResult(
         method="lilium",
         variant=options.variant,
@@ -297,7 +263,7 @@ def lilium_sfo(skull, photo, options=LiliumOptions(), seed=0, depth_table=None, 
         skull_id=skull.id,
         photo_id=photo.id,
         camera=camera,
-        fitness=float(best["fitness"][0]),
+        fitness=de.fun,
         terms=terms,
         facial_landmarks_mm=dict(zip(problem.corr.facial_names, facial, strict=True)),
         seconds=time.perf_counter() - start,

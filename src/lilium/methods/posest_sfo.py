@@ -12,8 +12,9 @@ import numpy as np
 
 from ..geometry.camera import principal_point_of
 from ..inputs import correspondences
-from ..pose.posest import PosestOptions, posest
+from ..pose.posest import posest
 from ..softtissue.depths import depth_stats
+from .options import SfoOptions
 from .result import SfoResult
 
 
@@ -34,15 +35,15 @@ def mean_depth_landmarks(corr, depth_table=None):
     return corr.cranial_mm + depth[:, None] * corr.axes
 
 
-def posest_sfo(skull, photo, depth_table=None, options=PosestOptions(), seed=0):
+def posest_sfo(skull, photo, options=SfoOptions(), seed=0):
     """Run POSEST-SFO on one skull and one photo.
 
     Parameters
     ----------
     skull : lilium.inputs.Skull
     photo : lilium.inputs.Photo
-    depth_table : dict, optional
-    options : PosestOptions
+    options : SfoOptions
+        Uses ``posest`` and ``depth_table``.
     seed : int
         RANSAC seed (fixed: the method is deterministic).
 
@@ -59,9 +60,9 @@ def posest_sfo(skull, photo, depth_table=None, options=PosestOptions(), seed=0):
     """
     start = time.perf_counter()
     corr = correspondences(skull, photo)
-    facial_mm = mean_depth_landmarks(corr, depth_table)
+    facial_mm = mean_depth_landmarks(corr, options.depth_table)
     centre = principal_point_of(photo.image_size_wh)
-    pose = posest(corr.uv_px, facial_mm, centre, options, rng=seed)
+    pose = posest(corr.uv_px, facial_mm, centre, options.posest, rng=seed)
     landmarks = dict(zip(corr.facial_names, facial_mm, strict=True))
     common = dict(
         method="posest-sfo",

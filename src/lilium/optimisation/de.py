@@ -15,6 +15,12 @@ Decisions the paper leaves open (SPEC section 6), fixed here:
 - Greedy one-to-one selection (a trial replaces its target when not worse).
 - Termination: a generation count, a wall-clock limit, or a stagnation count (generations without
   improvement of the best fitness), whichever comes first; each can be switched off.
+
+Payloads: an objective may return, with the fitness, a *payload* per member: a dict of arrays
+whose first axis is the population (e.g. each member's camera and fitness terms). The solver
+keeps the payload of every member next to its genes, hands the payload of the members the trials
+compete with back to the objective (warm starts), replaces it where a trial wins, and returns the
+best member's payload with its genes: what the result reports is exactly what DE ranked.
 """
 
 import time
@@ -79,6 +85,10 @@ class DEResult:
     history : ndarray of shape (nit + 1,)
         Best fitness after initialisation and after every generation.
     seconds : float
+    payload : dict of str -> ndarray or None
+        The best member's payload (each array indexed at that member), when the objective
+        returns payloads.
+    population_payload : dict of str -> ndarray of shape (S, ...) or None
     """
 
     x: np.ndarray
@@ -90,6 +100,29 @@ class DEResult:
     population_fitness: np.ndarray
     history: np.ndarray
     seconds: float
+    payload: dict | None = None
+    population_payload: dict | None = None
+
+
+def _split(output):
+    """``(fitness (S,) float, payload dict or None)`` of an objective's return value."""
+    if isinstance(output, tuple):
+        fitness, payload = output
+    else:
+        fitness, payload = output, None
+    return np.asarray(fitness, dtype=float), payload
+
+
+def select_payload(accepted, trial, current):
+    """Member payloads after selection: ``trial[k][i]`` where ``accepted[i]``, else ``current``."""
+    if current is None:
+        return None
+    out = {}
+    for key, old in current.items():
+        new = np.asarray(trial[key])
+        shape = (-1,) + (1,) * (new.ndim - 1)
+        out[key] = np.where(np.reshape(accepted, shape), new, old)
+    return out
 
 
 def exponential_crossover_mask(n_members, n_genes, CR, rng):
@@ -138,12 +171,13 @@ class DifferentialEvolution:
     Parameters
     ----------
     objective : callable
-        ``objective(population (S, D), parents (S,) int or None, thresholds (S,) or None) -> (S,)``
-        fitness, lower is better. ``parents[i]`` is the population index trial ``i`` competes
-        with (for warm starts) and ``thresholds[i]`` that member's fitness; both are ``None`` at
-        initialisation. Where an objective can prove a trial worse than its threshold (a partial
-        sum of non-negative terms already above it) it may return that lower bound instead of
-        the full fitness: the trial loses either way, so the run is unchanged.
+        ``objective(population (S, D), members, thresholds) -> fitness (S,)`` or
+        ``(fitness (S,), payload)``, lower is better. ``members`` is the payload of the members
+        the trials compete with (trial ``i`` against member ``i``; see the module notes) and
+        ``thresholds[i]`` member ``i``'s fitness; both are ``None`` at initialisation. Where an
+        objective can prove a trial worse than its threshold (a partial sum of non-negative
+        terms already above it) it may return that lower bound instead of the full fitness: the
+        trial loses either way, so the run is unchanged and every member's fitness is exact.
     n_genes : int
     periodic : array_like of shape (D,), bool, optional
         Genes that wrap (azimuths).
@@ -165,7 +199,7 @@ class DifferentialEvolution:
         self.callback = callback
         self._start = time.perf_counter()
         self.population = self.rng.random((options.population_size, n_genes))
-        self.fitness = np.asarray(objective(self.population, None, None), dtype=float)
+        self.fitness, self.payload = _split(objective(self.population, None, None))
         self.nfev = options.population_size
         self.nit = 0
         self.history = [float(self.fitness.min())]
@@ -212,25 +246,20 @@ class DifferentialEvolution:
         mutant = pop[r[:, 0]] + o.F * (pop[r[:, 1]] - pop[r[:, 2]])
         take = exponential_crossover_mask(S, D, o.CR, self.rng)
         trial = fold_into_cube(np.where(take, mutant, pop), self.periodic, self.rng)
-        trial_fitness = np.asarray(
-            self.objective(trial, np.arange(S), self.fitness.copy()), dtype=float
+        trial_fitness, trial_payload = _split(
+            self.objective(trial, self.payload, self.fitness.copy())
         )
         self.nfev += S
         better = trial_fitness <= self.fitness
         before = self.fitness.min()
         self.population[better] = trial[better]
         self.fitness[better] = trial_fitness[better]
-        self.on_selection(better)
+        self.payload = select_payload(better, trial_payload, self.payload)
         self.nit += 1
         best = self.fitness.min()
         improved = best < before - o.stagnation_tol * max(abs(before), 1e-300)
         self._since_improvement = 0 if improved else self._since_improvement + 1
         self.history.append(float(best))
-
-    def on_selection(self, accepted):
-        """Hook for problems that keep per-member state (e.g. warm-start cameras)."""
-        if hasattr(self.objective, "on_selection"):
-            self.objective.on_selection(accepted)
 
     def solve(self):
         """Run to termination and return a :class:`DEResult`."""
@@ -247,6 +276,8 @@ class DifferentialEvolution:
             population_fitness=self.fitness.copy(),
             history=np.asarray(self.history),
             seconds=self.elapsed,
+            payload=None if self.payload is None else {k: v[i] for k, v in self.payload.items()},
+            population_payload=self.payload,
         )
 
 

@@ -1,0 +1,96 @@
+"""Every SFO of a user's case, written as it goes, and one HTML report for them all."""
+
+from pathlib import Path
+
+from ..inputs import correspondences
+from ..io.case import read_depth_table
+from ..io.results import write_result
+from ..methods.options import SfoOptions
+from ..methods.overlay import result_overlay
+from ..methods.registry import check_method, method_tag, run_sfo
+from .inputs import load_photos, load_skull
+
+
+def run_case(
+    skull_path,
+    photos,
+    out,
+    landmarks=None,
+    axes=None,
+    methods=("lilium",),
+    options=SfoOptions(),
+    seed=0,
+    depth_table=None,
+    title=None,
+    command=None,
+    log=print,
+    **photo_options,
+):
+    """Read and check every input, run every SFO, write each result and the report.
+
+    Parameters
+    ----------
+    skull_path : path
+        Subject folder or skull mesh (:func:`~lilium.casework.inputs.load_skull`).
+    photos : list of path
+        Photo folders or images; ``photo_options`` go to
+        :func:`~lilium.casework.inputs.load_photos`.
+    out : path
+        Output folder: ``report.html`` and, per photo, ``<photo>/result.json`` and
+        ``overlay.png`` (``<photo>/<method tag>/`` when several methods run).
+    landmarks, axes : path, optional
+    methods : sequence of str
+    options : SfoOptions
+    seed : int
+    depth_table : path, optional
+    title, command : str, optional
+        Report title and the equivalent command line (provenance).
+    log : callable
+        Receives one line per SFO.
+
+    Returns
+    -------
+    list of ReportEntry
+    """
+    from ..report.html import ReportEntry, write_report
+
+    methods = list(dict.fromkeys(methods)) or ["lilium"]
+    for method in methods:
+        check_method(method, options.variant)
+    skull, skull_inputs = load_skull(skull_path, landmarks, axes)
+    records = load_photos(photos, **photo_options)
+    if depth_table:
+        from dataclasses import replace
+
+        options = replace(options, depth_table=read_depth_table(depth_table))
+    for photo, inputs, _ in records:  # every problem before any long run
+        try:
+            correspondences(skull, photo)
+        except ValueError as exc:
+            where = inputs.get("facial landmarks") or inputs.get("photo.json")
+            raise ValueError(f"{where}: {exc}") from None
+    out = Path(out)
+    entries = []
+    for photo, inputs, notes in records:
+        for method in methods:
+            result = run_sfo(method, skull, photo, options, seed)
+            tag = method_tag(method, options.variant)
+            folder = out / photo.id / tag if len(methods) > 1 else out / photo.id
+            write_result(folder, result, result_overlay(result, skull, photo))
+            rel = folder.relative_to(out)
+            outputs = {"result.json": f"{rel.as_posix()}/result.json"}
+            if (folder / "overlay.png").is_file():
+                outputs["overlay.png"] = f"{rel.as_posix()}/overlay.png"
+            name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
+            status = (
+                f"focal {result.camera.focal_px:.0f} px, score {result.fitness:.4g}"
+                if result
+                else f"FAILED ({result.error})"
+            )
+            log(f"{photo.id}: {name}: {status}, {result.seconds:.2f} s -> {folder}")
+            entries.append(
+                ReportEntry(skull, photo, result, {**skull_inputs, **inputs}, notes, outputs)
+            )
+    report = write_report(out / "report.html", entries, title=title, command=command)
+    log(f"report: {report}")
+    return entries

@@ -1,0 +1,227 @@
+"""A user's skull and photos, from SPEC section 8 folders or the files a practitioner has.
+
+A mesh's landmark file defaults to a sibling with the mesh's stem (``skull.fcsv``, ...); an
+image's landmark file to ``<stem>.csv``/``.json`` or ``<stem>_landmarks.*`` and its mask to
+``<stem>_mask.png``. Priors: the command line's ``--focal-px``/``--scd-mm`` override
+``photo.json``; without either, the focal prior comes from the photo's EXIF when it has one.
+"""
+
+from dataclasses import replace
+from pathlib import Path
+
+from ..io.case import IMAGE_NAMES, photo_from_files, read_photo, read_skull, skull_from_files
+from ..io.formats import find_landmark_file
+from ..io.mesh import MESH_SUFFIXES
+
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
+
+
+def _first_file(folder, names):
+    return next((folder / n for n in names if (folder / n).is_file()), None)
+
+
+def load_skull(skull_path, landmarks=None, axes=None):
+    """Read the skull from a subject folder or a mesh file.
+
+    Returns
+    -------
+    skull : Skull
+    inputs : dict of str -> Path
+        The files used, labelled, for the provenance.
+    """
+    skull_path = Path(skull_path)
+    if skull_path.is_dir():
+        mesh = _first_file(skull_path, [f"skull{s}" for s in MESH_SUFFIXES])
+        if landmarks is None:
+            skull = read_skull(skull_path, axes_path=axes)
+            landmarks = _first_file(skull_path, ["cranial_landmarks.json"]) or find_landmark_file(
+                skull_path, ["cranial_landmarks", "skull"]
+            )
+        else:
+            if mesh is None:
+                read_skull(skull_path)  # raises its "no skull mesh" message
+            axes = axes or skull_path / "soft_tissue_axes.json"
+            skull = skull_from_files(mesh, landmarks, axes, skull_id=skull_path.name)
+        axes = Path(axes) if axes else skull_path / "soft_tissue_axes.json"
+    elif skull_path.is_file():
+        mesh = skull_path
+        if skull_path.suffix.lower() not in MESH_SUFFIXES:
+            raise ValueError(
+                f"{skull_path}: --skull must be a subject folder or a PLY/OBJ/STL mesh; convert "
+                "the skull to one of those"
+            )
+        if landmarks is None:
+            landmarks = find_landmark_file(
+                skull_path.parent, [skull_path.stem, f"{skull_path.stem}_landmarks"]
+            )
+            if landmarks is None:
+                raise ValueError(
+                    f"{skull_path}: no cranial landmark file next to the mesh; give it with "
+                    "--landmarks FILE (.mrk.json, .fcsv, .pp, .csv or .json)"
+                )
+        skull = skull_from_files(mesh, landmarks, axes)
+    else:
+        raise ValueError(
+            f"{skull_path}: --skull not found; give a subject folder or a skull mesh file"
+        )
+    inputs = {"skull mesh": mesh, "cranial landmarks": landmarks}
+    if axes is not None and Path(axes).is_file():
+        inputs["soft-tissue axes"] = Path(axes)
+    return skull, inputs
+
+
+def _per_photo(values, n, option, allow_one=False):
+    if not values:
+        return [None] * n
+    if allow_one and len(values) == 1:
+        return values * n
+    if len(values) != n:
+        raise ValueError(
+            f"command line: {option} given {len(values)} times for {n} photo image(s); give it "
+            "once per --photo image (not folder), in the same order"
+        )
+    return list(values)
+
+
+def _sibling(image_path, stems, suffixes):
+    for stem in stems:
+        for suffix in suffixes:
+            candidate = image_path.with_name(stem + suffix)
+            if candidate.is_file() and candidate != image_path:
+                return candidate
+    return None
+
+
+def _check_interval(values, option):
+    if values is None:
+        return None
+    lo, hi = values
+    if not (0 < lo <= hi) or not all(map(_finite, values)):
+        raise ValueError(
+            f"command line: {option} must be LO HI with 0 < LO <= HI, got {lo:g} {hi:g}"
+        )
+    return float(lo), float(hi)
+
+
+def _finite(x):
+    return x == x and abs(x) != float("inf")
+
+
+def load_photos(
+    photos,
+    photo_landmarks=(),
+    masks=(),
+    views=(),
+    focal_px=None,
+    scd_mm=None,
+    use_exif=True,
+    sensor_width_mm=None,
+):
+    """Read every photo (folders and image files) with its priors.
+
+    Parameters
+    ----------
+    photos : list of path
+        Photo folders (SPEC section 8) or PNG/JPEG images.
+    photo_landmarks, masks : list of path
+        Per image file (not folder), in order; landmark files default to a sibling
+        ``<stem>.csv``/``.json``/``<stem>_landmarks.*``, masks to ``<stem>_mask.png``.
+    views : list of str
+        Once for all images, or once per image (default frontal).
+    focal_px, scd_mm : (lo, hi), optional
+        Priors from the command line: they win over ``photo.json``; without a focal prior the
+        photo's EXIF gives one when ``use_exif``.
+    sensor_width_mm : float, optional
+        For the EXIF focal prior.
+
+    Returns
+    -------
+    list of (Photo, dict inputs, dict notes)
+        ``inputs``: the files used, labelled (provenance); ``notes``: where each prior came from.
+    """
+    photos = [Path(p) for p in photos]
+    image_files = [p for p in photos if not p.is_dir()]
+    lm_files = _per_photo(list(photo_landmarks), len(image_files), "--photo-landmarks")
+    masks = _per_photo(list(masks), len(image_files), "--mask")
+    views = _per_photo(list(views), len(image_files), "--view", allow_one=True)
+    focal_cli = _check_interval(focal_px, "--focal-px")
+    scd_cli = _check_interval(scd_mm, "--scd-mm")
+    records, k_file = [], 0
+    for path in photos:
+        inputs, notes = {}, {}
+        if path.is_dir():
+            photo = read_photo(path)
+            image = _first_file(path, IMAGE_NAMES)
+            inputs["photo"] = image
+            inputs["photo.json"] = path / "photo.json"
+            lm_file = find_landmark_file(path, ["facial_landmarks", "landmarks"])
+            if lm_file is not None and "landmarks" not in _json_keys(path / "photo.json"):
+                inputs["facial landmarks"] = lm_file
+            for name, label in (("face_mask.png", "face mask"), ("face_curve.json", "face curve")):
+                if (path / name).is_file():
+                    inputs[label] = path / name
+        else:
+            if not path.is_file():
+                raise ValueError(f"{path}: --photo not found; give a photo folder or an image")
+            if path.suffix.lower() not in IMAGE_SUFFIXES:
+                raise ValueError(f"{path}: --photo must be a folder or a PNG/JPEG image")
+            image = path
+            lm_file = lm_files[k_file] or _sibling(
+                path,
+                [path.stem, f"{path.stem}_landmarks", f"{path.stem}.landmarks"],
+                (".csv", ".json", ".tsv", ".txt"),
+            )
+            if lm_file is None:
+                raise ValueError(
+                    f"{path}: no facial landmark file for this photo; give it with "
+                    "--photo-landmarks FILE (CSV name,u,v or JSON), once per --photo image"
+                )
+            mask = masks[k_file] or _sibling(
+                path, [f"{path.stem}_mask", f"{path.stem}.mask"], (".png",)
+            )
+            view = views[k_file] or "frontal"
+            k_file += 1
+            photo = photo_from_files(path, lm_file, view, mask)
+            inputs["photo"] = path
+            inputs["facial landmarks"] = lm_file
+            if mask is not None:
+                inputs["face mask"] = mask
+        priors = photo.priors
+        if focal_cli is not None:
+            priors = replace(priors, focal_px=focal_cli)
+            notes["focal prior"] = "command line --focal-px"
+        elif priors.focal_px is not None:
+            notes["focal prior"] = "photo.json"
+        elif use_exif:
+            from ..io.exif import focal_prior_from_exif
+
+            exif = focal_prior_from_exif(image, sensor_width_mm=sensor_width_mm)
+            if exif is not None:
+                priors = replace(priors, focal_px=exif.focal_px)
+                notes["focal prior"] = exif.source
+        if scd_cli is not None:
+            priors = replace(priors, scd_mm=scd_cli)
+            notes["SCD prior"] = "command line --scd-mm"
+        elif priors.scd_mm is not None:
+            notes["SCD prior"] = "photo.json"
+        for key, value in (("focal prior", priors.focal_px), ("SCD prior", priors.scd_mm)):
+            if value is not None:
+                unit = "px" if key == "focal prior" else "mm"
+                notes[key] = f"{value[0]:.0f}-{value[1]:.0f} {unit} ({notes[key]})"
+            else:
+                notes[key] = "none (penalty off)"
+        records.append((replace(photo, priors=priors), inputs, notes))
+    seen = {}
+    for i, (photo, inputs, notes) in enumerate(records):  # unique photo ids for the outputs
+        n = seen.get(photo.id, 0)
+        seen[photo.id] = n + 1
+        if n:
+            records[i] = (replace(photo, id=f"{photo.id}_{n + 1}"), inputs, notes)
+    return records
+
+
+def _json_keys(path):
+    from ..io.jsonio import read_json
+
+    data = read_json(path)
+    return data.keys() if isinstance(data, dict) else ()

@@ -1,0 +1,94 @@
+"""One way to run an SFO: the method registry and :func:`run_sfo`.
+
+Every caller (``lilium sfo``, ``lilium case``, the experiment runner, the demo, benchmarks)
+runs a method through :func:`run_sfo` with one :class:`~lilium.methods.options.SfoOptions`;
+:data:`METHODS` is the one list of methods and their variants.
+"""
+
+from dataclasses import dataclass
+
+from .lilium import VARIANTS, lilium_sfo
+from .options import SfoOptions
+from .posest_sfo import posest_sfo
+
+
+@dataclass(frozen=True)
+class Method:
+    """An SFO method.
+
+    Attributes
+    ----------
+    name : str
+        As on the command line and in ``result.json``.
+    run : callable
+        ``run(skull, photo, options, seed) -> SfoResult``.
+    variants : tuple of str
+        Fitness variants (empty for a method without variants).
+    stochastic : bool
+        Whether the seed changes the result (repetitions make sense).
+    """
+
+    name: str
+    run: object
+    variants: tuple = ()
+    stochastic: bool = False
+
+
+def _posest_sfo(skull, photo, options, seed):
+    del seed  # deterministic: RANSAC runs with its fixed seed
+    return posest_sfo(skull, photo, options)
+
+
+def _lilium(skull, photo, options, seed):
+    return lilium_sfo(skull, photo, options, seed=seed)
+
+
+#: The methods, by name.
+METHODS = {
+    "posest-sfo": Method("posest-sfo", _posest_sfo),
+    "lilium": Method("lilium", _lilium, tuple(VARIANTS), stochastic=True),
+}
+
+
+def check_method(method, variant=None):
+    """Validate a method name (and variant); returns the :class:`Method`."""
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+    m = METHODS[method]
+    if m.variants and variant is not None and variant not in m.variants:
+        raise ValueError(
+            f"unknown {method} variant {variant!r}; use one of {', '.join(m.variants)}"
+        )
+    return m
+
+
+def method_tag(method, variant=None):
+    """Folder-safe label of a method run: ``posest-sfo``, ``lilium-skof+pll``."""
+    return f"{method}-{variant}" if METHODS[method].variants and variant else method
+
+
+def run_sfo(method, skull, photo, options=SfoOptions(), seed=0):
+    """Run one SFO.
+
+    Parameters
+    ----------
+    method : str
+        A key of :data:`METHODS`.
+    skull : lilium.inputs.Skull
+    photo : lilium.inputs.Photo
+    options : SfoOptions
+        ``options.variant`` selects the variant of a method that has them.
+    seed : int
+        For stochastic methods; the same seed gives the same result.
+
+    Returns
+    -------
+    SfoResult
+
+    Raises
+    ------
+    ValueError
+        Unknown method or variant, or a case the method cannot run (too few landmarks, ...).
+    """
+    m = check_method(method, options.variant)
+    return m.run(skull, photo, options, seed)
