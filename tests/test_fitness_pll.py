@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+import pll_oracle as oracle
 from lilium.fitness.curves import (
     detect_curve,
     face_curve_from_mask,
@@ -231,7 +232,20 @@ def test_batched_pll_equals_the_reference_on_random_cameras(view):
     if view != "frontal":
         span_v = np.column_stack([uv[:, 0, 1] + 40, uv[:, -1, 1] - 40])
     ref = np.array(
-        [ctx.evaluate(u, None if span_v is None else span_v[i]).total for i, u in enumerate(uv)]
+        [
+            oracle.pll_penalty(
+                oracle.detect_curve(
+                    u,
+                    faces,
+                    view,
+                    span_v=None if span_v is None else span_v[i],
+                    image_shape=(480, 640),
+                ),
+                ctx.face_curve,
+                view,
+            ).total
+            for i, u in enumerate(uv)
+        ]
     )
     batch = ctx.evaluate_batch(uv, span_v)
     np.testing.assert_array_equal(batch, ref)
@@ -249,7 +263,7 @@ def test_batched_curves_equal_detect_curve():
     for view in ("frontal", "lateral_left", "lateral_right"):
         batch = detect_curves_batch(uv, view, topology=topo, image_shape=(480, 640))
         for i in range(len(uv)):
-            ref = detect_curve(uv[i], faces, view, image_shape=(480, 640))
+            ref = oracle.detect_curve(uv[i], faces, view, image_shape=(480, 640))
             np.testing.assert_array_equal(batch.curve(i), ref)
 
 
