@@ -18,8 +18,8 @@ import numpy as np
 from scipy import ndimage
 from scipy.spatial.transform import Rotation
 
-from lilium.fitness.curves import face_curve_from_mask
-from lilium.fitness.pll import PllContext, pll_penalty
+from lilium.fitness.curves import CurveBatch, face_curve_from_mask
+from lilium.fitness.pll import PllContext, pll_terms_batch
 from lilium.fitness.raster import mesh_edge_topology
 from lilium.fitness.regions import submesh
 from lilium.fitness.skof import (
@@ -155,14 +155,15 @@ def bench_pll():
     skull_curve = ctx.skull_curve(uv)
     terms = ctx.evaluate(uv)
     t_detect = timeit(lambda: ctx.skull_curve(uv), 50)
-    t_pen = timeit(lambda: pll_penalty(skull_curve, ctx.face_curve, "frontal"), 50)
+    one = CurveBatch.from_curves([skull_curve])
+    t_pen = timeit(lambda: pll_terms_batch(one, ctx.face_index, "frontal"), 50)
     t_all = timeit(lambda: ctx.evaluate(uv), 50)
     print(
         f"\nP_pll (frontal, chin-sized region of {len(sub_faces)} faces from the 50k mesh, "
         f"skull curve {len(skull_curve)} px, face curve {len(ctx.face_curve)} px): {terms}"
     )
     print(
-        f"detect_curve {1e3 * t_detect:.3f} ms, pll_penalty (trim + pair + terms) "
+        f"skull_curve {1e3 * t_detect:.3f} ms, pll_terms_batch (trim + pair + terms) "
         f"{1e3 * t_pen:.3f} ms, PllContext.evaluate (both) {1e3 * t_all:.3f} ms"
     )
 

@@ -8,9 +8,11 @@ populations of 30 cameras drawn around the ground truth ("near": 2 deg, 10 mm, 3
 
 Reported per term and view:
 
-- P_pll: the reference path (:meth:`PllContext.evaluate`, one individual at a time: detect_curve
-  + pll_penalty with cKDTrees) against the batched :meth:`PllContext.evaluate_batch`, and the
-  largest difference between their totals (must be 0).
+- P_pll: the readable per-curve oracle of the tests (``tests/pll_oracle.py``, one individual at
+  a time: detect_curve + pll_penalty), production one individual at a time
+  (:meth:`PllContext.evaluate`, a batch of one) and the batched
+  :meth:`PllContext.evaluate_batch`, and the largest difference between the oracle's totals and
+  the batched ones (must be 0).
 - P_skof: :meth:`SkofTerm.outside_pixels` (projection + exact union count) at the decimated
   level, and the pixel-count difference of the decimated skull (:data:`SKOF_FACES`) against the
   full mesh on the same cameras (relative to the full count and to ``|S|``).
@@ -28,6 +30,10 @@ from lilium.fitness.skof import prepare_skof, skull_outside_pixels_batch
 from lilium.geometry.camera import Cameras, principal_point_of
 from lilium.io.case import read_photo, read_skull
 from lilium.methods.lilium_terms import PllTerm, SkofTerm
+
+# The tests' readable per-curve P_pll, the reference the batched totals must equal.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+import pll_oracle  # noqa: E402
 
 POPULATION = 30
 REPEAT = 5
@@ -82,13 +88,33 @@ def bench_case(name, skull, photo, truth):
         def reference(uv=uv, span_v=span_v, ctx=ctx):
             return np.array(
                 [
+                    pll_oracle.pll_penalty(
+                        pll_oracle.detect_curve(
+                            u,
+                            view=ctx.view,
+                            span_v=None if span_v is None else span_v[i],
+                            topology=ctx.topology,
+                            image_shape=ctx.image_shape,
+                        ),
+                        ctx.face_curve,
+                        ctx.view,
+                    ).total
+                    for i, u in enumerate(uv)
+                ]
+            )
+
+        def one_by_one(uv=uv, span_v=span_v, ctx=ctx):
+            return np.array(
+                [
                     ctx.evaluate(u, None if span_v is None else span_v[i]).total
                     for i, u in enumerate(uv)
                 ]
             )
 
         t_ref, ref = best_time(reference)
+        t_one, one = best_time(one_by_one)
         t_new, new = best_time(lambda uv=uv, span_v=span_v, ctx=ctx: ctx.evaluate_batch(uv, span_v))
+        assert np.array_equal(one, new)
         diff = np.max(np.abs(ref - new))
         t_skof, dec = best_time(lambda R=R, t=t, f=f: skof.outside_pixels(Cameras(R, t, f, centre)))
         uv_full = Cameras(R, t, f, centre).project(skull.vertices_mm)
@@ -106,8 +132,9 @@ def bench_case(name, skull, photo, truth):
         rel = np.abs(dec - exact) / np.maximum(exact, 1)
         ms = 1e3 / len(R)
         print(
-            f"{name:8s} {photo.view:13s} {label:4s} | P_pll ref {t_ref * ms:6.3f} ms  "
-            f"batch {t_new * ms:6.3f} ms  x{t_ref / max(t_new, 1e-9):4.1f}  max|diff| {diff:.3g}"
+            f"{name:8s} {photo.view:13s} {label:4s} | P_pll oracle {t_ref * ms:6.3f} ms  "
+            f"one by one {t_one * ms:6.3f} ms  batch {t_new * ms:6.3f} ms  "
+            f"x{t_ref / max(t_new, 1e-9):4.1f}  max|diff| {diff:.3g}"
             f" | P_skof {len(skof.context.topology.faces)} faces {t_skof * ms:6.3f} ms, "
             f"{len(skull.faces)} faces {t_full * ms:6.3f} ms; |S\\F| median {np.median(exact):.0f}"
             f" px, decimated-full median {np.median(dec - exact):+.0f} px "

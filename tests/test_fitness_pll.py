@@ -1,23 +1,32 @@
-"""P_pll: curve detection, refinement, pairing and the three terms, on hand-made cases."""
+"""P_pll: curve detection, refinement, pairing and the three terms.
+
+Hand-made cases with known answers check the production code (batched; one curve is a batch of
+one); random cameras check it against the readable per-curve oracle, ``pll_oracle.py``.
+"""
 
 import numpy as np
 import pytest
 
+import pll_oracle as oracle
 from lilium.fitness.curves import (
-    detect_curve,
+    CurveBatch,
+    detect_curves_batch,
     face_curve_from_mask,
     join_fragments,
+    join_fragments_batch,
     order_points,
     refine_curve,
 )
 from lilium.fitness.pll import (
     PLL_NO_CURVE,
     PllContext,
-    convergence_penalty,
-    pair_curves,
+    convergence_penalties,
+    face_curve_index,
+    pair_curves_batch,
     pll_penalty,
-    trim_curves,
+    trim_curves_batch,
 )
+from lilium.fitness.raster import mesh_edge_topology
 
 # A rectangle of pixel centres u = 11..30, v = 21..40.
 RECT_UV = np.array([[10.5, 20.5], [30.5, 20.5], [30.5, 40.5], [10.5, 40.5]])
@@ -27,6 +36,49 @@ RECT = np.array([[0, 1, 2], [0, 2, 3]])
 def line(u, v):
     u = np.atleast_1d(np.asarray(u, dtype=float))
     return np.column_stack([u, np.broadcast_to(np.asarray(v, dtype=float), u.shape)])
+
+
+def detect_curve(uv, faces, view, span_v=None, image_shape=None):
+    """The production skull curve of one projection (a batch of one), checked by the oracle."""
+    batch = detect_curves_batch(
+        np.asarray(uv, dtype=float)[None],
+        view,
+        topology=mesh_edge_topology(faces),
+        span_v=None if span_v is None else [span_v],
+        image_shape=image_shape,
+    )
+    assert len(batch) == 1
+    curve = batch.curve(0)
+    ref = oracle.detect_curve(uv, faces, view, span_v=span_v, image_shape=image_shape)
+    np.testing.assert_array_equal(curve, ref)
+    return curve
+
+
+def pair_curves(skull, face):
+    """The production pairs of one skull curve and a face curve, checked by the oracle."""
+    pairs = pair_curves_batch(CurveBatch.from_curves([skull]), face_curve_index(face))
+    for got, want in zip(
+        (pairs.skull, pairs.face, pairs.distance), oracle.pair_curves(skull, face), strict=True
+    ):
+        np.testing.assert_array_equal(got, want)
+    return pairs.skull, pairs.face, pairs.distance
+
+
+def trim_curves(skull, face):
+    """The production trimming of one skull curve and a face curve, checked by the oracle."""
+    trimmed, lo, hi = trim_curves_batch(CurveBatch.from_curves([skull]), face_curve_index(face))
+    s, p = trimmed.curve(0), np.asarray(face, dtype=float)[lo[0] : hi[0]]
+    ref_s, ref_p = oracle.trim_curves(skull, face)
+    np.testing.assert_array_equal(s, ref_s)
+    np.testing.assert_array_equal(p, ref_p)
+    return s, p
+
+
+def convergence_penalty(d):
+    """The production P_conv of one list of distances, checked by the oracle."""
+    got = convergence_penalties(d, [0, len(d)])[0]
+    assert got == oracle.convergence_penalty(d)
+    return got
 
 
 # --- detection -------------------------------------------------------------------------------
@@ -62,6 +114,15 @@ def test_detection_drops_isolated_pixels_and_joins_steps():
 def test_join_fragments_inserts_straight_segments():
     joined = join_fragments([[0, 0], [3, 0], [3, 0], [5, 2]])
     assert joined.tolist() == [[0, 0], [1, 0], [2, 0], [3, 0], [4, 1], [5, 2]]
+
+
+def test_join_fragments_batch_keeps_the_curves_apart_and_equals_the_oracle():
+    rng = np.random.default_rng(5)
+    curves = [np.cumsum(rng.integers(-4, 5, (n, 2)), axis=0) for n in (7, 0, 1, 12, 2, 0)]
+    batch = join_fragments_batch(*(lambda b: (b.points, b.offset))(CurveBatch.from_curves(curves)))
+    assert len(batch) == len(curves)
+    for m, c in enumerate(curves):
+        np.testing.assert_array_equal(batch.curve(m), oracle.join_fragments(c))
 
 
 def test_refine_orders_and_orients_a_shuffled_curve():
@@ -159,6 +220,28 @@ def test_trimming_uses_the_end_normals_of_the_other_curve():
 def test_empty_curve_fails_as_a_value():
     terms = pll_penalty(np.zeros((0, 2)), line([1, 2], 3), "frontal")
     assert not terms and terms.total == PLL_NO_CURVE and np.isnan(terms.delta_d)
+    terms = pll_penalty(line([1, 2], 3), np.zeros((0, 2)), "frontal")
+    assert not terms and terms.total == PLL_NO_CURVE and terms.n_pairs == 0
+
+
+def test_hand_made_terms_equal_the_oracle():
+    skull = line([0, 10, 20, 30, 40], 100)
+    face = np.array([[0, 110], [10, 110], [20, 110], [30, 110], [40, 102.0]])
+    cases = [
+        (skull, face, "frontal", False),
+        (line(np.arange(10, 30), 100), line(np.arange(0, 40), 106), "frontal", True),
+        (line(np.arange(10), 100), line(np.arange(12), 95), "frontal", True),
+        (
+            np.column_stack([[50.0, 52, 48], [10.0, 11, 12]]),
+            np.column_stack([[45.0, 45, 45], [10.0, 11, 12]]),
+            "lateral_right",
+            False,
+        ),
+        (line([3.5, 4.2, 7.9], 10.5), line(np.arange(12), 12), "frontal", True),  # off the grid
+    ]
+    for s, p, view, trim in cases:
+        got = pll_penalty(s, p, view, trim=trim)
+        assert got == oracle.pll_penalty(s, p, view, trim=trim)
 
 
 def test_context_end_to_end_on_a_projected_rectangle():
@@ -231,25 +314,53 @@ def test_batched_pll_equals_the_reference_on_random_cameras(view):
     if view != "frontal":
         span_v = np.column_stack([uv[:, 0, 1] + 40, uv[:, -1, 1] - 40])
     ref = np.array(
-        [ctx.evaluate(u, None if span_v is None else span_v[i]).total for i, u in enumerate(uv)]
+        [
+            oracle.pll_penalty(
+                oracle.detect_curve(
+                    u,
+                    faces,
+                    view,
+                    span_v=None if span_v is None else span_v[i],
+                    image_shape=(480, 640),
+                ),
+                ctx.face_curve,
+                view,
+            ).total
+            for i, u in enumerate(uv)
+        ]
     )
     batch = ctx.evaluate_batch(uv, span_v)
     np.testing.assert_array_equal(batch, ref)
+    terms = ctx.terms_batch(uv, span_v)
+    for i, u in enumerate(uv):
+        span = None if span_v is None else span_v[i]
+        want = oracle.pll_penalty(
+            oracle.detect_curve(u, faces, view, span_v=span, image_shape=(480, 640)),
+            ctx.face_curve,
+            view,
+        )
+        got = terms.member(i)
+        assert got == ctx.evaluate(u, span) or np.isnan(got.delta_d)
+        np.testing.assert_array_equal(
+            [got.delta_d, got.p_conv, got.p_int, got.total, got.n_pairs],
+            [want.delta_d, want.p_conv, want.p_int, want.total, want.n_pairs],
+        )
     assert ref[1] == PLL_NO_CURVE and np.isfinite(ref).all()
     assert (ref < PLL_NO_CURVE).sum() >= 30
 
 
-def test_batched_curves_equal_detect_curve():
-    from lilium.fitness.curves import detect_curves_batch
-
+def test_batched_curves_equal_the_oracle():
     rng = np.random.default_rng(3)
     verts, faces = _bumpy_sheet(rng=3)
     uv = _random_projections(verts, 25, rng, spread=20.0)
     topo = PllContext.build(faces, line(np.arange(5), 0), "frontal").topology
+    uv[1] = np.nan
+    uv[2] += 5000.0  # clipped window
     for view in ("frontal", "lateral_left", "lateral_right"):
         batch = detect_curves_batch(uv, view, topology=topo, image_shape=(480, 640))
+        assert len(batch) == len(uv)
         for i in range(len(uv)):
-            ref = detect_curve(uv[i], faces, view, image_shape=(480, 640))
+            ref = oracle.detect_curve(uv[i], faces, view, image_shape=(480, 640))
             np.testing.assert_array_equal(batch.curve(i), ref)
 
 

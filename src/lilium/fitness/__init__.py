@@ -4,8 +4,8 @@
 - :mod:`lilium.fitness.raster`          exact union raster of projected meshes (contour-edge scan)
 - :mod:`lilium.fitness.skof`            P_skof = 100 |S \\ F|
 - :mod:`lilium.fitness.regions`         forehead / chin-jaw mesh regions, Frankfurt frame
-- :mod:`lilium.fitness.curves`          contour detection and refinement
-- :mod:`lilium.fitness.pll`             P_pll = Delta_d + P_conv + P_int
+- :mod:`lilium.fitness.curves`          skull-curve detection (a population at once), facial curves
+- :mod:`lilium.fitness.pll`             P_pll = Delta_d + P_conv + P_int (a population at once)
 """
 
 from .camera_penalty import (
@@ -15,21 +15,27 @@ from .camera_penalty import (
     head_deviation_deg,
 )
 from .curves import (
-    detect_curve,
+    CurveBatch,
+    detect_curves_batch,
     face_curve_from_mask,
     join_fragments,
+    join_fragments_batch,
     order_points,
     refine_curve,
 )
 from .pll import (
+    FaceCurveIndex,
+    PairBatch,
     PllContext,
     PllTerms,
-    convergence_penalty,
-    intersection_count,
-    pair_curves,
+    convergence_penalties,
+    face_curve_index,
+    pair_curves_batch,
     pll_penalty,
-    pll_terms,
-    trim_curves,
+    pll_terms_batch,
+    terms_from_pairs,
+    trim_curves_batch,
+    wrong_side,
 )
 from .raster import EdgeTopology, mesh_edge_topology
 from .regions import (
@@ -55,8 +61,11 @@ from .skof import (
 __all__ = [
     "AnatomicalFrame",
     "CameraPriors",
+    "CurveBatch",
     "EdgeTopology",
+    "FaceCurveIndex",
     "FaceMaskIndex",
+    "PairBatch",
     "PllContext",
     "PllTerms",
     "Region",
@@ -65,20 +74,21 @@ __all__ = [
     "camera_penalty",
     "camera_penalty_from_priors",
     "chin_jaw_region",
-    "convergence_penalty",
-    "detect_curve",
+    "convergence_penalties",
+    "detect_curves_batch",
     "face_chin_jaw_region",
     "face_curve_from_mask",
+    "face_curve_index",
     "face_mask_index",
     "forehead_region",
     "head_deviation_deg",
-    "intersection_count",
     "join_fragments",
+    "join_fragments_batch",
     "mesh_edge_topology",
     "order_points",
-    "pair_curves",
+    "pair_curves_batch",
     "pll_penalty",
-    "pll_terms",
+    "pll_terms_batch",
     "prepare_skof",
     "refine_curve",
     "skof_penalty",
@@ -86,5 +96,7 @@ __all__ = [
     "skull_outside_pixels_batch",
     "skull_raster",
     "submesh",
-    "trim_curves",
+    "terms_from_pairs",
+    "trim_curves_batch",
+    "wrong_side",
 ]

@@ -1,17 +1,26 @@
-"""Curve detection and refinement of the parallelism term (SPEC section 5).
+"""The curves of the parallelism term (SPEC section 5): skull-curve detection, facial curves.
 
 Curves are pixel polylines ``(N, 2)`` in ``uv`` (u = column, v = row), ordered along the curve
 and 8-connected after refinement. Orientation, written once: chin-jaw curves (frontal views)
 run left to right in the image (increasing u), forehead curves (lateral views) top to bottom
 (increasing v), so the two curves of a pair start at the same end.
 
-Detection of a projected mesh region: rasterise it (union of its triangles at the photo's
-resolution, :mod:`lilium.fitness.raster`), drop isolated pixels (no 8-neighbour), then take its
-outer boundary on the side that faces the skin: the lowest pixel of every column for the
-chin-jaw in frontal views; the most anterior pixel of every row for the forehead in lateral
-views (smallest u for ``lateral_left``, where the face points to -u; largest u for
-``lateral_right``), keeping only the rows inside the glabella-metopion span. Gaps between
-consecutive boundary pixels (steep stretches, fragments) are joined by straight pixel segments.
+Skull curves, for a population of projected regions at once (:func:`detect_curves_batch`; a
+single camera is a batch of one, the result a :class:`CurveBatch`): rasterise the region (the
+union of its triangles at the photo's resolution, :mod:`lilium.fitness.raster`), drop isolated
+pixels (no 8-neighbour), then take its outer boundary on the side that faces the skin: the
+lowest pixel of every column for the chin-jaw in frontal views; the most anterior pixel of
+every row for the forehead in lateral views (smallest u for ``lateral_left``, where the face
+points to -u; largest u for ``lateral_right``), keeping only the rows inside the
+glabella-metopion span. Gaps between consecutive boundary pixels (steep stretches, fragments)
+are joined by straight pixel segments (:func:`join_fragments_batch`). Boundary pixels come out
+in increasing u (frontal) or v (lateral), so detected curves need no reorientation.
+
+Facial curves, once per SFO: :func:`face_curve_from_mask` (from the face mask and landmarks) or
+:func:`refine_curve` (a given contour: pixels, order, direction, joined gaps).
+
+``tests/pll_oracle.py`` spells the same detection out for one curve at a time; the tests check
+this module against it.
 """
 
 from dataclasses import dataclass
@@ -19,10 +28,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..constants import VIEWS
-from .raster import mesh_edge_topology, scan_crossings, winding_intervals
+from .raster import scan_crossings, winding_intervals
 
 #: Largest side (pixels) of the window a region is rasterised in; beyond, it is clipped.
 MAX_WINDOW_PX = 8192
+
+#: Cells (members x rows x columns) of the stacked rasters of :func:`detect_curves_batch`.
+BATCH_CELL_BUDGET = 2_000_000
 
 
 def check_view(view):
@@ -32,35 +44,53 @@ def check_view(view):
     return view
 
 
-def join_fragments(points):
-    """Join consecutive points by straight 8-connected pixel segments.
+@dataclass(frozen=True)
+class CurveBatch:
+    """Curves of a population, concatenated.
 
-    Parameters
+    Attributes
     ----------
-    points : array_like of shape (N, 2)
-        Integer-valued pixel positions, in curve order.
-
-    Returns
-    -------
-    curve : ndarray of shape (M, 2)
-        The same points with the pixels of the joining segments inserted; consecutive
-        duplicates removed.
+    points : ndarray of shape (N, 2)
+        ``uv`` of all curves, member after member, each in curve order.
+    offset : ndarray of shape (S + 1,) of int64
+        Member ``m``'s curve is ``points[offset[m] : offset[m + 1]]``.
     """
+
+    points: np.ndarray
+    offset: np.ndarray
+
+    @classmethod
+    def from_curves(cls, curves):
+        """Concatenate a sequence of curves, each an array_like of shape (N_m, 2)."""
+        curves = [np.asarray(c, dtype=float).reshape(-1, 2) for c in curves]
+        points = np.concatenate(curves) if curves else np.zeros((0, 2))
+        offset = np.concatenate([[0], np.cumsum([len(c) for c in curves], dtype=np.int64)])
+        return cls(points, offset.astype(np.int64))
+
+    def __len__(self):
+        return len(self.offset) - 1
+
+    @property
+    def lengths(self):
+        """Points per curve, ndarray of shape (S,)."""
+        return np.diff(self.offset)
+
+    def curve(self, m):
+        """Member ``m``'s curve, ndarray of shape (N_m, 2)."""
+        return self.points[self.offset[m] : self.offset[m + 1]]
+
+
+# --- facial curves (once per SFO) ------------------------------------------------------------
+
+
+def join_fragments(points):
+    """:func:`join_fragments_batch` of one curve ``(N, 2)``: the joined curve ``(M, 2)``."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
-    if len(p) < 2:
-        return p.copy()
-    d = np.diff(p, axis=0)
-    steps = np.maximum(np.abs(d[:, 0]), np.abs(d[:, 1])).astype(np.int64)  # 0: a duplicate
-    total = int(steps.sum())
-    seg = np.repeat(np.arange(len(d)), steps)
-    k = np.arange(total) - np.repeat(np.cumsum(steps) - steps, steps)
-    t = (k / np.repeat(steps, steps))[:, None]
-    filled = np.rint(p[seg] + t * d[seg])
-    return np.vstack([filled, p[-1:]])
+    return join_fragments_batch(p, [0, len(p)]).points
 
 
 def orient_curve(curve, view):
-    """Reverse a curve when needed so that it runs in the direction of the module docstring."""
+    """Reverse a curve ``(N, 2)`` when needed so that it runs as the module docstring says."""
     curve = np.asarray(curve, dtype=float)
     if len(curve) < 2:
         return curve
@@ -109,14 +139,15 @@ def refine_curve(points, view, ordered=True):
     Parameters
     ----------
     points : array_like of shape (N, 2)
-        ``uv`` positions (sub-pixel allowed).
-    view : str
+        ``uv`` positions (sub-pixel allowed; non-finite rows are dropped).
+    view : {"frontal", "lateral_left", "lateral_right"}
     ordered : bool
         Whether ``points`` are already in curve order; if not, :func:`order_points` orders them.
 
     Returns
     -------
     curve : ndarray of shape (M, 2)
+        Ordered, oriented, 8-connected pixel curve.
     """
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     p = p[np.all(np.isfinite(p), axis=1)]
@@ -124,127 +155,6 @@ def refine_curve(points, view, ordered=True):
     if not ordered:
         p = order_points(np.unique(p, axis=0))
     return orient_curve(join_fragments(p), view)
-
-
-def _drop_isolated(grid):
-    """Pixels with at least one 8-neighbour."""
-    g = grid.astype(np.uint8)
-    pad = np.pad(g, 1)
-    h, w = g.shape
-    n = np.zeros((h, w), np.uint8)
-    for dr in (0, 1, 2):
-        for dc in (0, 1, 2):
-            if dr != 1 or dc != 1:
-                n += pad[dr : dr + h, dc : dc + w]
-    return grid & (n > 0)
-
-
-def region_raster(uv, faces=None, *, topology=None, image_shape=None):
-    """Rasterise a projected region in its own window.
-
-    Parameters
-    ----------
-    uv : array_like of shape (K, 2)
-        Projected region vertices.
-    faces : array_like of shape (G, 3), optional if ``topology`` is given
-    topology : EdgeTopology, optional
-    image_shape : (int, int), optional
-        When given, the window is clipped to the image grown by one image size on every side.
-
-    Returns
-    -------
-    grid : ndarray of shape (h, w) of bool
-    origin : (int, int)
-        ``(u0, v0)``: the image position of ``grid[0, 0]``.
-    """
-    uv = np.asarray(uv, dtype=float)
-    if topology is None:
-        topology = mesh_edge_topology(faces)
-    u, v = uv[:, 0], uv[:, 1]
-    if np.isnan(u.sum()):  # (a column-wise reduction of an (N, 2) array is slow)
-        ok = np.isfinite(u) & np.isfinite(v)
-        u, v = u[ok], v[ok]
-    if len(u) == 0 or topology.n_faces == 0:
-        return np.zeros((0, 0), bool), (0, 0)
-    lo = np.array([np.floor(u.min()), np.floor(v.min())], dtype=np.int64)
-    hi = np.array([np.ceil(u.max()), np.ceil(v.max())], dtype=np.int64) + 1
-    if image_shape is not None:
-        height, width = image_shape
-        lo = np.maximum(lo, [-width, -height])
-        hi = np.minimum(hi, [2 * width, 2 * height])
-    hi = np.minimum(hi, lo + MAX_WINDOW_PX)
-    if np.any(hi <= lo):
-        return np.zeros((0, 0), bool), (0, 0)
-    (u0, v0), (u1, v1) = lo, hi
-    c = scan_crossings(uv[None], topology, (int(v0), int(v1)), (int(u0), int(u1)))
-    _, row, start, stop = winding_intervals(c)
-    h, w = int(v1 - v0), int(u1 - u0)
-    n = h * (w + 1)
-    base = (row - v0) * (w + 1)
-    diff = np.bincount(base + (start - u0), minlength=n) - np.bincount(
-        base + (stop - u0), minlength=n
-    )
-    grid = np.cumsum(diff.reshape(h, w + 1), axis=1)[:, :w] > 0
-    return grid, (int(u0), int(v0))
-
-
-def boundary_pixels(grid, origin, view):
-    """The outer boundary of a raster on the skin side (see the module docstring).
-
-    Returns
-    -------
-    points : ndarray of shape (N, 2)
-        ``uv`` of one pixel per column (frontal) or per row (lateral), in curve order.
-    """
-    check_view(view)
-    u0, v0 = origin
-    if grid.size == 0:
-        return np.zeros((0, 2))
-    h, w = grid.shape
-    if view == "frontal":
-        cols = np.flatnonzero(grid.any(axis=0))
-        rows = h - 1 - np.argmax(grid[::-1, cols], axis=0)
-    else:
-        rows = np.flatnonzero(grid.any(axis=1))
-        if view == "lateral_left":
-            cols = np.argmax(grid[rows], axis=1)
-        else:
-            cols = w - 1 - np.argmax(grid[rows, ::-1], axis=1)
-    return np.column_stack([cols + u0, rows + v0]).astype(float)
-
-
-def detect_curve(uv, faces=None, view="frontal", *, span_v=None, topology=None, image_shape=None):
-    """The skin-side contour of a projected region (chin-jaw or forehead).
-
-    Parameters
-    ----------
-    uv : array_like of shape (K, 2)
-        Projected vertices of the region (:class:`lilium.fitness.regions.Region`).
-    faces : array_like of shape (G, 3), optional if ``topology`` is given
-        The region's faces.
-    view : {"frontal", "lateral_left", "lateral_right"}
-    span_v : (float, float), optional
-        For the forehead: the v of the projected glabella and metopion; boundary pixels outside
-        that span are dropped.
-    topology : EdgeTopology, optional
-        ``mesh_edge_topology(region.faces)``, computed once.
-    image_shape : (int, int), optional
-        Bounds the raster window (see :func:`region_raster`).
-
-    Returns
-    -------
-    curve : ndarray of shape (N, 2)
-        Ordered, 8-connected pixel curve (may be empty).
-    """
-    check_view(view)
-    grid, origin = region_raster(uv, faces, topology=topology, image_shape=image_shape)
-    if grid.size:
-        grid = _drop_isolated(grid)
-    points = boundary_pixels(grid, origin, view)
-    if span_v is not None and len(points):
-        lo, hi = sorted(span_v)
-        points = points[(points[:, 1] >= lo) & (points[:, 1] <= hi)]
-    return orient_curve(join_fragments(points), view)
 
 
 def face_curve_from_mask(face_mask, view, landmarks_uv):
@@ -305,54 +215,52 @@ def face_curve_from_mask(face_mask, view, landmarks_uv):
     return orient_curve(join_fragments(points.astype(float)), view)
 
 
-#: Cells (members x rows x columns) of the stacked rasters of :func:`detect_curves_batch`.
-BATCH_CELL_BUDGET = 2_000_000
-
-
-@dataclass(frozen=True)
-class CurveBatch:
-    """The skull curves of a population, concatenated.
-
-    Attributes
-    ----------
-    points : ndarray of shape (N, 2)
-        ``uv`` of all curves, member after member, each in curve order.
-    offset : ndarray of shape (S + 1,) of int64
-        Member ``m``'s curve is ``points[offset[m] : offset[m + 1]]``.
-    """
-
-    points: np.ndarray
-    offset: np.ndarray
-
-    def __len__(self):
-        return len(self.offset) - 1
-
-    def curve(self, m):
-        return self.points[self.offset[m] : self.offset[m + 1]]
+# --- skull curves (a population at once) -----------------------------------------------------
 
 
 def _windows(uv, image_shape):
-    """Per-member raster windows of :func:`region_raster`, and which need the reference path.
+    """Per-member raster windows (the bounding box of the finite vertices) and which are clipped.
 
-    Returns ``lo (S, 2)``, ``hi (S, 2)`` (int64, ``(u, v)``), ``empty (S,)`` (no finite vertex)
-    and ``slow (S,)`` (window clipped: left to :func:`detect_curve`).
+    Parameters
+    ----------
+    uv : ndarray of shape (S, K, 2)
+    image_shape : (int, int) or None
+
+    Returns
+    -------
+    lo, hi : ndarray of shape (S, 2) of int64
+        ``(u, v)`` of the window's first pixel and one past its last; clipped to the image
+        grown by one image size on every side (when ``image_shape`` is given) and to
+        :data:`MAX_WINDOW_PX` per side.
+    empty : ndarray of shape (S,) of bool
+        No finite vertex, or a window clipped to nothing.
+    clipped : ndarray of shape (S,) of bool
+        The window was clipped: its raster is scanned on its own (crossings outside it).
     """
     u, v = uv[..., 0], uv[..., 1]
     finite = np.isfinite(u) & np.isfinite(v)
     empty = ~finite.any(axis=1)
     lo = np.stack([np.where(finite, x, np.inf).min(axis=1) for x in (u, v)], axis=1)
     hi = np.stack([np.where(finite, x, -np.inf).max(axis=1) for x in (u, v)], axis=1)
-    lo = np.where(empty[:, None], 0.0, np.floor(lo))
-    hi = np.where(empty[:, None], 1.0, np.ceil(hi) + 1)
-    slow = np.any(hi - lo > MAX_WINDOW_PX, axis=1)
+    lo = np.where(empty[:, None], 0.0, np.floor(lo)).astype(np.int64)
+    hi = np.where(empty[:, None], 1.0, np.ceil(hi) + 1).astype(np.int64)
+    box_lo, box_hi = lo, hi
     if image_shape is not None:
         height, width = image_shape
-        slow |= np.any(lo < [-width, -height], axis=1) | np.any(hi > [2 * width, 2 * height], 1)
-    return lo.astype(np.int64), hi.astype(np.int64), empty, slow
+        lo = np.maximum(lo, [-width, -height])
+        hi = np.minimum(hi, [2 * width, 2 * height])
+    hi = np.minimum(hi, lo + MAX_WINDOW_PX)
+    clipped = np.any(lo != box_lo, axis=1) | np.any(hi != box_hi, axis=1)
+    empty |= np.any(hi <= lo, axis=1)
+    return lo, hi, empty, clipped & ~empty
 
 
 def _stacked_rasters(uv, topology, lo, hi):
-    """Rasters of several members in windows of a common size, each at its own origin ``lo``."""
+    """Union rasters ``(S, h, w)`` of several members, each in its window ``lo``, ``hi`` (S, 2).
+
+    The windows share one size (the largest); the scan covers their union, so every member's
+    crossings must lie inside its own window (true unless the window was clipped).
+    """
     h, w = (hi - lo).max(axis=0)[::-1]
     c = scan_crossings(
         uv,
@@ -368,7 +276,7 @@ def _stacked_rasters(uv, topology, lo, hi):
 
 
 def _drop_isolated_stack(grid):
-    """:func:`_drop_isolated` of every raster of a stack ``(S, h, w)``."""
+    """Pixels of every raster of a stack ``(S, h, w)`` that have at least one 8-neighbour."""
     g = grid.view(np.uint8)
     pad = np.pad(g, ((0, 0), (1, 1), (1, 1)))
     h, w = g.shape[1:]
@@ -381,7 +289,11 @@ def _drop_isolated_stack(grid):
 
 
 def _boundary_stack(grid, lo, view):
-    """:func:`boundary_pixels` of a stack: ``member (N,)``, ``points (N, 2)`` in member order."""
+    """Skin-side boundary pixels of a stack of rasters ``(S, h, w)`` with origins ``lo (S, 2)``.
+
+    One pixel per covered column (frontal: the lowest) or row (lateral: the most anterior).
+    Returns ``member (N,)`` and ``points (N, 2)`` (``uv``), in member order, then curve order.
+    """
     S, h, w = grid.shape
     if view == "frontal":
         member, cols = np.nonzero(grid.any(axis=1))
@@ -399,7 +311,7 @@ def _boundary_stack(grid, lo, view):
 
 
 def _runs_boundary(member, row, start, stop, view):
-    """Lateral :func:`boundary_pixels` straight from covered runs (no raster), isolated dropped.
+    """Lateral :func:`_boundary_stack` straight from covered runs (no raster), isolated dropped.
 
     Runs come sorted by (member, row, start), non-overlapping within a row. A pixel is isolated
     when it is a one-pixel run and no other run of its row or of the rows above and below
@@ -435,10 +347,26 @@ def _runs_boundary(member, row, start, stop, view):
 
 
 def join_fragments_batch(points, offset):
-    """:func:`join_fragments` of many curves concatenated (``offset`` as in :class:`CurveBatch`).
+    """Join the consecutive points of every curve by straight 8-connected pixel segments.
 
-    Returns the joined :class:`CurveBatch`; the arithmetic is that of :func:`join_fragments`, so
-    the curves are identical.
+    Parameters
+    ----------
+    points : array_like of shape (N, 2)
+        Integer-valued pixel positions of all curves, concatenated, each in curve order.
+    offset : array_like of shape (S + 1,)
+        Curve ``m`` is ``points[offset[m] : offset[m + 1]]`` (as in :class:`CurveBatch`).
+
+    Returns
+    -------
+    CurveBatch
+        The same points with the pixels of the joining segments inserted (a step of ``n``
+        pixels gets ``n - 1``); consecutive duplicates removed; curves never joined to each
+        other.
+
+    Examples
+    --------
+    >>> join_fragments_batch([[0, 0], [3, 0], [3, 0], [5, 2]], [0, 4]).points.tolist()
+    [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 1.0], [5.0, 2.0]]
     """
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     offset = np.asarray(offset, dtype=np.int64)
@@ -463,77 +391,82 @@ def join_fragments_batch(points, offset):
     return CurveBatch(out, new_offset)
 
 
-def detect_curves_batch(uv, view="frontal", *, span_v=None, topology=None, image_shape=None):
-    """:func:`detect_curve` for a population, all members at once (identical curves).
+def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
+    """The skin-side contours of a projected region (chin-jaw or forehead), for a population.
 
-    The rasters of the members are scanned together and stacked in windows of a common size;
-    boundary, span filter and the joining of fragments run on the concatenated points. Members
-    whose window :func:`region_raster` would clip (regions far off the image, or wider than
-    :data:`MAX_WINDOW_PX`) go through :func:`detect_curve`.
+    The rasters of the members are scanned together and stacked in windows of a common size
+    (in chunks of at most :data:`BATCH_CELL_BUDGET` cells; lateral views take the anterior pixel
+    of every row straight from the covered runs, without a raster); boundary, span filter and
+    the joining of fragments run on the concatenated points. A member whose window is clipped
+    (a region far off the image, or wider than :data:`MAX_WINDOW_PX`) is scanned on its own.
 
     Parameters
     ----------
-    uv : ndarray of shape (S, K, 2)
+    uv : array_like of shape (S, K, 2)
+        Projected vertices of the region (:class:`lilium.fitness.regions.Region`), one row per
+        member; NaN for vertices behind the camera.
     view : {"frontal", "lateral_left", "lateral_right"}
-    span_v : ndarray of shape (S, 2), optional
     topology : EdgeTopology
+        ``mesh_edge_topology(region.faces)``, computed once.
+    span_v : array_like of shape (S, 2), optional
+        For the forehead: the v of the projected glabella and metopion of every member;
+        boundary pixels outside that span are dropped.
     image_shape : (int, int), optional
+        ``(height, width)``: windows are clipped to the image grown by one image size on every
+        side.
 
     Returns
     -------
     CurveBatch
+        ``S`` ordered, 8-connected pixel curves (some may be empty).
     """
     check_view(view)
     uv = np.asarray(uv, dtype=float)
+    if uv.ndim != 3 or uv.shape[-1] != 2:
+        raise ValueError(f"uv must have shape (S, K, 2), got {uv.shape}")
     S = len(uv)
     lo, hi = np.zeros((S, 2), np.int64), np.ones((S, 2), np.int64)
-    empty = np.ones(S, bool)
-    slow = np.zeros(S, bool)
+    empty, clipped = np.ones(S, bool), np.zeros(S, bool)
     if topology.n_faces and S:
-        lo, hi, empty, slow = _windows(uv, image_shape)
+        lo, hi, empty, clipped = _windows(uv, image_shape)
     members, points = [], []
-    fast = np.flatnonzero(~empty & ~slow)
-    cells = np.prod(hi - lo, axis=1)[fast]
-    # Chunks of members whose stacked rasters stay within the cell budget.
-    if view != "frontal" and len(fast):
-        # Lateral: the anterior pixel of every row comes straight from the covered runs.
+    together = np.flatnonzero(~empty & ~clipped)
+    if view != "frontal" and len(together):
         c = scan_crossings(
-            uv[fast],
+            uv[together],
             topology,
-            (int(lo[fast, 1].min()), int(hi[fast, 1].max())),
-            (int(lo[fast, 0].min()), int(hi[fast, 0].max())),
+            (int(lo[together, 1].min()), int(hi[together, 1].max())),
+            (int(lo[together, 0].min()), int(hi[together, 0].max())),
         )
         m, pts = _runs_boundary(*winding_intervals(c), view)
-        members.append(fast[m])
+        members.append(together[m])
         points.append(pts)
-        fast = fast[:0]
-    start = 0
-    while start < len(fast):
-        stop = start + 1
-        while stop < len(fast) and (stop - start + 1) * cells[start : stop + 1].max() <= (
+        together = together[:0]
+    # Chunks of members whose stacked rasters stay within the cell budget; clipped windows alone.
+    cells = np.prod(hi - lo, axis=1)[together]
+    chunks = []
+    first = 0
+    while first < len(together):
+        stop = first + 1
+        while stop < len(together) and (stop - first + 1) * cells[first : stop + 1].max() <= (
             BATCH_CELL_BUDGET
         ):
             stop += 1
-        sel = fast[start:stop]
+        chunks.append(together[first:stop])
+        first = stop
+    chunks += [np.array([m]) for m in np.flatnonzero(clipped)]
+    for sel in chunks:
         grid = _drop_isolated_stack(_stacked_rasters(uv[sel], topology, lo[sel], hi[sel]))
         m, pts = _boundary_stack(grid, lo[sel], view)
         members.append(sel[m])
         points.append(pts)
-        start = stop
-    for m in np.flatnonzero(slow):
-        grid, origin = region_raster(uv[m], topology=topology, image_shape=image_shape)
-        if grid.size:
-            grid = _drop_isolated(grid)
-        pts = boundary_pixels(grid, origin, view)
-        members.append(np.full(len(pts), m))
-        points.append(pts)
     member = np.concatenate(members) if members else np.zeros(0, np.int64)
     points = np.concatenate(points) if points else np.zeros((0, 2))
-    if len(slow) and slow.any():
+    if clipped.any():
         order = np.argsort(member, kind="stable")
         member, points = member[order], points[order]
     if span_v is not None and len(points):
-        span_v = np.asarray(span_v, dtype=float)
+        span_v = np.asarray(span_v, dtype=float).reshape(S, 2)
         a, b = span_v[member, 0], span_v[member, 1]
         v = points[:, 1]
         keep = (v >= np.minimum(a, b)) & (v <= np.maximum(a, b))
