@@ -98,7 +98,11 @@ def test_presets_and_methods():
     assert (quick.dataset.subjects, 2 * quick.dataset.photos) == (5, 4)
     assert (paper.dataset.subjects, 2 * paper.dataset.photos) == (17, 60)
     assert (paper.repetitions, paper.axes_sets, paper.runs_per_axes_set) == (5, 5, 5)
-    assert (paper.de.population_size, paper.de.max_generations, paper.de.max_seconds) == (30, 750, 500)
+    assert (paper.de.population_size, paper.de.max_generations, paper.de.max_seconds) == (
+        30,
+        750,
+        500,
+    )
     assert load_config("quick") == PRESETS["quick"]
     assert parse_methods(["lilium"]) == ALL_METHODS[1:]
     assert parse_methods(["lilium:skof+pll", "posest-sfo"]) == (
