@@ -1,0 +1,83 @@
+"""The layer picture of docs/architecture.md, checked: imports only run down the layers, and
+modules stay readable in one sitting."""
+
+import ast
+from pathlib import Path
+
+import lilium
+
+#: Layer of each top-level module or subpackage (docs/architecture.md); a module may import
+#: from its own layer or below, never above.
+LAYERS = {
+    "constants": 0,
+    "geometry": 1,
+    "optimisation": 1,
+    "softtissue": 2,
+    "pose": 2,
+    "fitness": 3,
+    "imaging": 3,
+    "inputs": 4,
+    "methods": 5,
+    "evaluation": 5,
+    "io": 6,
+    "synthetic": 7,
+    "ct": 7,
+    "casework": 8,
+    "report": 8,
+    "experiments": 9,
+    "demo": 9,
+    "cli": 10,
+}
+
+#: Longest module (lines) that still reads in one sitting.
+MAX_MODULE_LINES = 650
+
+ROOT = Path(lilium.__file__).parent
+
+
+def _top(path):
+    return path.relative_to(ROOT).parts[0].removesuffix(".py")
+
+
+def _imports(path):
+    """Top-level lilium packages a module imports (relative and absolute imports)."""
+    rel = path.relative_to(ROOT).parts[:-1]
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.level:
+            base = list(rel[: len(rel) - node.level + 1])
+            target = base + (node.module.split(".") if node.module else [])
+            if target:
+                yield target[0]
+        elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith("lilium."):
+            yield node.module.split(".")[1]
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.startswith("lilium."):
+                    yield alias.name.split(".")[1]
+
+
+def _modules():
+    return [p for p in ROOT.rglob("*.py") if _top(p) not in ("__init__", "__main__")]
+
+
+def test_every_package_has_a_layer():
+    assert {_top(p) for p in _modules()} <= set(LAYERS)
+
+
+def test_imports_run_down_the_layers():
+    upward = [
+        f"{p.relative_to(ROOT)} imports lilium.{target}"
+        for p in _modules()
+        for target in _imports(p)
+        if target in LAYERS and LAYERS[target] > LAYERS[_top(p)]
+    ]
+    assert not upward, "\n".join(upward)
+
+
+def test_modules_read_in_one_sitting():
+    long = {
+        str(p.relative_to(ROOT)): n
+        for p in _modules()
+        if (n := len(p.read_text().splitlines())) > MAX_MODULE_LINES
+    }
+    assert not long, long
