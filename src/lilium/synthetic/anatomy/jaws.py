@@ -215,7 +215,7 @@ def add_dentition(bone, s, d):
     """
     fw, pr, ua = s.fw, s.prognathism_mm, UPPER_ALVEOLAR
     n = ua["points"]
-    up = arch(ua["half_width_mm"] * fw, ua["front_z_mm"] + pr, ua["back_z_mm"])
+    up = arch(ua["half_width_mm"] * fw, ua["front_z_mm"] + pr, ua["back_z_mm"], n)
     yy, oc, inf = d["prosthion_y"], d["occlusal_y"], d["infradentale_y"]
     add_sweep(
         bone,

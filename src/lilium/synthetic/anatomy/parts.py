@@ -12,6 +12,9 @@ import numpy as np
 
 from ..volume_fields import capsule, ellipsoid
 
+#: A Gaussian bump (:func:`add_gaussian`) is evaluated within this many sigma of its centre.
+GAUSSIAN_REACH_SIGMA = 3.5
+
 
 @dataclass(frozen=True)
 class Blob:
@@ -106,7 +109,7 @@ def add_capsule(field, a, b, ra, rb, margin_mm, op, blend_mm):
 
 
 def add_gaussian(field, centre, height, sigma):
-    """Add a Gaussian bump to ``field`` (in place), evaluated within 3.5 sigma of ``centre``.
+    """Add a Gaussian bump to ``field`` (in place), within :data:`GAUSSIAN_REACH_SIGMA`.
 
     Adds ``height * exp(-|p - centre|^2 / (2 sigma^2))``: a positive height pushes the surface
     (the zero level) inwards, a negative one outwards.
@@ -130,7 +133,7 @@ def add_gaussian(field, centre, height, sigma):
                 / (2 * sigma**2)
             )
         ),
-        centre - 3.5 * sigma,
-        centre + 3.5 * sigma,
+        centre - GAUSSIAN_REACH_SIGMA * sigma,
+        centre + GAUSSIAN_REACH_SIGMA * sigma,
         "add",
     )

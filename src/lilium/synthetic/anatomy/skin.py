@@ -350,7 +350,7 @@ def build_skin(bone, d, s, targets, depths, cranial_of):
     add_pad(skin, targets[nm], targets[nm] - cranial_of[nm], flat_axis, radius)
     for sx in (1, -1):
         add_ear(skin, d["canal"] * (sx, 1, 1), sx, s.ear)
-    skin.combine(
+    skin.combine(  # the neck cut, over the whole grid
         lambda p: plane(p, (0, NECK_CUT_Y_MM, 0), (0, -1, 0)),
         skin.lo,
         skin.lo + 1e4,
