@@ -157,3 +157,15 @@ def test_silhouette_landmarks_are_seen_in_frontal_and_profile_views(subjects):
             photo = P.render_photo(head, cam)
             for n in names:
                 assert n in photo.visible, (s.subject_id, yaw, n)
+
+
+def test_shape_priors_cover_every_parameter_and_bound_the_draws():
+    from dataclasses import asdict, fields
+
+    from lilium.synthetic.anatomy.shape import SHAPE_PRIORS, SubjectShape, draw_shape
+
+    assert list(SHAPE_PRIORS) == [f.name for f in fields(SubjectShape)]
+    for seed in range(20):
+        for name, value in asdict(draw_shape(seed)).items():
+            prior = SHAPE_PRIORS[name]
+            assert prior.lo <= value <= prior.hi, name

@@ -126,7 +126,13 @@ def _local(p, centre, rotation):
 
 
 def rotation_xyz(rx_deg=0.0, ry_deg=0.0, rz_deg=0.0):
-    """Rotation matrix ``Rz @ Ry @ Rx`` from angles in degrees (columns = rotated axes)."""
+    """Rotation matrix ``Rz @ Ry @ Rx`` from angles in degrees (columns = rotated axes).
+
+    :mod:`lilium.geometry.rotations` has no Euler-angle constructor; composing three
+    :func:`~lilium.geometry.rotations.rotvec_to_matrix` gives the same rotation but rounds
+    differently (about half of all angles differ in the last bit), which would change every
+    seeded synthetic subject, so this stays.
+    """
     ax, ay, az = np.radians([rx_deg, ry_deg, rz_deg])
     cx, sx, cy, sy, cz, sz = np.cos(ax), np.sin(ax), np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
     Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
