@@ -6,7 +6,7 @@ run left to right in the image (increasing u), forehead curves (lateral views) t
 (increasing v), so the two curves of a pair start at the same end.
 
 Detection of a projected mesh region: rasterise it (union of its triangles at the photo's
-resolution, :mod:`lilium.fitness.raster`), drop isolated pixels (no 8-neighbour), then take its
+resolution, :mod:`lilium.imaging.raster`), drop isolated pixels (no 8-neighbour), then take its
 outer boundary on the side that faces the skin: the lowest pixel of every column for the
 chin-jaw in frontal views; the most anterior pixel of every row for the forehead in lateral
 views (smallest u for ``lateral_left``, where the face points to -u; largest u for
@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..constants import VIEWS
-from .raster import mesh_edge_topology, scan_crossings, winding_intervals
+from ..imaging.raster import mesh_edge_topology, scan_crossings, winding_intervals
 
 #: Largest side (pixels) of the window a region is rasterised in; beyond, it is clipped.
 MAX_WINDOW_PX = 8192
