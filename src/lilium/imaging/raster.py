@@ -386,16 +386,16 @@ def skull_raster(uv, faces=None, shape=None, *, topology=None):
     return rasterise_union(uv, check_topology(faces, topology), shape)
 
 
-def mesh_mask(camera, vertices_mm, faces, image_size_wh, *, topology=None):
+def mesh_mask(vertices_mm, faces, camera, image_size_wh, *, topology=None):
     """Pixels covered by a mesh seen by a camera: :func:`skull_raster` of its projection.
 
     Parameters
     ----------
-    camera : Camera
-        Projects the vertices (NaN behind the camera: those faces cover nothing).
     vertices_mm : array_like of shape (V, 3)
         Skull-frame vertices (mm).
-    faces : array_like of shape (F, 3), optional if ``topology`` is given
+    faces : array_like of shape (F, 3), or None if ``topology`` is given
+    camera : Camera
+        Projects the vertices (NaN behind the camera: those faces cover nothing).
     image_size_wh : (int, int)
         ``(width, height)`` of the image in pixels.
     topology : EdgeTopology, optional
