@@ -18,8 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lilium.evaluation.metrics import back_projection_error_from_dicts, implausible_sfo
-from lilium.fitness.skof import skull_raster
+from lilium.evaluation.metrics import back_projection_error_from_dicts, outside_face
 from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 from lilium.methods import METHODS, SfoOptions, run_sfo
@@ -37,10 +36,7 @@ def evaluate(result, skull, photo, truth, facial_truth):
         truth["landmarks_noise_free"],
         result.camera,
     )
-    uv = result.camera.project(skull.vertices_mm)
-    w, h = photo.image_size_wh
-    raster = skull_raster(uv, skull.faces, (h, w))
-    imp = implausible_sfo(raster, photo.face_mask)
+    imp = outside_face(result.camera, skull.vertices_mm, skull.faces, photo.face_mask)
     return bpe, imp.outside_px > 0, imp.percent_outside
 
 

@@ -27,7 +27,7 @@ from lilium.fitness.pll import (
     PLL_NO_CURVE,
     PllTerms,
 )
-from lilium.fitness.raster import mesh_edge_topology, scan_crossings, winding_intervals
+from lilium.imaging.raster import mesh_edge_topology, scan_crossings, winding_intervals
 
 # --- detection -------------------------------------------------------------------------------
 

@@ -26,7 +26,7 @@ from lilium.fitness.pll import (
     pll_penalty,
     trim_curves_batch,
 )
-from lilium.fitness.raster import mesh_edge_topology
+from lilium.imaging.raster import mesh_edge_topology
 
 # A rectangle of pixel centres u = 11..30, v = 21..40.
 RECT_UV = np.array([[10.5, 20.5], [30.5, 20.5], [30.5, 40.5], [10.5, 40.5]])

@@ -4,17 +4,15 @@ import cv2
 import numpy as np
 import pytest
 
-from lilium.fitness.raster import mesh_edge_topology
 from lilium.fitness.skof import (
     face_mask_index,
     prepare_skof,
     skof_penalty,
     skull_outside_pixels,
     skull_outside_pixels_batch,
-    skull_raster,
-    skull_raster_cv2,
-    skull_raster_per_triangle,
 )
+from lilium.imaging.raster import mesh_edge_topology, skull_raster
+from raster_oracle import skull_raster_cv2, skull_raster_per_triangle
 
 # A square of pixel centres 11..20 x 11..20 (corners between pixel centres).
 SQUARE_UV = np.array([[10.5, 10.5], [20.5, 10.5], [20.5, 20.5], [10.5, 20.5]])

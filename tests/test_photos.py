@@ -1,7 +1,9 @@
 import cv2
 import numpy as np
 import pytest
+from scipy import ndimage
 
+from lilium.imaging.raster import mesh_mask
 from lilium.synthetic.photos import (
     MIN_VISIBLE_LANDMARKS,
     VIEWS,
@@ -13,7 +15,7 @@ from lilium.synthetic.photos import (
     prepare_head,
     sample_camera,
 )
-from lilium.synthetic.render import render_mesh, triangle_union_mask
+from lilium.synthetic.render import render_mesh
 from lilium.synthetic.toyhead import make_toy_subject
 
 SMALL = CameraRanges(image_sizes=((640, 480), (1024, 768), (1280, 960)))
@@ -165,10 +167,15 @@ def test_union_mask_matches_render_silhouette(subject):
         cam.camera,
         cam.image_size_wh,
     )
-    union = triangle_union_mask(*args)
+    union = mesh_mask(*args)
     painter = render_mesh(*args).mask
     assert union.sum() > 1000
-    assert np.count_nonzero(union != painter) <= 1e-3 * union.sum()
+    # The depth buffer fills by OpenCV's rule, which also paints the pixels its edges graze: it
+    # holds every pixel of the exact union, and more only on the 1-px ring around it (0.7 %).
+    assert not np.any(union & ~painter)
+    ring = ndimage.binary_dilation(union) & ~union
+    assert not np.any(painter & ~union & ~ring)
+    assert np.count_nonzero(union != painter) <= 1e-2 * union.sum()
 
 
 def test_procedural_subject_skull_stays_inside_the_face_mask():
@@ -181,7 +188,7 @@ def test_procedural_subject_skull_stays_inside_the_face_mask():
     for view in VIEWS:
         photo = make_photo(head, view, 1, SMALL)
         cam = photo.camera
-        skull = triangle_union_mask(
+        skull = mesh_mask(
             subject.skull_vertices_mm,
             subject.skull_faces,
             cam.camera,

@@ -6,6 +6,7 @@ from .metrics import (
     back_projection_error_from_dicts,
     back_projection_errors,
     implausible_sfo,
+    outside_face,
     rank_of_true,
 )
 
@@ -15,5 +16,6 @@ __all__ = [
     "back_projection_error_from_dicts",
     "back_projection_errors",
     "implausible_sfo",
+    "outside_face",
     "rank_of_true",
 ]

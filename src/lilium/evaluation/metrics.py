@@ -6,7 +6,10 @@
   camera scores 0.
 - :func:`rank_of_true`: rank of the true skull among the scores of one photo against every skull
   (1 = best, ties share the mean rank).
-- :func:`implausible_sfo`: skull pixels outside the face mask.
+- :func:`implausible_sfo`: skull pixels outside the face mask, from a skull raster;
+  :func:`outside_face` the same for an SFO's camera and skull mesh (the one count every caller
+  uses: the experiment runner, the report, the contact sheet), rasterised by
+  :func:`lilium.imaging.raster.mesh_mask`, the ``S`` of P_skof.
 """
 
 from dataclasses import dataclass
@@ -14,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.camera import point_ray_distance
+from ..imaging.raster import mesh_mask
 
 
 def back_projection_errors(facial_points_mm, uv_true, camera):
@@ -151,3 +155,37 @@ def implausible_sfo(skull_mask, face_mask):
     outside_px = int(np.count_nonzero(s & ~f))
     percent = 100.0 * outside_px / skull_px if skull_px else 0.0
     return ImplausibleSFO(outside_px, skull_px, percent)
+
+
+def outside_face(camera, vertices_mm, faces, face_mask, topology=None):
+    """Skull pixels outside the face mask for a camera and a skull mesh (SPEC section 7).
+
+    The skull is projected by ``camera`` and rasterised at the mask's resolution by the one
+    mesh raster (:func:`lilium.imaging.raster.mesh_mask`: the exact union of the projected
+    triangles, clipped to the photo), so ``outside_px`` is the ``|S \\ F|`` of P_skof.
+
+    Parameters
+    ----------
+    camera : Camera
+        The SFO's (estimated) camera.
+    vertices_mm : array_like of shape (V, 3)
+        Skull vertices, skull frame (mm).
+    faces : array_like of shape (F, 3), optional if ``topology`` is given
+    face_mask : array_like of shape (H, W)
+        Non-zero = face/head pixels of the photo, indexed ``[row, column]``.
+    topology : EdgeTopology, optional
+        ``mesh_edge_topology(faces)``, cached by callers that score many SFOs of one skull.
+
+    Returns
+    -------
+    ImplausibleSFO
+    """
+    face_mask = np.asarray(face_mask)
+    if face_mask.ndim != 2:
+        raise ValueError(
+            f"face_mask must be a 2D (rows, columns) array, got shape {face_mask.shape}; "
+            "convert a colour mask to one channel first"
+        )
+    height, width = face_mask.shape
+    skull_mask = mesh_mask(vertices_mm, faces, camera, (width, height), topology=topology)
+    return implausible_sfo(skull_mask, face_mask)

@@ -201,7 +201,7 @@ _TOPOLOGIES = {}
 
 def _topology(subject_dir, skull):
     """Edge topology of a subject's skull mesh (the same for every axis set)."""
-    from ..fitness.raster import mesh_edge_topology
+    from ..imaging.raster import mesh_edge_topology
 
     if subject_dir not in _TOPOLOGIES:
         if len(_TOPOLOGIES) >= SKULL_CACHE:
@@ -259,8 +259,7 @@ def score_result(result, skull, photo, truth, facial_truth, topology=None):
     dict
         ``bpe_mm``, ``skull_px``, ``outside_px``, ``percent_outside`` (None where not defined).
     """
-    from ..evaluation.metrics import back_projection_error_from_dicts, implausible_sfo
-    from ..fitness.skof import skull_raster
+    from ..evaluation.metrics import back_projection_error_from_dicts, outside_face
 
     out = {"bpe_mm": None, "skull_px": None, "outside_px": None, "percent_outside": None}
     if not result:
@@ -269,10 +268,9 @@ def score_result(result, skull, photo, truth, facial_truth, topology=None):
     if facial_truth and noise_free:
         out["bpe_mm"] = back_projection_error_from_dicts(facial_truth, noise_free, result.camera)
     if photo.face_mask is not None:
-        uv = result.camera.project(skull.vertices_mm)
-        width, height = photo.image_size_wh
-        mask = skull_raster(uv, skull.faces, (height, width), topology=topology)
-        imp = implausible_sfo(mask, photo.face_mask)
+        imp = outside_face(
+            result.camera, skull.vertices_mm, skull.faces, photo.face_mask, topology=topology
+        )
         out.update(
             skull_px=imp.skull_px, outside_px=imp.outside_px, percent_outside=imp.percent_outside
         )

@@ -1,13 +1,13 @@
 """Fitness terms of SPEC section 5, as pure functions over arrays (no file I/O).
 
 - :mod:`lilium.fitness.camera_penalty`  P_cam over a population (focal, SCD, head prior)
-- :mod:`lilium.fitness.raster`          exact union raster of projected meshes (contour-edge scan)
-- :mod:`lilium.fitness.skof`            P_skof = 100 |S \\ F|
+- :mod:`lilium.fitness.skof`            P_skof = 100 |S \\ F| (S from :mod:`lilium.imaging.raster`)
 - :mod:`lilium.fitness.regions`         forehead / chin-jaw mesh regions, Frankfurt frame
 - :mod:`lilium.fitness.curves`          skull-curve detection (a population at once), facial curves
 - :mod:`lilium.fitness.pll`             P_pll = Delta_d + P_conv + P_int (a population at once)
 """
 
+from ..imaging.raster import EdgeTopology, mesh_edge_topology
 from .camera_penalty import (
     CameraPriors,
     camera_penalty,
@@ -37,7 +37,6 @@ from .pll import (
     trim_curves_batch,
     wrong_side,
 )
-from .raster import EdgeTopology, mesh_edge_topology
 from .regions import (
     AnatomicalFrame,
     Region,

@@ -7,7 +7,7 @@ run left to right in the image (increasing u), forehead curves (lateral views) t
 
 Skull curves, for a population of projected regions at once (:func:`detect_curves_batch`; a
 single camera is a batch of one, the result a :class:`CurveBatch`): rasterise the region (the
-union of its triangles at the photo's resolution, :mod:`lilium.fitness.raster`), drop isolated
+union of its triangles at the photo's resolution, :mod:`lilium.imaging.raster`), drop isolated
 pixels (no 8-neighbour), then take its outer boundary on the side that faces the skin: the
 lowest pixel of every column for the chin-jaw in frontal views; the most anterior pixel of
 every row for the forehead in lateral views (smallest u for ``lateral_left``, where the face
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..constants import VIEWS
-from .raster import scan_crossings, winding_intervals
+from ..imaging.raster import scan_crossings, winding_intervals
 
 #: Largest side (pixels) of the window a region is rasterised in; beyond, it is clipped.
 MAX_WINDOW_PX = 8192

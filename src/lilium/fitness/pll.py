@@ -44,8 +44,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..constants import C_INF
+from ..imaging.raster import mesh_edge_topology
 from .curves import CurveBatch, check_view, detect_curves_batch, refine_curve
-from .raster import mesh_edge_topology
 
 #: Fraction of a curve's length whose mean tangent defines its end normal (SPEC: 20 %).
 END_FRACTION = 0.2

@@ -34,9 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..imaging.raster import check_faces
 from ..softtissue.cones import midsagittal_plane
 from ..softtissue.landmarks import side, twin
-from .raster import check_faces
 
 UPPER_MIDLINE = ("nasion", "glabella", "metopion", "bregma")
 LOWER_MIDLINE = ("prosthion", "subspinale", "infradentale", "pogonion", "gnathion")

@@ -1,7 +1,7 @@
 """P_skof, the skull-outside-face term of SPEC section 5: ``100 * |S \\ F|``.
 
 ``S`` is the union of the projected skull triangles rasterised at the photo's resolution (pixel
-centres, see :mod:`lilium.fitness.raster` for the rule), clipped to the photo: pixels beyond the
+centres, see :mod:`lilium.imaging.raster` for the rule), clipped to the photo: pixels beyond the
 image border are not pixels of the photo, so a vault cut off by the frame costs nothing (the face
 mask of such a photo reaches the border too). ``F`` is the face mask.
 
@@ -27,13 +27,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from .raster import (
+from ..imaging.raster import (
     EdgeTopology,
-    check_faces,
+    check_topology,
     face_orientations,
     mesh_edge_topology,
-    rasterise_union,
     scan_crossings,
+    skull_raster,  # noqa: F401 - the raster S itself, re-exported next to the count
     winding_intervals,
 )
 
@@ -116,16 +116,6 @@ def prepare_skof(faces, face_mask):
     return SkofContext(mesh_edge_topology(faces), face_mask_index(face_mask))
 
 
-def _topology(faces, topology):
-    if topology is not None:
-        if faces is not None and len(faces) != topology.n_faces:
-            raise ValueError(
-                f"topology was built for {topology.n_faces} faces but {len(faces)} were given"
-            )
-        return topology
-    return mesh_edge_topology(check_faces(faces))
-
-
 def _check_uv(uv, batched):
     uv = np.asarray(uv, dtype=float)
     want = 3 if batched else 2
@@ -181,7 +171,7 @@ def skull_outside_pixels_batch(
         Pixels of the photo covered by the projected skull and not in the face mask.
     """
     uv = _check_uv(uv, batched=True)
-    topology = _topology(faces, topology)
+    topology = check_topology(faces, topology)
     if mask_index is None:
         if face_mask is None:
             raise ValueError("give face_mask or mask_index")
@@ -240,85 +230,3 @@ def skull_outside_pixels(
 def skof_penalty(outside_pixels):
     """P_skof = ``100 * |S \\ F|`` (works on scalars and arrays)."""
     return SKOF_WEIGHT * np.asarray(outside_pixels, dtype=float)
-
-
-def skull_raster(uv, faces=None, shape=None, *, topology=None):
-    """The exact union raster ``S`` of a projected mesh (for overlays and plausibility metrics).
-
-    Parameters
-    ----------
-    uv : array_like of shape (V, 2)
-    faces : array_like of shape (F, 3), optional if ``topology`` is given
-    shape : (int, int)
-        ``(height, width)`` of the photo.
-
-    Returns
-    -------
-    mask : ndarray of shape (height, width), bool
-        Indexed ``[row, column]``.
-    """
-    if shape is None:
-        raise ValueError("give the image shape (height, width)")
-    uv = _check_uv(uv, batched=False)
-    return rasterise_union(uv, _topology(faces, topology), shape)
-
-
-def skull_raster_per_triangle(uv, faces, shape):
-    """Reference union: every triangle tested on its own (closed triangles, pixel centres).
-
-    Slow (a Python loop over triangle size classes); for tests and benchmarks. Agrees with
-    :func:`skull_raster` except for pixel centres lying exactly on an edge.
-    """
-    uv = np.asarray(uv, dtype=float)
-    faces = check_faces(faces, len(uv))
-    height, width = int(shape[0]), int(shape[1])
-    out = np.zeros((height, width), bool)
-    tri = uv[faces]  # (F, 3, 2)
-    ok = np.all(np.isfinite(tri), axis=(1, 2))
-    tri = tri[ok]
-    lo = np.ceil(tri.min(axis=1)).astype(np.int64)  # (F, 2) = (u, v)
-    hi = np.floor(tri.max(axis=1)).astype(np.int64)
-    lo = np.maximum(lo, 0)
-    hi = np.minimum(hi, [width - 1, height - 1])
-    size = np.maximum(hi - lo + 1, 0).max(axis=1)
-    for k in np.unique(size[size > 0]):
-        sel = np.flatnonzero(size == k)
-        for chunk in np.array_split(sel, max(1, len(sel) * k * k // 2_000_000 + 1)):
-            t = tri[chunk]
-            g = np.arange(k)
-            cu = lo[chunk, 0, None, None] + g[None, None, :]  # (n, 1, k)
-            cv = lo[chunk, 1, None, None] + g[None, :, None]  # (n, k, 1)
-            inside = np.ones((len(chunk), k, k), bool)
-            area = (t[:, 1, 0] - t[:, 0, 0]) * (t[:, 2, 1] - t[:, 0, 1]) - (
-                t[:, 2, 0] - t[:, 0, 0]
-            ) * (t[:, 1, 1] - t[:, 0, 1])
-            s = np.sign(area)[:, None, None]
-            for i in range(3):
-                a, b = t[:, i], t[:, (i + 1) % 3]
-                e = (b[:, 0, None, None] - a[:, 0, None, None]) * (cv - a[:, 1, None, None]) - (
-                    b[:, 1, None, None] - a[:, 1, None, None]
-                ) * (cu - a[:, 0, None, None])
-                inside &= s * e >= 0
-            inside &= s != 0
-            inside &= (cu <= hi[chunk, 0, None, None]) & (cv <= hi[chunk, 1, None, None])
-            n, r, q = np.nonzero(inside)
-            out[lo[chunk[n], 1] + r, lo[chunk[n], 0] + q] = True
-    return out
-
-
-def skull_raster_cv2(uv, faces, shape, shift=8):
-    """Union by a Python loop of ``cv2.fillConvexPoly`` (OpenCV's own fill rule), for comparison.
-
-    ``shift`` fractional bits keep sub-pixel vertex positions. About 2 us per triangle.
-    """
-    import cv2
-
-    uv = np.asarray(uv, dtype=float)
-    faces = check_faces(faces, len(uv))
-    out = np.zeros((int(shape[0]), int(shape[1])), np.uint8)
-    tri = uv[faces]
-    ok = np.all(np.isfinite(tri), axis=(1, 2))
-    pts = np.round(tri[ok] * (1 << shift)).astype(np.int32)
-    for p in pts:
-        cv2.fillConvexPoly(out, p, 1, lineType=cv2.LINE_8, shift=shift)
-    return out.astype(bool)

@@ -1,1 +1,5 @@
-"""Pictures: overlays of the projected skull on the photo."""
+"""Pixels: the one mesh raster and the overlay pictures.
+
+- :mod:`lilium.imaging.raster`   exact union raster of projected meshes (every mesh mask)
+- :mod:`lilium.imaging.overlay`  the projected skull drawn over the photo
+"""

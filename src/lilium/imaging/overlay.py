@@ -6,6 +6,8 @@ Pure functions returning ``(H, W, 3)`` uint8 RGB arrays; writing them is :mod:`l
 import cv2
 import numpy as np
 
+from .raster import skull_raster
+
 #: Colours (RGB).
 SKULL_RGB = np.array([235, 225, 190], dtype=float)
 PHOTO_LANDMARK_RGB = (0, 200, 255)
@@ -14,8 +16,13 @@ OUTLINE_RGB = (255, 170, 0)
 LIGHT_DIR_CAM = np.array([-0.3, -0.4, -1.0]) / np.linalg.norm([-0.3, -0.4, -1.0])
 
 
-def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh):
-    """Lambert-shaded render of a mesh by the painter's algorithm.
+def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh, *, topology=None):
+    """Lambert-shaded render of a mesh: the exact silhouette, shaded by the painter's algorithm.
+
+    The silhouette ``covered`` is the one mesh raster (:func:`lilium.imaging.raster.mesh_mask`,
+    the exact union of the projected triangles, the ``S`` of P_skof); the shading inside it is
+    a painter's fill (far to near) of per-triangle intensities, which only decides which
+    triangle's intensity a covered pixel shows.
 
     Parameters
     ----------
@@ -23,17 +30,21 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh):
     faces : ndarray of shape (F, 3)
     camera : Camera
     image_size_wh : tuple (width, height)
+    topology : EdgeTopology, optional
+        ``mesh_edge_topology(faces)``, to skip recomputing it.
 
     Returns
     -------
-    shade : ndarray of shape (H, W), float
-        Shading in [0, 1] where the mesh covers the pixel.
+    shade : ndarray of shape (H, W), float32
+        Shading in [0, 1] where ``covered``, 0 elsewhere.
     covered : ndarray of shape (H, W), bool
-        The union of the projected triangles.
+        The union of the projected triangles (exact raster).
     """
-    width, height = image_size_wh
-    X = camera.to_camera_frame(vertices_mm)
+    width, height = (int(s) for s in image_size_wh)
+    faces = np.asarray(faces, dtype=np.int64)
     uv_vertices = camera.project(vertices_mm)
+    covered = skull_raster(uv_vertices, faces, (height, width), topology=topology)
+    X = camera.to_camera_frame(vertices_mm)
     tri = X[faces]
     keep = np.all(np.isfinite(uv_vertices[faces]), axis=(1, 2))
     tri, faces = tri[keep], faces[keep]
@@ -44,7 +55,6 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh):
     intensity = 0.25 + 0.75 * np.abs(normal @ LIGHT_DIR_CAM)
     order = np.argsort(-tri[..., 2].mean(axis=1))  # far to near
     shade = np.zeros((height, width), dtype=np.float32)
-    covered = np.zeros((height, width), dtype=np.uint8)
     # Sub-pixel precision: coordinates in 1/16 px, shifted so pixel centres are integers.
     shift = 4
     pts_all = np.round(uv * (1 << shift)).astype(np.int64)
@@ -59,8 +69,8 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh):
             continue
         pts = pts_all[k].astype(np.int32)
         cv2.fillConvexPoly(shade, pts, float(intensity[k]), lineType=cv2.LINE_8, shift=shift)
-        cv2.fillConvexPoly(covered, pts, 1, lineType=cv2.LINE_8, shift=shift)
-    return shade, covered.astype(bool)
+    shade[~covered] = 0.0
+    return shade, covered
 
 
 def draw_overlay(
@@ -72,6 +82,8 @@ def draw_overlay(
     estimated_uv=None,
     opacity=0.55,
     curves=None,
+    *,
+    topology=None,
 ):
     """The photo with the projected skull drawn semi-transparent over it and landmarks marked.
 
@@ -90,20 +102,24 @@ def draw_overlay(
         Skull opacity in [0, 1].
     curves : list of (ndarray of shape (K, 2), RGB tuple), optional
         Polylines to draw (e.g. skull and face chin-jaw curves).
+    topology : EdgeTopology, optional
+        ``mesh_edge_topology(skull_faces)``, to skip recomputing it.
 
     Returns
     -------
     ndarray of shape (H, W, 3), uint8
     """
     height, width = image.shape[:2]
-    shade, covered = render_mesh_shaded(skull_vertices_mm, skull_faces, camera, (width, height))
+    shade, covered = render_mesh_shaded(
+        skull_vertices_mm, skull_faces, camera, (width, height), topology=topology
+    )
     out = image.astype(float)
     skull_rgb = shade[..., None] * SKULL_RGB
     alpha = opacity * covered[..., None]
     out = (1 - alpha) * out + alpha * skull_rgb
     out = np.clip(out, 0, 255).astype(np.uint8)
     scale = max(1, round(max(width, height) / 800))
-    # The skull's silhouette, so its outline can be judged against the face's.
+    # The skull's silhouette (the exact raster, P_skof's S), to judge against the face's.
     contours, _ = cv2.findContours(
         covered.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE
     )

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..evaluation.metrics import implausible_sfo
 from ..geometry.camera import Camera, principal_point_of
+from ..imaging.raster import mesh_mask
 from ..io.jsonio import read_json
 from . import render as _render
 
@@ -66,7 +67,8 @@ def overlay_tile(
     camera = Camera(gt["skull2cam"], gt["focal_px"], principal_point_of((width, height)))
     skull = _render.render_mesh(skull_vertices_mm, skull_faces, camera, (width, height))
     bone = _render.shade(skull, albedo_rgb=BONE_RGB, smooth_px=1.0)
-    skull_mask = skull.mask
+    # The silhouette (and its outside count) from the one mesh raster; the depth buffer shades.
+    skull_mask = mesh_mask(skull_vertices_mm, skull_faces, camera, (width, height))
     out = image.astype(np.float32)
     out[skull_mask] = (1 - SKULL_ALPHA) * out[skull_mask] + SKULL_ALPHA * bone[skull_mask]
     face = np.asarray(face_mask) != 0

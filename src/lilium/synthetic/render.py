@@ -13,6 +13,11 @@ visibility tolerance (:data:`VISIBILITY_TOLERANCE_MM`) absorbs that.
 
 A Python loop over ``fillConvexPoly`` costs about 2 us per triangle whatever its size.
 
+This is a depth buffer (which triangle is seen where), not the mask rasteriser: a mesh's
+silhouette mask *as a set of pixels* (the skull's ``S``) is :func:`lilium.imaging.raster.mesh_mask`,
+the one exact union raster. The head mask of a synthetic photo is this buffer's coverage, because
+the photo's pixels are the ones this buffer shades.
+
 Camera convention (:mod:`lilium.geometry.camera`): ``X_cam = R X + t`` with ``skull2cam``,
 x right, y down, z forward; ``uv = c + f X_cam[:2] / X_cam[2]``.
 """
@@ -298,31 +303,3 @@ def visible_points(render, points_mm, camera, tolerance_mm=VISIBILITY_TOLERANCE_
     surface = surface_depth_along_rays(render, uv)
     visible = inside & np.isfinite(surface) & (z <= surface + tolerance_mm)
     return visible, uv
-
-
-def triangle_union_mask(vertices_mm, faces, camera, image_size_wh):
-    """Pixels covered by the union of a mesh's projected triangles (each filled on its own).
-
-    Parameters
-    ----------
-    vertices_mm : array_like of shape (V, 3)
-    faces : array_like of shape (F, 3), int
-    camera : Camera
-    image_size_wh : (int, int)
-
-    Returns
-    -------
-    mask : ndarray of shape (H, W), bool
-    """
-    width, height = (int(s) for s in image_size_wh)
-    pts, keep, _ = _fixed_point_triangles(
-        camera.to_camera_frame(vertices_mm),
-        np.asarray(faces, dtype=np.int64),
-        camera.focal_px,
-        camera.principal_point_px,
-    )
-    mask = np.zeros((height, width), dtype=np.uint8)
-    fill = cv2.fillConvexPoly
-    for i in np.flatnonzero(keep).tolist():
-        fill(mask, pts[i], 1, cv2.LINE_8, _SHIFT_BITS)
-    return mask.astype(bool)

@@ -1,5 +1,16 @@
 """Exact union rasterisation of projected triangle meshes, without a per-triangle loop.
 
+This is the one rasteriser of every mesh mask in Lilium (P_skof, P_pll curves, the implausible
+SFO metric, overlays, synthetic photos). It lives in :mod:`lilium.imaging`, the pixels layer,
+rather than in :mod:`lilium.fitness`, because fitness, evaluation, imaging and synthetic data all
+need it and only fitness is about the objective: the others should not depend on the fitness
+layer for their pixels.
+
+- :func:`skull_raster` the raster ``S`` of projected vertices ``uv`` (any mesh, skull or skin);
+- :func:`mesh_mask` the raster of a mesh seen by a :class:`~lilium.geometry.camera.Camera`;
+- :func:`mesh_edge_topology`, :func:`scan_crossings`, :func:`winding_intervals` the pieces, for
+  callers that count pixels without building a mask (:mod:`lilium.fitness.skof`).
+
 Rule, written once: pixel ``(row, column)`` belongs to the raster of a set of triangles when its
 centre ``(u, v) = (column, row)`` lies inside at least one triangle (the *union*, so overlapping
 triangles count once, whatever their orientation). A centre exactly on an edge is decided by a
@@ -22,6 +33,21 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
+
+__all__ = [
+    "Crossings",
+    "EdgeTopology",
+    "check_faces",
+    "check_topology",
+    "contour_edges",
+    "face_orientations",
+    "mesh_edge_topology",
+    "mesh_mask",
+    "rasterise_union",
+    "scan_crossings",
+    "skull_raster",
+    "winding_intervals",
+]
 
 
 @dataclass(frozen=True)
@@ -308,3 +334,78 @@ def rasterise_union(uv, topology, shape):
         row * (width + 1) + stop, minlength=n
     )
     return np.cumsum(diff.reshape(height, width + 1), axis=1)[:, :width] > 0
+
+
+def _check_uv(uv):
+    uv = np.asarray(uv, dtype=float)
+    if uv.ndim != 2 or uv.shape[-1] != 2:
+        raise ValueError(f"uv must have shape (V, 2), got {uv.shape}")
+    return uv
+
+
+def check_topology(faces, topology):
+    """The :class:`EdgeTopology` of ``faces``: ``topology`` when given (checked), else built."""
+    if topology is not None:
+        if faces is not None and len(faces) != topology.n_faces:
+            raise ValueError(
+                f"topology was built for {topology.n_faces} faces but {len(faces)} were given"
+            )
+        return topology
+    if faces is None:
+        raise ValueError("give the mesh faces or its topology")
+    return mesh_edge_topology(check_faces(faces))
+
+
+def skull_raster(uv, faces=None, shape=None, *, topology=None):
+    """The exact union raster ``S`` of a projected mesh (the one raster of every mesh mask).
+
+    Parameters
+    ----------
+    uv : array_like of shape (V, 2)
+        Projected vertices (u = column, v = row); NaN rows (behind the camera) drop their faces.
+    faces : array_like of shape (F, 3), optional if ``topology`` is given
+    shape : (int, int)
+        ``(height, width)`` of the photo.
+    topology : EdgeTopology, optional
+        From :func:`mesh_edge_topology`, to skip recomputing it.
+
+    Returns
+    -------
+    mask : ndarray of shape (height, width), bool
+        Indexed ``[row, column]``.
+
+    Examples
+    --------
+    >>> uv = np.array([[10.5, 10.5], [20.5, 10.5], [20.5, 20.5], [10.5, 20.5]])
+    >>> int(skull_raster(uv, [[0, 1, 2], [0, 2, 3]], (40, 40)).sum())  # pixel centres 11..20
+    100
+    """
+    if shape is None:
+        raise ValueError("give the image shape (height, width)")
+    uv = _check_uv(uv)
+    return rasterise_union(uv, check_topology(faces, topology), shape)
+
+
+def mesh_mask(vertices_mm, faces, camera, image_size_wh, *, topology=None):
+    """Pixels covered by a mesh seen by a camera: :func:`skull_raster` of its projection.
+
+    Parameters
+    ----------
+    vertices_mm : array_like of shape (V, 3)
+        Skull-frame vertices (mm).
+    faces : array_like of shape (F, 3), or None if ``topology`` is given
+    camera : Camera
+        Projects the vertices (NaN behind the camera: those faces cover nothing).
+    image_size_wh : (int, int)
+        ``(width, height)`` of the image in pixels.
+    topology : EdgeTopology, optional
+        From :func:`mesh_edge_topology`, to skip recomputing it.
+
+    Returns
+    -------
+    mask : ndarray of shape (height, width), bool
+        Indexed ``[row, column]``.
+    """
+    width, height = (int(s) for s in image_size_wh)
+    uv = camera.project(np.asarray(vertices_mm, dtype=float))
+    return skull_raster(uv, faces, (height, width), topology=topology)
