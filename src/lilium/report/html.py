@@ -18,11 +18,8 @@ pictures are base64 ``data:`` URIs, styles and script are inline.
 
 import base64
 import datetime as _dt
-import hashlib
 import html
 import io
-import platform
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -30,6 +27,7 @@ import numpy as np
 
 from ..geometry.rotations import geodesic_angle_deg, matrix_to_rotvec
 from ..imaging.overlay import SKULL_RGB, render_mesh_shaded
+from ..io.provenance import sha256_of, software_versions
 
 #: Longest side (pixels) of the pictures embedded in the report; larger photos are scaled down.
 MAX_REPORT_PX = 2000
@@ -51,9 +49,6 @@ OUTLINE_PX = 2
 
 #: Skull pixels outside the face mask (RGBA).
 OUTSIDE_RGBA = (255, 0, 200, 170)
-
-#: Packages whose versions the provenance lists.
-_PACKAGES = ("lilium", "numpy", "scipy", "poselib", "opencv-python-headless", "trimesh", "pillow")
 
 
 @dataclass(frozen=True)
@@ -226,28 +221,6 @@ def camera_facts(result, photo):
     if prior is not None:
         facts["head_deviation_deg"] = float(geodesic_angle_deg(R, prior))
     return facts
-
-
-def sha256_of(path, chunk=1 << 20):
-    """Hex SHA-256 of a file."""
-    digest = hashlib.sha256()
-    with Path(path).open("rb") as fh:
-        while block := fh.read(chunk):
-            digest.update(block)
-    return digest.hexdigest()
-
-
-def software_versions():
-    """Versions of Python, the platform and the packages the results depend on."""
-    from importlib import metadata
-
-    out = {"python": sys.version.split()[0], "platform": platform.platform()}
-    for name in _PACKAGES:
-        try:
-            out[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            out[name] = "not installed"
-    return out
 
 
 # --------------------------------------------------------------------------------------------
