@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 
 from lilium.io.case import read_photo, read_skull
+from lilium.io.provenance import sha256_of
 from lilium.methods.posest_sfo import posest_sfo
 from lilium.report import ReportEntry, build_report, skull_layer_rgba, write_report
-from lilium.report.html import sha256_of, view_box
+from lilium.report.pictures import view_box
 
 CHROMIUM = next(
     (shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)),

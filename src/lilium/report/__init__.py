@@ -1,5 +1,38 @@
-"""Reports a forensic practitioner reads: a self-contained HTML page per case."""
+"""Reports a forensic practitioner reads: a self-contained HTML page per case.
 
-from .html import ReportEntry, build_report, skull_layer_rgba, write_report
+The report is built in two steps, computing first and formatting second:
 
-__all__ = ["ReportEntry", "build_report", "skull_layer_rgba", "write_report"]
+- :mod:`~lilium.report.records`: :class:`ReportEntry` (one SFO to report: skull, photo,
+  result, labelled inputs, notes and outputs) -> :class:`SfoRecord` (:func:`sfo_record`), and
+  a page's entries -> :class:`ReportRecord` (:func:`report_record`); computes the landmark
+  rows, camera facts and the skull pixels outside the face mask (exact skull raster).
+- :mod:`~lilium.report.record_types`: the frozen records, of numbers, strings and encoded
+  pictures (summary row, landmark rows, camera facts, fitness terms, outside pixels, input
+  fingerprints; a page adds the software versions, date and command).
+- :mod:`~lilium.report.pictures`: the pictured region of the photo and its layers (photo
+  JPEG, shaded and outlined skull RGBA PNG, skull-outside-the-face PNG).
+- :mod:`~lilium.report.html`: formats records into the templates of
+  ``lilium/report/templates/`` (HTML, CSS and JS, read with :mod:`importlib.resources`);
+  :func:`build_report` and :func:`write_report` do both steps.
+- :mod:`~lilium.report.svg`: the inline SVGs (landmark marks, fitness curve).
+
+Input hashing and software versions come from :mod:`lilium.io.provenance`.
+"""
+
+from .html import build_report, format_report, write_report
+from .pictures import skull_layer_rgba, view_box
+from .record_types import ReportRecord, SfoRecord
+from .records import ReportEntry, report_record, sfo_record
+
+__all__ = [
+    "ReportEntry",
+    "ReportRecord",
+    "SfoRecord",
+    "build_report",
+    "format_report",
+    "report_record",
+    "sfo_record",
+    "skull_layer_rgba",
+    "view_box",
+    "write_report",
+]

@@ -1,0 +1,272 @@
+"""Plain records of a case report: everything the page shows, computed before any markup.
+
+:func:`sfo_record` turns one SFO (skull, photo, result and the labelled inputs, notes and
+outputs of a :class:`ReportEntry`) into an :class:`SfoRecord` of numbers, strings and encoded
+pictures; :func:`report_record` collects the records of a page with its provenance. The HTML
+module (:mod:`lilium.report.html`) only formats these records.
+
+Image coordinates are ``uv`` = (column, row) pixels of the full photo; the skull frame and the
+camera follow :class:`lilium.geometry.camera.Camera` (``x_cam = R x_skull + t``).
+"""
+
+import datetime as _dt
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry.rotations import geodesic_angle_deg, matrix_to_rotvec
+from ..io.provenance import input_files, software_versions
+from .pictures import sfo_pictures, view_box
+from .record_types import CameraFacts, LandmarkRow, ReportRecord, SfoRecord, Summary
+
+#: Extra run facts of ``SfoResult.extra`` the report lists, in this order.
+RUN_EXTRAS = ("generations", "evaluations", "stop", "fallbacks")
+
+
+@dataclass(frozen=True)
+class ReportEntry:
+    """One SFO to report.
+
+    Attributes
+    ----------
+    skull : lilium.inputs.Skull
+    photo : lilium.inputs.Photo
+        Read with its image.
+    result : lilium.methods.result.SfoResult
+    inputs : dict of str -> Path
+        Input files, labelled (``{"skull mesh": path, ...}``); hashed into the provenance.
+    notes : dict of str -> str
+        Extra facts shown with the camera (e.g. where each prior came from).
+    outputs : dict of str -> str
+        Output files, labelled, as links relative to the report.
+    """
+
+    skull: object
+    photo: object
+    result: object
+    inputs: dict = field(default_factory=dict)
+    notes: dict = field(default_factory=dict)
+    outputs: dict = field(default_factory=dict)
+
+
+def _floats(values):
+    return tuple(float(x) for x in np.ravel(values))
+
+
+def method_label(result):
+    """Method and variant of an SFO, e.g. ``"lilium skof+pll"``."""
+    return result.method + (f" {result.variant}" if result.variant else "")
+
+
+def landmark_rows(result, photo):
+    """Photo landmark, projected estimate and error of every landmark the SFO used.
+
+    Parameters
+    ----------
+    result : SfoResult
+    photo : Photo
+
+    Returns
+    -------
+    tuple of LandmarkRow
+        In the order of ``result.facial_landmarks_mm``; estimates and errors are NaN when the
+        SFO failed.
+    """
+    names = [n for n in result.facial_landmarks_mm if n in photo.landmarks_uv]
+    photo_uv = np.array([photo.landmarks_uv[n] for n in names], dtype=float).reshape(-1, 2)
+    if result and names:
+        est3d = np.array([result.facial_landmarks_mm[n] for n in names])
+        est_uv = result.camera.project(est3d)
+    else:
+        est_uv = np.full_like(photo_uv, np.nan)
+    errors = np.linalg.norm(est_uv - photo_uv, axis=1)
+    return tuple(
+        LandmarkRow(n, _floats(p), _floats(e), float(d))
+        for n, p, e, d in zip(names, photo_uv, est_uv, errors, strict=True)
+    )
+
+
+def camera_facts(result, photo):
+    """Camera parameters of a successful SFO, for the report (degrees, mm, pixels).
+
+    Parameters
+    ----------
+    result : SfoResult
+        Successful.
+    photo : Photo
+        Its priors are recorded with the facts.
+
+    Returns
+    -------
+    CameraFacts
+    """
+    from scipy.spatial.transform import Rotation
+
+    camera = result.camera
+    T, R = camera.skull2cam, camera.R
+    rotvec = matrix_to_rotvec(R)
+    angle = float(np.degrees(np.linalg.norm(rotvec)))
+    axis = rotvec / np.linalg.norm(rotvec) if angle > 0 else np.array([0.0, 0.0, 1.0])
+    lms = result.facial_landmarks_mm
+    centre = lms["nasion"] if "nasion" in lms else np.mean(list(lms.values()), axis=0)
+    priors = photo.priors
+    prior = priors.head_rotation_skull2cam
+    return CameraFacts(
+        focal_px=float(camera.focal_px),
+        principal_point_px=_floats(camera.principal_point_px),
+        scd_mm=float(camera.distance_mm(centre)),
+        scd_point="facial nasion" if "nasion" in lms else "centroid of the facial landmarks",
+        rotation_angle_deg=angle,
+        rotation_axis=_floats(axis),
+        euler_xyz_deg=_floats(Rotation.from_matrix(R).as_euler("xyz", degrees=True)),
+        translation_mm=_floats(T[:3, 3]),
+        skull2cam=tuple(_floats(row) for row in T),
+        head_deviation_deg=None if prior is None else float(geodesic_angle_deg(R, prior)),
+        focal_prior_px=None if priors.focal_px is None else _floats(priors.focal_px),
+        scd_prior_mm=None if priors.scd_mm is None else _floats(priors.scd_mm),
+        head_tolerance_deg=None if prior is None else float(priors.head_tolerance_deg),
+    )
+
+
+def outside_face(camera, vertices_mm, faces, face_mask, topology=None):
+    """Skull pixels outside the face mask, from the exact skull raster at photo resolution.
+
+    The number the experiment store keeps (``score_result(...)["outside_px"]``); to be
+    replaced by ``lilium.evaluation.metrics.outside_face`` (same signature).
+
+    Parameters
+    ----------
+    camera : Camera
+    vertices_mm : ndarray of shape (V, 3)
+        Skull frame.
+    faces : ndarray of shape (F, 3)
+    face_mask : ndarray of shape (H, W), bool
+        Of the photo, indexed ``[row, column]``.
+    topology : EdgeTopology, optional
+        Of the mesh (cached by a caller).
+
+    Returns
+    -------
+    ImplausibleSFO
+    """
+    from ..evaluation.metrics import implausible_sfo
+    from ..fitness.skof import skull_raster
+
+    face_mask = np.asarray(face_mask)
+    raster = skull_raster(camera.project(vertices_mm), faces, face_mask.shape, topology=topology)
+    return implausible_sfo(raster, face_mask)
+
+
+def _skull_uv_in_image(camera, skull, size_wh):
+    """Projected skull vertices (V, 2) clipped to the image: the skull's extent in the photo."""
+    uv = camera.project(skull.vertices_mm)
+    uv = uv[np.all(np.isfinite(uv), axis=1)]
+    return np.clip(uv, 0, np.array(size_wh, dtype=float) - 1)
+
+
+def sfo_record(entry, index=1, hash_cache=None):
+    """The plain record of one SFO.
+
+    Parameters
+    ----------
+    entry : ReportEntry
+    index : int
+        1-based position on the page.
+    hash_cache : dict, optional
+        Digests of input files already hashed (see :func:`lilium.io.provenance.input_files`).
+
+    Returns
+    -------
+    SfoRecord
+    """
+    result, photo, skull = entry.result, entry.photo, entry.skull
+    if photo.image is None:
+        raise ValueError(f"photo {photo.id!r} was read without its image; read it with pixels")
+    rows = landmark_rows(result, photo)
+    errors = np.array([r.error_px for r in rows])
+    mean_err = float(np.mean(errors)) if len(errors) and np.all(np.isfinite(errors)) else None
+    camera = camera_facts(result, photo) if result else None
+    outside = None
+    if result and photo.face_mask is not None:
+        outside = outside_face(result.camera, skull.vertices_mm, skull.faces, photo.face_mask)
+    points = [r.photo_uv for r in rows] + [r.estimate_uv for r in rows]
+    if result:
+        points += list(_skull_uv_in_image(result.camera, skull, photo.image_size_wh))
+    box = view_box(photo.image_size_wh, None, photo.face_mask, points)
+    pictures = sfo_pictures(result, skull, photo, box, outside is not None and outside.implausible)
+    history = result.extra.get("history")
+    summary = Summary(
+        status="ok" if result else f"failed: {result.error}",
+        focal_px=camera.focal_px if camera else None,
+        scd_mm=camera.scd_mm if camera else None,
+        mean_error_px=mean_err,
+        fitness=result.fitness,
+        outside_pct=None if outside is None else outside.percent_outside,
+        seconds=float(result.seconds),
+    )
+    return SfoRecord(
+        index=index,
+        skull_id=str(skull.id),
+        photo_id=str(photo.id),
+        view=str(photo.view),
+        image_size_wh=tuple(int(s) for s in photo.image_size_wh),
+        method=result.method,
+        method_label=method_label(result),
+        ok=bool(result),
+        error=result.error,
+        summary=summary,
+        landmarks=rows,
+        mean_error_px=mean_err,
+        camera=camera,
+        notes=tuple((str(k), str(v)) for k, v in entry.notes.items()),
+        terms=tuple(result.terms.items()),
+        fitness=result.fitness,
+        outside=outside,
+        history=None if history is None else _floats(history),
+        seed=result.seed,
+        seconds=float(result.seconds),
+        run_extra=tuple((k, str(result.extra[k])) for k in RUN_EXTRAS if k in result.extra),
+        inputs=input_files(entry.inputs, hash_cache),
+        outputs=tuple((str(k), str(v)) for k, v in entry.outputs.items()),
+        pictures=pictures,
+    )
+
+
+def report_record(entries, title=None, command=None, date=None):
+    """The plain record of a report page.
+
+    Parameters
+    ----------
+    entries : list of ReportEntry
+        One per SFO; entries of the same photo (e.g. two methods) follow each other.
+    title : str, optional
+        By default from the skulls' ids.
+    command : str, optional
+        The command line that produced the results, for the provenance.
+    date : str, optional
+        ISO date-time; now (UTC) by default.
+
+    Returns
+    -------
+    ReportRecord
+    """
+    if not entries:
+        raise ValueError("a report needs at least one SFO result")
+    date = date or _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
+    skull_ids = tuple(sorted({str(e.skull.id) for e in entries}))
+    title = title or f"Skull-face overlay: skull {', '.join(skull_ids)}"
+    cache = {}
+    sfos = tuple(sfo_record(e, i, cache) for i, e in enumerate(entries, start=1))
+    versions = tuple(software_versions().items())
+    return ReportRecord(title, date, command, skull_ids, versions, sfos)
+
+
+__all__ = [
+    "ReportEntry",
+    "camera_facts",
+    "landmark_rows",
+    "method_label",
+    "outside_face",
+    "report_record",
+    "sfo_record",
+]
