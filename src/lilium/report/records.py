@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..evaluation.metrics import outside_face
 from ..geometry.rotations import geodesic_angle_deg, matrix_to_rotvec
 from ..io.provenance import input_files, software_versions
 from .pictures import sfo_pictures, view_box
@@ -128,35 +129,6 @@ def camera_facts(result, photo):
     )
 
 
-def outside_face(camera, vertices_mm, faces, face_mask, topology=None):
-    """Skull pixels outside the face mask, from the exact skull raster at photo resolution.
-
-    The number the experiment store keeps (``score_result(...)["outside_px"]``); to be
-    replaced by ``lilium.evaluation.metrics.outside_face`` (same signature).
-
-    Parameters
-    ----------
-    camera : Camera
-    vertices_mm : ndarray of shape (V, 3)
-        Skull frame.
-    faces : ndarray of shape (F, 3)
-    face_mask : ndarray of shape (H, W), bool
-        Of the photo, indexed ``[row, column]``.
-    topology : EdgeTopology, optional
-        Of the mesh (cached by a caller).
-
-    Returns
-    -------
-    ImplausibleSFO
-    """
-    from ..evaluation.metrics import implausible_sfo
-    from ..fitness.skof import skull_raster
-
-    face_mask = np.asarray(face_mask)
-    raster = skull_raster(camera.project(vertices_mm), faces, face_mask.shape, topology=topology)
-    return implausible_sfo(raster, face_mask)
-
-
 def _skull_uv_in_image(camera, skull, size_wh):
     """Projected skull vertices (V, 2) clipped to the image: the skull's extent in the photo."""
     uv = camera.project(skull.vertices_mm)
@@ -266,7 +238,6 @@ __all__ = [
     "camera_facts",
     "landmark_rows",
     "method_label",
-    "outside_face",
     "report_record",
     "sfo_record",
 ]
