@@ -192,8 +192,16 @@ def test_bad_view_and_priors(case):
         read_photo(photo_dir)
     _edit_json(path, lambda d: d.update(view="frontal"))
     _edit_json(path, lambda d: d["priors"].update(focal_px=[3000, 1000]))
-    with pytest.raises(ValueError, match=r"priors.focal_px must be \[lo, hi\]"):
+    with pytest.raises(
+        ValueError, match=r"photo.json: priors.focal_px must be a finite interval \[lo, hi\]"
+    ):
         read_photo(photo_dir)
+    for bad in ([0, 1000], [1000, "2000"], [1000], [1000, 1e400]):
+        _edit_json(path, lambda d, bad=bad: d["priors"].update(scd_mm=bad, focal_px=None))
+        with pytest.raises(
+            ValueError, match=r"photo.json: priors.scd_mm must be a finite interval"
+        ):
+            read_photo(photo_dir)
 
 
 def test_user_depth_table(tmp_path):

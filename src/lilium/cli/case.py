@@ -199,18 +199,9 @@ def _sibling(image_path, stems, suffixes):
 
 
 def _check_interval(values, option):
-    if values is None:
-        return None
-    lo, hi = values
-    if not (0 < lo <= hi) or not all(map(_finite, values)):
-        raise ValueError(
-            f"command line: {option} must be LO HI with 0 < LO <= HI, got {lo:g} {hi:g}"
-        )
-    return float(lo), float(hi)
+    from ..validation import check_interval
 
-
-def _finite(x):
-    return x == x and abs(x) != float("inf")
+    return None if values is None else check_interval(values, f"command line: {option}")
 
 
 def load_photos(args):

@@ -13,6 +13,7 @@ from ..inputs import Photo, Priors, Skull
 from ..softtissue.depths import DepthStats, check_depth_table
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from ..softtissue.normals import surface_normals_at
+from ..validation import check_interval
 from .formats import find_landmark_file, points_from_object, read_landmarks
 from .jsonio import read_json
 from .mesh import MESH_SUFFIXES, read_mesh
@@ -122,12 +123,7 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
 
 def _interval(path, priors, key):
     value = priors.get(key)
-    if value is None:
-        return None
-    lo_hi = np.asarray(value, dtype=float) if np.ndim(value) == 1 else np.empty(0)
-    if lo_hi.shape != (2,) or not np.all(np.isfinite(lo_hi)) or not 0 < lo_hi[0] <= lo_hi[1]:
-        raise ValueError(f"{path}: priors.{key} must be [lo, hi] with 0 < lo <= hi, got {value!r}")
-    return float(lo_hi[0]), float(lo_hi[1])
+    return None if value is None else check_interval(value, f"{path}: priors.{key}")
 
 
 def parse_priors(path, priors):
