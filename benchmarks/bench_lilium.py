@@ -18,24 +18,21 @@ from pathlib import Path
 
 import numpy as np
 
-from lilium.evaluation.metrics import back_projection_error_from_dicts, implausible_sfo
+from lilium.evaluation import implausible_sfo, score
 from lilium.fitness.skof import skull_raster
 from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
+from lilium.io.truth import read_ground_truth
 from lilium.methods.lilium import VARIANTS, LiliumOptions, lilium_sfo
 from lilium.methods.posest_sfo import posest_sfo
 from lilium.optimisation import DEOptions
 
 
-def evaluate(result, skull, photo, truth, facial_truth):
+def evaluate(result, skull, photo, truth):
     """BPE (mm) and implausibility of one SFO result."""
     if not result:
         return np.nan, True, np.nan
-    bpe = back_projection_error_from_dicts(
-        facial_truth,
-        truth["landmarks_noise_free"],
-        result.camera,
-    )
+    bpe = score(result, truth).bpe_mm
     uv = result.camera.project(skull.vertices_mm)
     w, h = photo.image_size_wh
     raster = skull_raster(uv, skull.faces, (h, w))
@@ -56,11 +53,10 @@ def run_photo(task):
     """POSEST-SFO and each Lilium variant on one Exp. C photo and its own skull."""
     root, entry, axes_set, variants, de, seed = task
     photo_dir = root / entry["paths"]["C"]
-    truth = read_json(photo_dir / "photo.json")["ground_truth"]
     subject_dir = root / "subjects" / entry["subject"]
+    truth = read_ground_truth(photo_dir, subject_dir)
     skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{axes_set}.json")
     photo = read_photo(photo_dir)
-    facial_truth = read_json(subject_dir / "facial_landmarks.json")["landmarks"]
     # POSEST-SFO is deterministic: run once, with the first seed.
     runs = [("posest-sfo", lambda: posest_sfo(skull, photo))] if seed == 0 else []
     runs += [
@@ -72,7 +68,7 @@ def run_photo(task):
         t0 = time.perf_counter()
         result = run()
         seconds = time.perf_counter() - t0
-        bpe, implausible, pct = evaluate(result, skull, photo, truth, facial_truth)
+        bpe, implausible, pct = evaluate(result, skull, photo, truth)
         rows.append(
             (name, entry["view"].split("_")[0], bpe, implausible, pct, seconds, entry["id"])
         )

@@ -8,12 +8,15 @@ from .metrics import (
     implausible_sfo,
     rank_of_true,
 )
+from .scoring import Score, score
 
 __all__ = [
     "ImplausibleSFO",
+    "Score",
     "back_projection_error",
     "back_projection_error_from_dicts",
     "back_projection_errors",
     "implausible_sfo",
     "rank_of_true",
+    "score",
 ]

@@ -223,20 +223,21 @@ def _topology(subject_dir, skull):
 
 @functools.lru_cache(maxsize=SKULL_CACHE)
 def _facial_truth(subject_dir):
-    from ..io.jsonio import read_json
+    from ..io.truth import read_facial_landmarks
 
-    path = Path(subject_dir) / "facial_landmarks.json"
-    return read_json(path)["landmarks"] if path.is_file() else None
+    return read_facial_landmarks(subject_dir)
 
 
 @functools.lru_cache(maxsize=PHOTO_CACHE)
 def _photo(photo_dir):
+    """The photo and its ground truth, ``{"landmarks_noise_free": ...}`` as
+    :func:`score_result` takes it (read by :func:`lilium.io.truth.read_ground_truth`)."""
     from ..io.case import read_photo
-    from ..io.jsonio import read_json
+    from ..io.truth import read_ground_truth
 
     photo = read_photo(photo_dir, load_image=False)
-    truth = read_json(Path(photo_dir) / "photo.json").get("ground_truth") or {}
-    return photo, truth
+    truth = read_ground_truth(photo_dir)
+    return photo, {"landmarks_noise_free": truth.landmarks_noise_free}
 
 
 def _run_method(task, skull, photo):
