@@ -18,24 +18,21 @@ from pathlib import Path
 
 import numpy as np
 
-from lilium.evaluation.metrics import back_projection_error_from_dicts, outside_face
+from lilium.evaluation import outside_face, score
 from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
+from lilium.io.truth import read_ground_truth
 from lilium.methods import METHODS, SfoOptions, run_sfo
 from lilium.optimisation import DEOptions
 
 VARIANTS = METHODS["lilium"].variants
 
 
-def evaluate(result, skull, photo, truth, facial_truth):
+def evaluate(result, skull, photo, truth):
     """BPE (mm) and implausibility of one SFO result."""
     if not result:
         return np.nan, True, np.nan
-    bpe = back_projection_error_from_dicts(
-        facial_truth,
-        truth["landmarks_noise_free"],
-        result.camera,
-    )
+    bpe = score(result, truth).bpe_mm
     imp = outside_face(result.camera, skull.vertices_mm, skull.faces, photo.face_mask)
     return bpe, imp.outside_px > 0, imp.percent_outside
 
@@ -53,11 +50,10 @@ def run_photo(task):
     """POSEST-SFO and each Lilium variant on one Exp. C photo and its own skull."""
     root, entry, axes_set, variants, de, seed = task
     photo_dir = root / entry["paths"]["C"]
-    truth = read_json(photo_dir / "photo.json")["ground_truth"]
     subject_dir = root / "subjects" / entry["subject"]
+    truth = read_ground_truth(photo_dir, subject_dir)
     skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{axes_set}.json")
     photo = read_photo(photo_dir)
-    facial_truth = read_json(subject_dir / "facial_landmarks.json")["landmarks"]
     # POSEST-SFO is deterministic: run once, with the first seed.
     runs = [("posest-sfo", lambda: run_sfo("posest-sfo", skull, photo))] if seed == 0 else []
     runs += [
@@ -69,7 +65,7 @@ def run_photo(task):
         t0 = time.perf_counter()
         result = run()
         seconds = time.perf_counter() - t0
-        bpe, implausible, pct = evaluate(result, skull, photo, truth, facial_truth)
+        bpe, implausible, pct = evaluate(result, skull, photo, truth)
         rows.append(
             (name, entry["view"].split("_")[0], bpe, implausible, pct, seconds, entry["id"])
         )

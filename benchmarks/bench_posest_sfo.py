@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from lilium.evaluation.metrics import back_projection_error_from_dicts, rank_of_true
-from lilium.geometry.camera import Camera
+from lilium.evaluation import rank_of_true, score
 from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
+from lilium.io.truth import read_ground_truth
 from lilium.methods.posest_sfo import posest_sfo
 
 
@@ -37,9 +37,6 @@ def main(argv=None):
         photos = [
             photos[i] for i in np.linspace(0, len(photos) - 1, args.limit).round().astype(int)
         ]
-    facial = {
-        i: read_json(root / "subjects" / i / "facial_landmarks.json")["landmarks"] for i in ids
-    }
     print(f"{len(ids)} subjects, {len(photos)} photos per experiment")
     print(
         f"{'exp':<4}{'view':<9}{'photos':>7}{'mean rank':>10}{'BPE mean':>10}{'BPE med':>9}"
@@ -55,29 +52,17 @@ def main(argv=None):
         for entry in photos:
             photo_dir = root / entry["paths"][exp]
             photo = read_photo(photo_dir, load_image=False)
-            truth = read_json(photo_dir / "photo.json")["ground_truth"]
+            truth = read_ground_truth(photo_dir, root / "subjects" / entry["subject"])
             scores = []
             for skull in skulls:
                 t0 = time.perf_counter()
                 result = posest_sfo(skull, photo)
                 times.append(time.perf_counter() - t0)
                 scores.append(result.fitness if result else np.nan)
-                if skull.id == truth["subject"]:
-                    bpe = (
-                        back_projection_error_from_dicts(
-                            facial[skull.id],
-                            truth["landmarks_noise_free"],
-                            result.camera,
-                        )
-                        if result
-                        else np.nan
-                    )
-                    gt_bpe = back_projection_error_from_dicts(
-                        facial[skull.id],
-                        truth["landmarks_noise_free"],
-                        Camera.from_dict(truth),
-                    )
-            rank = rank_of_true(scores, ids.index(truth["subject"]))
+                if skull.id == truth.subject:
+                    bpe = score(result, truth).bpe_mm
+                    gt_bpe = score(truth.camera, truth).bpe_mm
+            rank = rank_of_true(scores, ids.index(truth.subject))
             stats[entry["view"].split("_")[0]].append((rank, bpe, gt_bpe))
         for view, rows in stats.items():
             if not rows:

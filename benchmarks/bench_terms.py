@@ -29,6 +29,7 @@ from scipy.spatial.transform import Rotation
 from lilium.fitness.skof import prepare_skof, skull_outside_pixels_batch
 from lilium.geometry.camera import Cameras, principal_point_of
 from lilium.io.case import read_photo, read_skull
+from lilium.io.truth import read_ground_truth
 from lilium.methods.lilium_terms import PllTerm, SkofTerm
 
 # The tests' readable per-curve P_pll, the reference the batched totals must equal.
@@ -65,10 +66,8 @@ def load_cases(root):
     root = Path(root)
     for folder in sorted((root / "photos").glob("*/*")):
         photo = read_photo(folder, load_image=False)
-        import json
-
-        truth = json.loads((folder / "photo.json").read_text())["ground_truth"]
-        skull = read_skull(root / "subjects" / truth["subject"])
+        truth = read_ground_truth(folder)
+        skull = read_skull(root / "subjects" / truth.subject)
         yield folder.name, skull, photo, truth
 
 
@@ -78,7 +77,7 @@ def bench_case(name, skull, photo, truth):
     skof = SkofTerm(skull, photo, centre)
     full = prepare_skof(skull.faces, photo.face_mask)
     for label, spread in SPREADS.items():
-        R, t, f = cameras_around(truth["skull2cam"], truth["focal_px"], spread)
+        R, t, f = cameras_around(truth.camera.skull2cam, truth.camera.focal_px, spread)
         uv = Cameras(R, t, f, centre).project(pll.region_vertices_mm)
         span_v = None
         if pll.span_mm is not None:

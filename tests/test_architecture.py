@@ -10,6 +10,7 @@ import lilium
 #: from its own layer or below, never above.
 LAYERS = {
     "constants": 0,
+    "validation": 0,
     "geometry": 1,
     "optimisation": 1,
     "softtissue": 2,

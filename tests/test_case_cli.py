@@ -203,7 +203,12 @@ def test_command_line_mistakes(files, case, tmp_path, capsys):
     _one_line_error(
         capsys,
         _argv(files, tmp_path) + ["--focal-px", "3000", "2000"],
-        "--focal-px must be LO HI with 0 < LO <= HI",
+        "command line: --focal-px must be a finite interval [lo, hi] with 0 < lo <= hi",
+    )
+    _one_line_error(
+        capsys,
+        _argv(files, tmp_path) + ["--scd-mm", "0", "900"],
+        "--scd-mm must be a finite interval [lo, hi] with 0 < lo <= hi, got [0, 900]",
     )
     _, photo_dir = case
     argv = _argv(files, tmp_path) + ["--photo", photo_dir, "--photo-landmarks", files / "x.csv"]

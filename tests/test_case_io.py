@@ -58,12 +58,12 @@ def test_unknown_landmark_name_suggests_the_right_one(case):
     )
     with pytest.raises(
         ValueError,
-        match=r"cranial_landmarks.json: landmarks: unknown landmark "
+        match=r"cranial_landmarks.json: landmarks: unknown cranial landmark "
         r"'nasoin'; did you mean 'nasion'\?",
     ):
         read_skull(subject_dir)
     _edit_json(photo_dir / "photo.json", lambda d: d["landmarks"].update(chin=[1, 2]))
-    with pytest.raises(ValueError, match=r"photo.json: landmarks: unknown landmark 'chin'"):
+    with pytest.raises(ValueError, match=r"photo.json: landmarks: unknown facial landmark 'chin'"):
         read_photo(photo_dir)
 
 
@@ -73,8 +73,54 @@ def test_nan_landmark(case):
     data = json.loads(text)
     data["landmarks"]["nasion"] = [float("nan"), 3.0]
     (photo_dir / "photo.json").write_text(json.dumps(data))  # json writes NaN
-    with pytest.raises(ValueError, match=r"photo.json: landmarks.nasion is NaN or infinite; give"):
+    with pytest.raises(
+        ValueError, match=r"photo.json: landmarks: 'nasion' has NaN or infinite coordinates; give"
+    ):
         read_photo(photo_dir)
+
+
+def test_spec_files_accept_the_aliases_of_the_other_formats(case):
+    subject_dir, photo_dir = case
+    before = read_skull(subject_dir).landmarks_mm["nasion"]
+    _edit_json(
+        subject_dir / "cranial_landmarks.json",
+        lambda d: d["landmarks"].update(N=d["landmarks"].pop("nasion")),
+    )
+    _edit_json(
+        photo_dir / "photo.json",
+        lambda d: d["landmarks"].update(exR=d["landmarks"].pop("exocanthion_r")),
+    )
+    np.testing.assert_array_equal(read_skull(subject_dir).landmarks_mm["nasion"], before)
+    assert "exocanthion_r" in read_photo(photo_dir).landmarks_uv
+
+
+def test_a_landmark_given_twice_is_an_error(case):
+    subject_dir, photo_dir = case
+    path = subject_dir / "cranial_landmarks.json"
+    _edit_json(path, lambda d: d["landmarks"].update(n=d["landmarks"]["nasion"]))
+    with pytest.raises(
+        ValueError,
+        match=r"cranial_landmarks.json: landmarks: 'n' and 'nasion' are both nasion; keep one",
+    ):
+        read_skull(subject_dir)
+    # The same JSON key twice: json.loads would keep the last one silently.
+    text = (photo_dir / "photo.json").read_text()
+    (photo_dir / "photo.json").write_text(
+        text.replace('"landmarks": {', '"landmarks": {"nasion": [1.0, 2.0], ', 1)
+    )
+    with pytest.raises(
+        ValueError, match=r"photo.json: the key 'nasion' appears twice in one JSON object"
+    ):
+        read_photo(photo_dir)
+
+
+def test_duplicate_keys_are_an_error_in_every_json_read(tmp_path):
+    from lilium.io.jsonio import read_json
+
+    path = tmp_path / "dataset.json"
+    path.write_text('{"subjects": [{"id": "a", "id": "b"}]}')
+    with pytest.raises(ValueError, match=r"dataset.json: the key 'id' appears twice"):
+        read_json(path)
 
 
 def test_too_few_usable_correspondences(case):
@@ -146,8 +192,16 @@ def test_bad_view_and_priors(case):
         read_photo(photo_dir)
     _edit_json(path, lambda d: d.update(view="frontal"))
     _edit_json(path, lambda d: d["priors"].update(focal_px=[3000, 1000]))
-    with pytest.raises(ValueError, match=r"priors.focal_px must be \[lo, hi\]"):
+    with pytest.raises(
+        ValueError, match=r"photo.json: priors.focal_px must be a finite interval \[lo, hi\]"
+    ):
         read_photo(photo_dir)
+    for bad in ([0, 1000], [1000, "2000"], [1000], [1000, 1e400]):
+        _edit_json(path, lambda d, bad=bad: d["priors"].update(scd_mm=bad, focal_px=None))
+        with pytest.raises(
+            ValueError, match=r"photo.json: priors.scd_mm must be a finite interval"
+        ):
+            read_photo(photo_dir)
 
 
 def test_user_depth_table(tmp_path):

@@ -80,6 +80,14 @@ def test_priors_object_and_head_deviation():
 def test_invalid_priors_say_what_is_wrong():
     with pytest.raises(ValueError, match="focal_px must be a finite interval"):
         CameraPriors(focal_px=(1200, 800))
+    with pytest.raises(
+        ValueError, match=r"scd_mm must be a finite interval \[lo, hi\] with 0 < lo"
+    ):
+        CameraPriors(scd_mm=(-5, 800))
+    with pytest.raises(
+        ValueError, match=r"focal_interval_px must be a finite interval.*\[nan, 1\]"
+    ):
+        camera_penalty([1000.0], focal_interval_px=(np.nan, 1))
     with pytest.raises(ValueError, match="head_tolerance_deg must be >= 0"):
         CameraPriors(head_tolerance_deg=-1)
     with pytest.raises(ValueError, match="scd_mm is needed"):

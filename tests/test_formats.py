@@ -173,6 +173,13 @@ def test_facial_csv_and_json(tmp_path):
         ("a.csv", "", r"a.csv: no landmarks found"),
         ("a.pp", "<PickedPoints><point", r"not a valid MeshLab .pp file"),
         ("a.mrk.json", "{", r"not valid JSON"),
+        ("a.json", '{"n": [1, 2, 3], "n": [1, 2, 4]}', r"a.json: the key 'n' appears twice"),
+        (
+            "a.json",
+            '{"landmarks": {"g": [1, 2, 3], "glabella": [1, 2, 3]}}',
+            r"a.json: landmarks: "
+            r"'glabella' and 'g' are both glabella",
+        ),
         ("a.mrk.json", '{"markups": []}', r"no 'markups' list"),
         ("a.xyz", "n 1 2 3", r"unknown landmark file type; use .mrk.json"),
     ],

@@ -1,10 +1,10 @@
-import json
-
 import numpy as np
 import pytest
 
+from lilium.evaluation import score
 from lilium.geometry import geodesic_angle_deg
 from lilium.io.case import read_photo, read_skull
+from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions
 from lilium.methods.lilium import LiliumProblem, lilium_sfo
 from lilium.optimisation import DEOptions
@@ -16,13 +16,13 @@ def _opts(variant="base", generations=250, population=30):
 
 def test_recovers_the_ground_truth_camera_on_a_noise_free_case(case):
     subject_dir, photo_dir = case
-    truth = json.loads((photo_dir / "photo.json").read_text())["ground_truth"]
+    truth = read_ground_truth(photo_dir).camera
     result = lilium_sfo(
         read_skull(subject_dir), read_photo(photo_dir), _opts(generations=600), seed=0
     )
     assert result and result.terms["p_cam"] == 0.0
-    assert abs(result.camera.focal_px - truth["focal_px"]) / truth["focal_px"] < 0.08
-    R_true = np.array(truth["skull2cam"])[:3, :3]
+    assert abs(result.camera.focal_px - truth.focal_px) / truth.focal_px < 0.08
+    R_true = truth.R
     assert geodesic_angle_deg(result.camera.R, R_true) < 2.0
     # The true soft tissue lies in the cones: the fit gets within a few pixels.
     assert result.terms["mse_pix"] < 2.0
@@ -77,24 +77,16 @@ def test_full_method_recovers_the_camera_on_a_generated_noise_free_photo(tmp_pat
     4.5 %, rotation 3.8 deg, BPE 2.0 mm). The lateral photo of this subject is not asserted
     here: there Lilium measured 5.5 deg and BPE 4.7 mm (see docs/method.md, known limits).
     """
-    from lilium.evaluation.metrics import back_projection_error_from_dicts
-    from lilium.io.jsonio import read_json
     from lilium.synthetic.dataset import generate_dataset
 
     index = generate_dataset(tmp_path, 1, 1, seed=3, experiments=("A",), workers=1)
     subject_dir = tmp_path / index["subjects"][0]["path"]
-    facial = read_json(subject_dir / "facial_landmarks.json")["landmarks"]
     for entry in [e for e in index["photos"] if e["view"] == "frontal"]:
         photo_dir = tmp_path / entry["paths"]["A"]
-        truth = read_json(photo_dir / "photo.json")["ground_truth"]
+        truth = read_ground_truth(photo_dir, subject_dir)
         result = lilium_sfo(read_skull(subject_dir), read_photo(photo_dir), SfoOptions(), seed=0)
         assert result and result.terms["p_skof"] == 0.0
-        assert abs(result.camera.focal_px - truth["focal_px"]) / truth["focal_px"] < 0.05
-        R_true = np.array(truth["skull2cam"])[:3, :3]
-        assert geodesic_angle_deg(result.camera.R, R_true) < 5.0
-        bpe = back_projection_error_from_dicts(
-            facial,
-            truth["landmarks_noise_free"],
-            result.camera,
-        )
-        assert bpe < 3.0
+        f_true = truth.camera.focal_px
+        assert abs(result.camera.focal_px - f_true) / f_true < 0.05
+        assert geodesic_angle_deg(result.camera.R, truth.camera.R) < 5.0
+        assert score(result, truth).bpe_mm < 3.0

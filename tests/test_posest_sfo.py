@@ -6,6 +6,7 @@ from lilium.cli.main import main
 from lilium.geometry import Camera, geodesic_angle_deg
 from lilium.inputs import Photo, correspondences
 from lilium.io.case import read_photo, read_skull
+from lilium.io.truth import read_ground_truth
 from lilium.methods.posest_sfo import mean_depth_landmarks, posest_sfo
 
 
@@ -13,8 +14,8 @@ def test_recovers_the_camera_when_soft_tissue_is_the_mean(case):
     """Photo landmarks made from mean-depth facial landmarks: an exact PnP+f problem."""
     subject_dir, photo_dir = case
     skull, photo = read_skull(subject_dir), read_photo(photo_dir)
-    truth = json.loads((photo_dir / "photo.json").read_text())["ground_truth"]
-    skull2cam, focal = np.array(truth["skull2cam"]), truth["focal_px"]
+    truth = read_ground_truth(photo_dir).camera
+    skull2cam, focal = truth.skull2cam, truth.focal_px
     corr = correspondences(skull, photo)
     facial = mean_depth_landmarks(corr)
     uv = Camera(skull2cam, focal, [599.5, 449.5]).project(facial)

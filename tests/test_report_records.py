@@ -38,7 +38,7 @@ def test_outside_pixels_are_the_experiment_stores_number(sfo, dx_mm):
     skull, photo, result, _ = sfo
     result = _shifted(result, dx_mm)
     record = sfo_record(ReportEntry(skull, photo, result))
-    expected = score_result(result, skull, photo, {}, None)
+    expected = score_result(result, skull, photo)
     assert record.outside.outside_px == expected["outside_px"]
     assert record.outside.skull_px == expected["skull_px"]
     assert record.summary.outside_pct == pytest.approx(expected["percent_outside"])

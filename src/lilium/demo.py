@@ -9,9 +9,9 @@ method's back-projection error (BPE, mm).
 
 from pathlib import Path
 
-from .evaluation.metrics import back_projection_error_from_dicts
-from .geometry.camera import Camera
-from .io.jsonio import read_json
+from .evaluation import score
+from .io.results import read_result_camera
+from .io.truth import read_ground_truth
 
 #: Subjects and photos per view of the demo dataset.
 DEMO_SUBJECTS, DEMO_PHOTOS = 1, 1
@@ -41,11 +41,5 @@ def build_demo_case(folder, seed=0):
 
 def ground_truth_bpe(result_path, subject_dir, photo_dir):
     """BPE (mm) of a written ``result.json`` against the synthetic ground truth (NaN if failed)."""
-    result = read_json(result_path)
-    if result["camera"] is None:
-        return float("nan")
-    truth = read_json(Path(photo_dir) / "photo.json")["ground_truth"]
-    facial = read_json(Path(subject_dir) / "facial_landmarks.json")["landmarks"]
-    return back_projection_error_from_dicts(
-        facial, truth["landmarks_noise_free"], Camera.from_dict(result["camera"])
-    )
+    truth = read_ground_truth(photo_dir, subject_dir)
+    return score(read_result_camera(result_path), truth).bpe_mm

@@ -12,6 +12,7 @@ from pathlib import Path
 from ..io.case import IMAGE_NAMES, photo_from_files, read_photo, read_skull, skull_from_files
 from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
+from ..validation import check_interval
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
@@ -93,18 +94,7 @@ def _sibling(image_path, stems, suffixes):
 
 
 def _check_interval(values, option):
-    if values is None:
-        return None
-    lo, hi = values
-    if not (0 < lo <= hi) or not all(map(_finite, values)):
-        raise ValueError(
-            f"command line: {option} must be LO HI with 0 < LO <= HI, got {lo:g} {hi:g}"
-        )
-    return float(lo), float(hi)
-
-
-def _finite(x):
-    return x == x and abs(x) != float("inf")
+    return None if values is None else check_interval(values, f"command line: {option}")
 
 
 def load_photos(

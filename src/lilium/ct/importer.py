@@ -1,11 +1,7 @@
 """CT volume -> subject folder (SPEC section 8): skull and skin meshes, optional landmarks."""
 
-import csv
 from pathlib import Path
 
-import numpy as np
-
-from ..softtissue.landmarks import CRANIAL_NAMES
 from .mesh import volume_to_mesh
 from .readers import read_volume
 from .volume import Volume
@@ -16,8 +12,9 @@ DEFAULT_BONE_ISO = 1150.0
 
 
 def read_landmark_file(path):
-    """Cranial landmarks from JSON (``{"landmarks": {name: [x, y, z]}}`` or a bare mapping) or
-    CSV (rows ``name,x,y,z``; a header row is allowed).
+    """Cranial landmarks of a CT, from any file :func:`lilium.io.formats.read_landmarks` reads:
+    JSON (``{"landmarks": {name: [x, y, z]}}`` or a bare mapping), CSV (rows ``name,x,y,z``; a
+    header row is allowed), 3D Slicer or MeshLab; the usual aliases accepted.
 
     Returns
     -------
@@ -28,43 +25,9 @@ def read_landmark_file(path):
     ValueError
         Unreadable file, unknown landmark name, or a point that is not 3 finite numbers.
     """
-    from ..io.jsonio import read_json
+    from ..io.formats import read_landmarks
 
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{path}: file not found")
-    if path.suffix.lower() == ".csv":
-        raw = {}
-        with path.open(newline="") as fh:
-            for row in csv.reader(fh):
-                row = [c.strip() for c in row]
-                if not row or not row[0] or row[0].startswith("#"):
-                    continue
-                if row[0].lower() in ("name", "landmark", "label"):
-                    continue
-                if len(row) < 4:
-                    raise ValueError(f"{path}: row {row} needs name,x,y,z")
-                raw[row[0]] = row[1:4]
-    else:
-        data = read_json(path)
-        raw = data.get("landmarks", data) if isinstance(data, dict) else None
-        if not isinstance(raw, dict):
-            raise ValueError(f'{path}: expected {{"landmarks": {{"nasion": [x, y, z], ...}}}}')
-    out = {}
-    for name, value in raw.items():
-        if name not in CRANIAL_NAMES:
-            raise ValueError(
-                f"{path}: unknown cranial landmark {name!r}; use names such as "
-                f"{', '.join(CRANIAL_NAMES[:4])}, ... (SPEC section 2)"
-            )
-        try:
-            point = np.asarray(value, dtype=float).reshape(3)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"{path}: landmark {name!r} must be 3 numbers, got {value!r}") from exc
-        if not np.all(np.isfinite(point)):
-            raise ValueError(f"{path}: landmark {name!r} has a NaN or infinite coordinate")
-        out[name] = point
-    return out
+    return read_landmarks(path, "cranial")
 
 
 def import_ct(

@@ -23,7 +23,7 @@ import json
 import os
 import socket
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -212,20 +212,18 @@ def _topology(subject_dir, skull):
 
 @functools.lru_cache(maxsize=SKULL_CACHE)
 def _facial_truth(subject_dir):
-    from ..io.jsonio import read_json
+    from ..io.truth import read_facial_landmarks
 
-    path = Path(subject_dir) / "facial_landmarks.json"
-    return read_json(path)["landmarks"] if path.is_file() else None
+    return read_facial_landmarks(subject_dir)
 
 
 @functools.lru_cache(maxsize=PHOTO_CACHE)
 def _photo(photo_dir):
+    """The photo and its :class:`~lilium.io.truth.GroundTruth` (without the 3D landmarks)."""
     from ..io.case import read_photo
-    from ..io.jsonio import read_json
+    from ..io.truth import read_ground_truth
 
-    photo = read_photo(photo_dir, load_image=False)
-    truth = read_json(Path(photo_dir) / "photo.json").get("ground_truth") or {}
-    return photo, truth
+    return read_photo(photo_dir, load_image=False), read_ground_truth(photo_dir)
 
 
 def _run_method(task, skull, photo):
@@ -239,18 +237,17 @@ def _finite(value):
     return float(value) if value is not None and np.isfinite(value) else None
 
 
-def score_result(result, skull, photo, truth, facial_truth, topology=None):
-    """Evaluation columns of one SFO: BPE (positive pairs) and skull pixels outside the mask.
+def score_result(result, skull, photo, truth=None, topology=None):
+    """Evaluation columns of one SFO (:func:`lilium.evaluation.score`).
 
     Parameters
     ----------
     result : SfoResult
     skull : Skull
     photo : Photo
-    truth : dict
-        ``ground_truth`` of ``photo.json`` (``landmarks_noise_free``).
-    facial_truth : dict or None
-        The subject's ``facial_landmarks.json`` landmarks; None for a negative pair.
+    truth : GroundTruth, optional
+        With the tested skull's 3D facial landmarks for a positive pair (BPE); None or without
+        them for a negative pair.
     topology : EdgeTopology, optional
         Of the skull mesh (cached by the caller).
 
@@ -259,22 +256,16 @@ def score_result(result, skull, photo, truth, facial_truth, topology=None):
     dict
         ``bpe_mm``, ``skull_px``, ``outside_px``, ``percent_outside`` (None where not defined).
     """
-    from ..evaluation.metrics import back_projection_error_from_dicts, outside_face
+    from ..evaluation import score
 
-    out = {"bpe_mm": None, "skull_px": None, "outside_px": None, "percent_outside": None}
-    if not result:
-        return out
-    noise_free = truth.get("landmarks_noise_free")
-    if facial_truth and noise_free:
-        out["bpe_mm"] = back_projection_error_from_dicts(facial_truth, noise_free, result.camera)
-    if photo.face_mask is not None:
-        imp = outside_face(
-            result.camera, skull.vertices_mm, skull.faces, photo.face_mask, topology=topology
-        )
-        out.update(
-            skull_px=imp.skull_px, outside_px=imp.outside_px, percent_outside=imp.percent_outside
-        )
-    return out
+    s = score(result, truth, skull, photo.face_mask, topology)
+    imp = s.implausible
+    return {
+        "bpe_mm": _finite(s.bpe_mm),
+        "skull_px": imp.skull_px if imp else None,
+        "outside_px": imp.outside_px if imp else None,
+        "percent_outside": imp.percent_outside if imp else None,
+    }
 
 
 def run_task(task):
@@ -300,10 +291,9 @@ def run_task(task):
         row.update(success=0, error=str(exc), task_seconds=time.perf_counter() - start)
         row["finished_at"] = time.time()
         return row
-    facial_truth = _facial_truth(task.subject_dir) if row["positive"] else None
-    row.update(
-        score_result(result, skull, photo, truth, facial_truth, _topology(task.subject_dir, skull))
-    )
+    if row["positive"]:
+        truth = replace(truth, facial_landmarks_mm=_facial_truth(task.subject_dir))
+    row.update(score_result(result, skull, photo, truth, _topology(task.subject_dir, skull)))
     data = result.to_dict()
     for key in _DROPPED_RESULT_KEYS:
         data.pop(key, None)

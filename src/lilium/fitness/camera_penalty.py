@@ -17,15 +17,11 @@ import numpy as np
 
 from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX
 from ..geometry.rotations import geodesic_angle_deg
+from ..validation import check_interval
 
 
-def _interval(value, name, unit):
-    if value is None:
-        return None
-    lo, hi = (float(x) for x in value)
-    if not (np.isfinite(lo) and np.isfinite(hi)) or lo > hi:
-        raise ValueError(f"{name} must be a finite interval [lo, hi] in {unit}, got {value}")
-    return lo, hi
+def _interval(value, name):
+    return None if value is None else check_interval(value, name)
 
 
 @dataclass(frozen=True)
@@ -51,8 +47,8 @@ class CameraPriors:
     head_tolerance_deg: float | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "focal_px", _interval(self.focal_px, "focal_px", "pixels"))
-        object.__setattr__(self, "scd_mm", _interval(self.scd_mm, "scd_mm", "mm"))
+        object.__setattr__(self, "focal_px", _interval(self.focal_px, "focal_px"))
+        object.__setattr__(self, "scd_mm", _interval(self.scd_mm, "scd_mm"))
         if self.head_rotation_skull2cam is not None:
             R = np.asarray(self.head_rotation_skull2cam, dtype=float)
             if R.shape != (3, 3):
@@ -144,10 +140,10 @@ def camera_penalty(
         fail = fail | ~np.isfinite(x)
         terms = terms + np.where(np.isfinite(value), value, 0.0)
 
-    lo_hi = _interval(focal_interval_px, "focal_interval_px", "pixels")
+    lo_hi = _interval(focal_interval_px, "focal_interval_px")
     if lo_hi is not None:
         add(f, "focal_px", lambda x: _excess2(x, *lo_hi))
-    scd_lo_hi = _interval(scd_interval_mm, "scd_interval_mm", "mm")
+    scd_lo_hi = _interval(scd_interval_mm, "scd_interval_mm")
     if scd_lo_hi is not None:
         add(scd_mm, "scd_mm", lambda x: _excess2(x, *scd_lo_hi))
     if tolerance_deg is not None:

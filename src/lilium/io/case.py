@@ -4,7 +4,6 @@ Every problem found is a ``ValueError`` whose message names the file, the field 
 """
 
 import csv
-import difflib
 from pathlib import Path
 
 import numpy as np
@@ -12,8 +11,10 @@ import numpy as np
 from ..constants import VIEWS
 from ..inputs import Photo, Priors, Skull
 from ..softtissue.depths import DepthStats, check_depth_table
-from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL, FACIAL_NAMES
+from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from ..softtissue.normals import surface_normals_at
+from ..validation import check_interval
+from .formats import find_landmark_file, points_from_object, read_landmarks
 from .jsonio import read_json
 from .mesh import MESH_SUFFIXES, read_mesh
 
@@ -32,39 +33,6 @@ def _check_folder(folder, kind):
     if not folder.is_dir():
         raise ValueError(f"{folder}: {kind} folder not found")
     return folder
-
-
-def _unknown_name(path, field, name, known):
-    close = difflib.get_close_matches(name, known, n=1)
-    hint = f"did you mean {close[0]!r}?" if close else "see SPEC section 2 for the names"
-    return ValueError(f"{path}: {field}: unknown landmark {name!r}; {hint}")
-
-
-def parse_points(path, field, raw, known, dim):
-    """Validate ``{name: [coords]}`` from a file: known names, ``dim`` finite numbers each.
-
-    Returns
-    -------
-    dict of str -> ndarray of shape (dim,)
-    """
-    if not isinstance(raw, dict):
-        raise ValueError(f"{path}: {field} must be an object {{name: [{dim} numbers]}}")
-    out = {}
-    for name, value in raw.items():
-        if name not in known:
-            raise _unknown_name(path, field, name, known)
-        try:
-            point = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
-            point = np.empty(0)
-        if point.shape != (dim,):
-            raise ValueError(f"{path}: {field}.{name} must be {dim} numbers, got {value!r}")
-        if not np.all(np.isfinite(point)):
-            raise ValueError(
-                f"{path}: {field}.{name} is NaN or infinite; give its coordinates or remove it"
-            )
-        out[name] = point
-    return out
 
 
 def _field(path, data, key):
@@ -98,8 +66,6 @@ def read_skull(folder, axes_path=None):
     )
     lm_path = folder / "cranial_landmarks.json"
     if not lm_path.is_file():
-        from .formats import find_landmark_file
-
         # A Slicer / MeshLab / CSV file instead (cranial_landmarks.csv, skull.mrk.json, ...).
         lm_path = find_landmark_file(folder, ["cranial_landmarks", "skull"]) or lm_path
     axes_path = axes_path or folder / "soft_tissue_axes.json"
@@ -127,10 +93,8 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
     vertices, faces = read_mesh(mesh_path)
     if lm_path.name == "cranial_landmarks.json" or not lm_path.is_file():
         raw = _field(lm_path, read_json(lm_path), "landmarks")
-        landmarks = parse_points(lm_path, "landmarks", raw, CRANIAL_NAMES, 3)
+        landmarks = points_from_object(lm_path, "landmarks", raw, "cranial")
     else:
-        from .formats import read_landmarks
-
         landmarks = read_landmarks(lm_path, "cranial")
     extent = np.ptp(vertices, axis=0).max()
     for name, p in landmarks.items():
@@ -144,7 +108,8 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
     axes_path = Path(axes_path) if axes_path else None
     if axes_path is not None and axes_path.is_file():
         raw = _field(axes_path, read_json(axes_path), "axes")
-        for name, a in parse_points(axes_path, "axes", raw, CRANIAL_NAMES, 3).items():
+        axes_raw = points_from_object(axes_path, "axes", raw, "cranial", allow_empty=True)
+        for name, a in axes_raw.items():
             norm = np.linalg.norm(a)
             if norm == 0:
                 raise ValueError(f"{axes_path}: axes.{name} is the zero vector; give a direction")
@@ -158,12 +123,7 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
 
 def _interval(path, priors, key):
     value = priors.get(key)
-    if value is None:
-        return None
-    lo_hi = np.asarray(value, dtype=float) if np.ndim(value) == 1 else np.empty(0)
-    if lo_hi.shape != (2,) or not np.all(np.isfinite(lo_hi)) or not 0 < lo_hi[0] <= lo_hi[1]:
-        raise ValueError(f"{path}: priors.{key} must be [lo, hi] with 0 < lo <= hi, got {value!r}")
-    return float(lo_hi[0]), float(lo_hi[1])
+    return None if value is None else check_interval(value, f"{path}: priors.{key}")
 
 
 def parse_priors(path, priors):
@@ -248,14 +208,11 @@ def read_photo(folder, load_image=True):
         raise ValueError(f"{meta_path}: view must be one of {', '.join(VIEWS)}, got {view!r}")
     lm_path = meta_path
     if isinstance(meta, dict) and "landmarks" not in meta:
-        from .formats import find_landmark_file, read_landmarks
-
         # Facial landmarks in a file of their own (facial_landmarks.csv, landmarks.json, ...).
         lm_path = find_landmark_file(folder, ["facial_landmarks", "landmarks"]) or meta_path
     if lm_path == meta_path:
-        landmarks = parse_points(
-            meta_path, "landmarks", _field(meta_path, meta, "landmarks"), FACIAL_NAMES, 2
-        )
+        raw = _field(meta_path, meta, "landmarks")
+        landmarks = points_from_object(meta_path, "landmarks", raw, "facial")
     else:
         landmarks = read_landmarks(lm_path, "facial")
     check_in_image(lm_path, landmarks, size_wh, image_path.name)
@@ -319,8 +276,6 @@ def photo_from_files(
     photo_id : str, optional
         Defaults to the image's stem.
     """
-    from .formats import read_landmarks
-
     image_path = Path(image_path)
     if not image_path.is_file():
         raise ValueError(f"{image_path}: file not found; check the photo's path")

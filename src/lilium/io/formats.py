@@ -28,7 +28,6 @@ also the frame Slicer writes meshes in) unless told otherwise; see :func:`read_l
 
 import csv
 import difflib
-import json
 import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -36,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..softtissue.landmarks import CRANIAL_NAMES, FACIAL_NAMES, base_name, side
+from .jsonio import parse_json
 
 KINDS = ("cranial", "facial")
 
@@ -206,7 +206,12 @@ def canonical_name(name, kind):
     return None
 
 
-def name_error(path, field, name, kind):
+def _at(path, where):
+    """``"path: where"`` (or just the path when ``where`` is empty), to start a message."""
+    return f"{path}: {where}" if where else f"{path}"
+
+
+def name_error(path, where, name, kind):
     """The ``ValueError`` for a name :func:`canonical_name` does not recognise."""
     names, _ = _known(kind)
     other = "facial" if kind == "cranial" else "cranial"
@@ -216,14 +221,14 @@ def name_error(path, field, name, kind):
     if key in table:
         base = table[key]
         return ValueError(
-            f"{path}: {field}: landmark {name!r} ({base}) needs a side; write {base}_l or "
+            f"{_at(path, where)}: landmark {name!r} ({base}) needs a side; write {base}_l or "
             f"{base}_r (the subject's left or right)"
         )
     elsewhere = canonical_name(name, other)
     if elsewhere is not None:
         return ValueError(
-            f"{path}: {field}: {name!r} is a {other} landmark ({elsewhere}) but this file holds "
-            f"{kind} landmarks; use the {kind} name (see SPEC section 2) or the other file"
+            f"{_at(path, where)}: {name!r} is a {other} landmark ({elsewhere}) but this file "
+            f"holds {kind} landmarks; use the {kind} name (see SPEC section 2) or the other file"
         )
     choices = list(names) + list(table)
     close = difflib.get_close_matches(key, choices, n=1, cutoff=0.6)
@@ -232,27 +237,47 @@ def name_error(path, field, name, kind):
         hint = f"did you mean {guess!r}?"
     else:
         hint = f"use a {kind} name of SPEC section 2 (e.g. {names[0]!r})"
-    return ValueError(f"{path}: {field}: unknown {kind} landmark {name!r}; {hint}")
+    return ValueError(f"{_at(path, where)}: unknown {kind} landmark {name!r}; {hint}")
 
 
-def canonical_points(path, entries, kind, dim):
-    """Validate and rename ``(name, coords, where)`` entries read from a file.
+def canonical_points(path, entries, kind, dim=None, allow_empty=False, finite=True):
+    """Validate and rename ``(name, coords, where)`` entries read from a landmark file.
+
+    The one check every landmark reader goes through (SPEC JSON files, 3D Slicer, MeshLab,
+    CSV): names through the alias tables, ``dim`` numbers each, finite, each canonical landmark
+    once.
 
     Parameters
     ----------
     path : str or Path
         The file, for messages.
     entries : iterable of (str, sequence, str)
-        Name as written, coordinates, and where in the file it was (e.g. ``"line 3"``).
+        Name as written, coordinates, and where in the file it was (e.g. ``"line 3"``,
+        ``"landmarks"``; ``""`` for nowhere in particular).
     kind : {"cranial", "facial"}
-    dim : int
-        3 (mm) or 2 (pixels).
+    dim : int, optional
+        Numbers per point; default 3 (mm) for cranial and 2 (pixels) for facial landmarks.
+    allow_empty : bool
+        Accept a file without any entry (e.g. ``soft_tissue_axes.json`` with none given).
+    finite : bool
+        Reject NaN and infinite coordinates (``null`` in JSON reads as NaN). False only for
+        ground truth, where a landmark behind the camera has no image point.
 
     Returns
     -------
     dict of str -> ndarray of shape (dim,)
-        Keyed by canonical name.
+        Keyed by canonical name, in the file's order.
+
+    Raises
+    ------
+    ValueError
+        Naming the file and place: unknown or side-less name (with the closest known one),
+        wrong number of coordinates, NaN or infinite ones, two entries for one landmark
+        (e.g. ``n`` and ``nasion``), no entry at all.
     """
+    _known(kind)
+    if dim is None:
+        dim = 3 if kind == "cranial" else 2
     out, origin = {}, {}
     for name, coords, where in entries:
         canonical = canonical_name(name, kind)
@@ -264,22 +289,40 @@ def canonical_points(path, entries, kind, dim):
             point = np.empty(0)
         if point.shape != (dim,):
             raise ValueError(
-                f"{path}: {where}: {name!r} must have {dim} numeric coordinates, got {coords!r}"
+                f"{_at(path, where)}: {name!r} must have {dim} numeric coordinates, got {coords!r}"
             )
-        if not np.all(np.isfinite(point)):
+        if finite and not np.all(np.isfinite(point)):
             raise ValueError(
-                f"{path}: {where}: {name!r} has NaN or infinite coordinates; give its "
+                f"{_at(path, where)}: {name!r} has NaN or infinite coordinates; give its "
                 "coordinates or remove it"
             )
         if canonical in out:
             raise ValueError(
-                f"{path}: {where}: {name!r} and {origin[canonical]!r} are both {canonical}; "
+                f"{_at(path, where)}: {name!r} and {origin[canonical]!r} are both {canonical}; "
                 "keep one of them"
             )
         out[canonical], origin[canonical] = point, name
-    if not out:
+    if not out and not allow_empty:
         raise ValueError(f"{path}: no landmarks found; place landmarks and save the file again")
     return out
+
+
+def points_from_object(path, field, raw, kind, dim=None, allow_empty=False, finite=True):
+    """Validate a JSON object ``{name: coords}`` (the ``field`` of a SPEC section 8 file).
+
+    The ``"landmarks"`` of ``cranial_landmarks.json``, ``facial_landmarks.json`` and
+    ``photo.json``, the ``"axes"`` of ``soft_tissue_axes.json``: the same checks and aliases as
+    every other landmark file (:func:`canonical_points`).
+
+    Returns
+    -------
+    dict of str -> ndarray of shape (dim,)
+    """
+    if not isinstance(raw, dict):
+        n = dim or (3 if kind == "cranial" else 2)
+        raise ValueError(f"{_at(path, field)} must be an object {{name: [{n} numbers]}}")
+    entries = [(name, value, field) for name, value in raw.items()]
+    return canonical_points(path, entries, kind, dim, allow_empty=allow_empty, finite=finite)
 
 
 def landmark_format(path):
@@ -330,13 +373,13 @@ def read_landmarks(path, kind, coordinate_system="LPS"):
     except (OSError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: cannot read the file ({exc}); save it as UTF-8 text") from exc
     if fmt == "json":
-        data = _load_json(path, text)
+        data = parse_json(text, path)
         if isinstance(data, dict) and "markups" in data:
             entries, system = _slicer_json_entries(path, data)
         else:
             entries, system = _json_entries(path, data), None
     elif fmt == "mrk.json":
-        entries, system = _slicer_json_entries(path, _load_json(path, text))
+        entries, system = _slicer_json_entries(path, parse_json(text, path))
     elif fmt == "fcsv":
         entries, system = _fcsv_entries(path, text)
     elif fmt == "pp":
@@ -349,23 +392,16 @@ def read_landmarks(path, kind, coordinate_system="LPS"):
     return points
 
 
-def _load_json(path, text):
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{path}: not valid JSON ({exc}); fix the file's syntax") from exc
-
-
 def _json_entries(path, data):
     if isinstance(data, dict) and "landmarks" in data:
-        data, prefix = data["landmarks"], "landmarks."
+        data, where = data["landmarks"], "landmarks"
     else:
-        prefix = ""
+        where = ""
     if not isinstance(data, dict):
         raise ValueError(
             f'{path}: expected {{"landmarks": {{name: [coords]}}}} or {{name: [coords]}}'
         )
-    return [(name, value, f"{prefix}{name}") for name, value in data.items()]
+    return [(name, value, where) for name, value in data.items()]
 
 
 def _slicer_system(value):

@@ -32,12 +32,47 @@ def write_json(path, data, indent=2):
     os.replace(tmp, path)
 
 
+class _DuplicateKey(ValueError):
+    """A key that occurs twice in one JSON object (raised inside the decoder)."""
+
+
+def _unique_keys(pairs):
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise _DuplicateKey(key)
+        out[key] = value
+    return out
+
+
+def parse_json(text, source):
+    """Parse JSON text; malformed JSON or a key given twice in one object is a ``ValueError``
+    naming ``source`` (a file path, for messages).
+
+    Python's ``json`` lets the last of two equal keys win silently; here it is an error, as a
+    landmark or prior written twice is a mistake the user must resolve.
+    """
+    try:
+        return json.loads(text, object_pairs_hook=_unique_keys)
+    except _DuplicateKey as exc:
+        raise ValueError(
+            f"{source}: the key {exc.args[0]!r} appears twice in one JSON object; keep one of them"
+        ) from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{source}: not valid JSON ({exc}); fix the file's syntax") from exc
+
+
 def read_json(path):
-    """Read a JSON file; a missing or malformed file is a ``ValueError`` naming it."""
+    """Read a JSON file (UTF-8, a byte-order mark allowed).
+
+    A missing, undecodable or malformed file, or a key repeated in one object, is a
+    ``ValueError`` naming the file.
+    """
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"{path}: file not found")
     try:
-        return json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{path}: not valid JSON ({exc}); fix the file's syntax") from exc
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read the file ({exc}); save it as UTF-8 text") from exc
+    return parse_json(text, path)

@@ -1,10 +1,10 @@
-"""Writing SFO outputs: ``result.json`` (SPEC section 8) and PNG pictures."""
+"""SFO outputs: ``result.json`` (SPEC section 8) and PNG pictures."""
 
 from pathlib import Path
 
 import numpy as np
 
-from .jsonio import write_json
+from .jsonio import read_json, write_json
 
 
 def write_png(path, rgb):
@@ -30,3 +30,21 @@ def write_result(out_dir, result, overlay_rgb=None):
     if overlay_rgb is not None:
         write_png(out_dir / "overlay.png", overlay_rgb)
     return path
+
+
+def read_result_camera(path):
+    """The estimated camera of a ``result.json``; None for a failed SFO (``"camera": null``).
+
+    Raises
+    ------
+    ValueError
+        A missing or malformed file, or a malformed camera, naming the file.
+    """
+    from ..geometry.camera import Camera
+
+    data = read_json(path)
+    if not isinstance(data, dict) or "camera" not in data:
+        raise ValueError(f"{path}: missing field 'camera'")
+    if data["camera"] is None:
+        return None
+    return Camera.from_dict(data["camera"], name=f"{path}: camera")

@@ -12,9 +12,10 @@ import cv2
 import numpy as np
 
 from ..evaluation.metrics import implausible_sfo
-from ..geometry.camera import Camera, principal_point_of
 from ..imaging.raster import mesh_mask
+from ..io.case import read_photo
 from ..io.jsonio import read_json
+from ..io.truth import read_ground_truth
 from . import render as _render
 
 BONE_RGB = np.array([245.0, 245.0, 235.0])
@@ -23,25 +24,24 @@ _VIEW_ORDER = ("frontal", "lateral_left", "lateral_right")
 
 
 def _load_mesh(subject_dir):
-    import trimesh
+    from ..io.mesh import MESH_SUFFIXES, read_mesh
 
-    for name in ("skull.ply", "skull.obj", "skull.stl"):
-        path = Path(subject_dir) / name
+    for suffix in MESH_SUFFIXES:
+        path = Path(subject_dir) / f"skull{suffix}"
         if path.is_file():
-            mesh = trimesh.load(path, process=False, force="mesh")
-            return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64)
+            return read_mesh(path)
     raise ValueError(f"{subject_dir}: no skull.ply/.obj/.stl")
 
 
-def _read_rgb(path):
-    image = cv2.imread(str(path), cv2.IMREAD_COLOR)
-    if image is None:
-        raise ValueError(f"{path}: not a readable image")
-    return image[..., ::-1].copy()
-
-
 def overlay_tile(
-    image, face_mask, skull_vertices_mm, skull_faces, record, face_curve=None, tile_px=400
+    image,
+    face_mask,
+    skull_vertices_mm,
+    skull_faces,
+    truth,
+    landmarks_uv=None,
+    face_curve=None,
+    tile_px=400,
 ):
     """One contact-sheet tile.
 
@@ -51,9 +51,12 @@ def overlay_tile(
     face_mask : ndarray of shape (H, W)
     skull_vertices_mm : ndarray of shape (V, 3)
     skull_faces : ndarray of shape (F, 3)
-    record : dict
-        ``photo.json`` content (uses ``ground_truth`` and ``landmarks``).
-    face_curve : dict, optional
+    truth : GroundTruth
+        Of the photo (:func:`lilium.io.truth.read_ground_truth`): the camera and the noise-free
+        landmarks.
+    landmarks_uv : dict of str -> ndarray of shape (2,), optional
+        The landmarks given to the methods (the visible ones; ringed).
+    face_curve : dict of str -> ndarray of shape (K, 2), optional
     tile_px : int
 
     Returns
@@ -62,13 +65,11 @@ def overlay_tile(
     implausible : lilium.evaluation.metrics.ImplausibleSFO
         For the ground-truth camera.
     """
-    gt = record["ground_truth"]
     height, width = image.shape[:2]
-    camera = Camera(gt["skull2cam"], gt["focal_px"], principal_point_of((width, height)))
-    skull = _render.render_mesh(skull_vertices_mm, skull_faces, camera, (width, height))
+    skull = _render.render_mesh(skull_vertices_mm, skull_faces, truth.camera, (width, height))
     bone = _render.shade(skull, albedo_rgb=BONE_RGB, smooth_px=1.0)
     # The silhouette (and its outside count) from the one mesh raster; the depth buffer shades.
-    skull_mask = mesh_mask(skull_vertices_mm, skull_faces, camera, (width, height))
+    skull_mask = mesh_mask(skull_vertices_mm, skull_faces, truth.camera, (width, height))
     out = image.astype(np.float32)
     out[skull_mask] = (1 - SKULL_ALPHA) * out[skull_mask] + SKULL_ALPHA * bone[skull_mask]
     face = np.asarray(face_mask) != 0
@@ -104,9 +105,9 @@ def overlay_tile(
         pts = np.array([to_tile(p) for p in pts], dtype=np.int32)
         if len(pts):
             cv2.polylines(tile, [pts], False, (0, 255, 255), 2)
-    visible = record.get("landmarks", {})
-    for name, uv in gt["landmarks_noise_free"].items():
-        if uv is None:
+    visible = landmarks_uv or {}
+    for name, uv in truth.landmarks_noise_free.items():
+        if not np.all(np.isfinite(uv)):
             continue
         colour = (40, 230, 40) if name in visible else (230, 30, 30)
         cv2.circle(tile, to_tile(uv), 3, colour, -1)
@@ -141,16 +142,23 @@ def contact_sheet(dataset_dir, path, n_subjects=4, experiment="A", tile_px=400):
                 tiles.append(np.full((tile_px, tile_px, 3), 30, dtype=np.uint8))
                 continue
             folder = dataset_dir / entry["paths"][experiment]
-            record = read_json(folder / "photo.json")
-            curve_path = folder / "face_curve.json"
-            curve = read_json(curve_path) if curve_path.is_file() else None
-            mask = cv2.imread(str(folder / "face_mask.png"), cv2.IMREAD_GRAYSCALE)
+            photo = read_photo(folder)
+            truth = read_ground_truth(folder)
+            curve = None
+            if photo.face_curve_uv is not None:
+                curve = {"chin_jaw" if view == "frontal" else "forehead": photo.face_curve_uv}
             tile, stats = overlay_tile(
-                _read_rgb(folder / "image.png"), mask, vertices, faces, record, curve, tile_px
+                photo.image,
+                photo.face_mask,
+                vertices,
+                faces,
+                truth,
+                photo.landmarks_uv,
+                curve,
+                tile_px,
             )
-            gt = record["ground_truth"]
-            w, h = gt["image_size"]
-            label = f"{entry['id']} {w}x{h} f{gt['focal_px']:.0f} d{gt['scd_mm']:.0f}"
+            w, h = truth.image_size_wh
+            label = f"{entry['id']} {w}x{h} f{truth.camera.focal_px:.0f} d{truth.scd_mm:.0f}"
             label2 = f"{view} out {stats.percent_outside:.2f}%"
             for k, text in enumerate((label, label2)):
                 cv2.putText(
