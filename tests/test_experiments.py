@@ -129,7 +129,7 @@ def test_toml_overrides_and_errors(tmp_path):
         config_from_dict({"repetition": 2})
     with pytest.raises(ValueError, match="unknown experiment"):
         config_from_dict({"experiments": ["D"]})
-    with pytest.raises(ValueError, match="repetitions must be an integer >= 1"):
+    with pytest.raises(ValueError, match=r"repetitions must be an integer in \[1, 1000\], got 0"):
         config_from_dict({"repetitions": 0})
     with pytest.raises(ValueError, match="config file not found"):
         load_config(tmp_path / "missing.toml")

@@ -29,11 +29,11 @@ def register(subparsers):
 
 
 def run(args):
-    from ..experiments.config import load_config
+    from ..experiments.config import check_int, load_config
     from ..experiments.runner import run_experiment
 
-    if args.workers is not None and args.workers < 0:
-        raise ValueError("--workers must be >= 0 (0 = all cores)")
+    if args.workers is not None:
+        check_int("--workers (0 = all cores)", args.workers, "workers")
     cfg = load_config(args.config)
     summary = run_experiment(
         cfg,

@@ -30,10 +30,15 @@ file's folder (to the current folder for a preset). Example::
 
 ``methods`` entries are ``"posest-sfo"``, ``"lilium:<variant>"`` (variant among ``base``,
 ``pll``, ``skof``, ``skof+pll``) or ``"lilium"`` for all four variants.
+
+Every key is checked, with a message naming it: integers in the ranges of
+:data:`LIMITS` (seeds such that ``seed + run`` fits :data:`MAX_SEED`), ``max_seconds`` a finite
+number >= 0, paths non-empty strings, ``name`` a one-line string, unknown keys refused.
 """
 
 import hashlib
 import json
+import math
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -49,6 +54,26 @@ LILIUM_VARIANTS = METHODS["lilium"].variants
 
 #: Every method of the paper's protocol, as (method, variant) pairs.
 ALL_METHODS = (("posest-sfo", ""),) + tuple(("lilium", v) for v in LILIUM_VARIANTS)
+
+#: Largest seed (``seed + run`` included): 2^32 - 1, the range every seeded library takes and
+#: far inside SQLite's 64-bit INTEGER column.
+MAX_SEED = 2**32 - 1
+
+#: Ranges ``(lo, hi)`` of the integer keys. The upper bounds keep a typing slip from asking for
+#: runaway resources (a task list of billions, thousands of processes, a DE population that
+#: does not fit in memory); the paper's protocol lies far inside them.
+LIMITS = {
+    "repetitions": (1, 1000),
+    "axes_sets": (1, 1000),
+    "runs_per_axes_set": (1, 1000),
+    "workers": (0, 256),
+    "seed": (0, MAX_SEED),
+    "dataset.subjects": (1, 1000),
+    "dataset.photos": (1, 1000),
+    "dataset.seed": (0, MAX_SEED),
+    "de.population": (4, 10000),
+    "de.generations": (1, 10**7),
+}
 
 
 @dataclass(frozen=True)
@@ -206,9 +231,11 @@ def method_label(method, variant):
     return "Lilium+" + "+".join(f"P_{part}" for part in variant.split("+"))
 
 
-def _int(where, value, lo=0):
-    if isinstance(value, bool) or not isinstance(value, int) or value < lo:
-        raise ValueError(f"{where} must be an integer >= {lo}, got {value!r}")
+def check_int(where, value, key):
+    """``value`` as an integer in ``LIMITS[key]``, or a ``ValueError`` naming ``where``."""
+    lo, hi = LIMITS[key]
+    if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+        raise ValueError(f"{where} must be an integer in [{lo}, {hi}], got {value!r}")
     return value
 
 
@@ -233,20 +260,23 @@ def config_from_dict(data, base_dir=Path("."), where="config"):
     """
     _check_keys(where, data, _TOP_KEYS)
     preset = data.get("preset")
-    if preset is not None and preset not in PRESETS:
+    if preset is not None and (not isinstance(preset, str) or preset not in PRESETS):
         raise ValueError(f"{where}: unknown preset {preset!r}; use one of {', '.join(PRESETS)}")
     cfg = PRESETS[preset] if preset else ExperimentConfig()
     base_dir = Path(base_dir)
 
     def path(value, key):
-        if not isinstance(value, str) or not value:
-            raise ValueError(f"{where}: {key} must be a path string")
+        if not isinstance(value, str) or not value.strip() or "\0" in value:
+            raise ValueError(f"{where}: {key} must be a non-empty path string, got {value!r}")
         p = Path(value).expanduser()
         return p if p.is_absolute() else base_dir / p
 
     changes = {}
     if "name" in data:
-        changes["name"] = str(data["name"])
+        name = data["name"]
+        if not isinstance(name, str) or not name.strip() or not name.isprintable():
+            raise ValueError(f"{where}: name must be a non-empty one-line string, got {name!r}")
+        changes["name"] = name
     if "experiments" in data:
         exps = data["experiments"]
         if isinstance(exps, str) or not isinstance(exps, list) or not exps:
@@ -257,13 +287,9 @@ def config_from_dict(data, base_dir=Path("."), where="config"):
         changes["experiments"] = tuple(e for e in EXPERIMENTS if e in exps)
     if "methods" in data:
         changes["methods"] = parse_methods(data["methods"], f"{where}: methods")
-    for key in ("repetitions", "axes_sets", "runs_per_axes_set"):
+    for key in ("repetitions", "axes_sets", "runs_per_axes_set", "seed", "workers"):
         if key in data:
-            changes[key] = _int(f"{where}: {key}", data[key], lo=1)
-    if "seed" in data:
-        changes["seed"] = _int(f"{where}: seed", data["seed"])
-    if "workers" in data:
-        changes["workers"] = _int(f"{where}: workers", data["workers"])
+            changes[key] = check_int(f"{where}: {key}", data[key], key)
     changes["db"] = path(data["db"], "db") if "db" in data else base_dir / cfg.db
 
     ds = data.get("dataset", {})
@@ -275,27 +301,35 @@ def config_from_dict(data, base_dir=Path("."), where="config"):
         if not isinstance(ds["generate"], bool):
             raise ValueError(f"{where}: dataset.generate must be true or false")
         ds_changes["generate"] = ds["generate"]
-    for key in ("subjects", "photos"):
+    for key in ("subjects", "photos", "seed"):
         if key in ds:
-            ds_changes[key] = _int(f"{where}: dataset.{key}", ds[key], lo=1)
-    if "seed" in ds:
-        ds_changes["seed"] = _int(f"{where}: dataset.seed", ds["seed"])
+            ds_changes[key] = check_int(f"{where}: dataset.{key}", ds[key], f"dataset.{key}")
     changes["dataset"] = replace(cfg.dataset, **ds_changes)
 
     de = data.get("de", {})
     _check_keys(f"{where}: [de]", de, _DE_KEYS)
     de_changes = {}
-    if "population" in de:
-        de_changes["population_size"] = _int(f"{where}: de.population", de["population"], lo=4)
-    if "generations" in de:
-        de_changes["max_generations"] = _int(f"{where}: de.generations", de["generations"], lo=1)
+    for key, name in DE_KEYS.items():
+        if key in de and key != "max_seconds":
+            de_changes[name] = check_int(f"{where}: de.{key}", de[key], f"de.{key}")
     if "max_seconds" in de:
         value = de["max_seconds"]
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or value < 0:
-            raise ValueError(f"{where}: de.max_seconds must be a number >= 0 (0 = no limit)")
+        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not ok or not math.isfinite(value) or value < 0:
+            raise ValueError(
+                f"{where}: de.max_seconds must be a finite number >= 0 (0 = no limit), "
+                f"got {value!r}"
+            )
         de_changes["max_seconds"] = float(value) or None
     changes["de"] = replace(cfg.de, **de_changes)
-    return replace(cfg, **changes)
+    out = replace(cfg, **changes)
+    runs = max(out.repetitions, out.runs_per_axes_set)
+    if out.seed + runs - 1 > MAX_SEED:
+        raise ValueError(
+            f"{where}: seed = {out.seed} with {runs} runs gives seeds up to {out.seed + runs - 1}, "
+            f"above {MAX_SEED}; lower seed"
+        )
+    return out
 
 
 def load_config(source):
@@ -319,7 +353,9 @@ def load_config(source):
             f"{path}: config file not found; give a TOML file or a preset ({', '.join(PRESETS)})"
         )
     try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: not valid TOML ({exc})") from None
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read the config ({exc.strerror})") from None
     return config_from_dict(data, path.parent, where=str(path))

@@ -26,13 +26,14 @@ Definitions (decisions the paper leaves open are marked *):
 
 import csv
 import math
+import sqlite3
 from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
 
 from .config import ALL_METHODS, EXPERIMENTS, method_label
-from .store import ResultStore
+from .store import ResultStore, database_error
 
 #: Views of the tables: frontal photos and lateral ones (left and right together).
 VIEW_GROUPS = ("frontal", "lateral")
@@ -55,12 +56,21 @@ def _mean_sd(values):
 
 
 def load_rows(db):
-    """Rows of the database (every column but the stored result JSON)."""
+    """Rows of the database (every column but the stored result JSON).
+
+    The database is opened read-only (nothing is written to it, not even a WAL switch); a file
+    that is not a Lilium results database, or a corrupt one, is a ``ValueError``.
+    """
     db = Path(db)
     if not db.is_file():
         raise ValueError(f"{db}: database not found; run lilium experiment first")
-    with ResultStore(db) as store:
-        rows = store.rows()
+    try:
+        with ResultStore(db, read_only=True) as store:
+            rows = store.rows()
+    except sqlite3.DatabaseError as exc:
+        raise database_error(
+            db, exc, "give the database written by lilium experiment (or restore it from a copy)"
+        ) from None
     if not rows:
         raise ValueError(f"{db}: the database holds no SFO yet")
     return rows
@@ -521,7 +531,17 @@ def write_report(db, out_dir):
     """
     rows = load_rows(db)
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise ValueError(f"--out {out_dir}: is a file, not a folder; give a folder for the report")
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        probe = out_dir / ".lilium-write-test"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise ValueError(
+            f"--out {out_dir}: cannot write there ({exc.strerror}); give a writable folder"
+        ) from None
     ranks = photo_ranks(rows)
     summary = summary_table(rows, ranks)
     tests = wilcoxon_table(rows, ranks)

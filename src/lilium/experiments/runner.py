@@ -13,15 +13,22 @@ projected-skull pixels outside the face mask (implausible SFOs). The parent writ
 the :class:`~lilium.experiments.store.ResultStore` as it arrives, so a killed run loses only the
 SFOs in flight; a rerun skips the stored keys.
 
+Before the first SFO the run checks the dataset (:mod:`lilium.experiments.dataset`: the
+index, every file the tasks read, the fingerprint the database keeps) and takes the database's
+lock (:class:`~lilium.experiments.store.RunLock`): a second run on the same database refuses at
+once.
+
 Executors: a local process pool (default, all cores) or a Dask distributed cluster
 (``scheduler="tcp://host:8786"``); the dataset folder must then be readable by every worker at
-the same path (a shared file system).
+the same path (a shared file system). Local workers end when the parent process dies, however
+it dies (:func:`lilium.experiments.processes.exit_with_parent`).
 """
 
 import functools
 import json
 import os
 import socket
+import sqlite3
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -29,7 +36,9 @@ from pathlib import Path
 import numpy as np
 
 from ..optimisation.de import DEOptions
-from .store import KEY_COLUMNS, ResultStore
+from .dataset import check_index, check_task_files, dataset_fingerprint
+from .processes import exit_with_parent
+from .store import KEY_COLUMNS, ResultStore, RunLock, database_error
 
 #: Tasks in flight per worker (keeps workers busy without queueing the whole run).
 IN_FLIGHT_PER_WORKER = 3
@@ -119,7 +128,9 @@ def load_dataset(cfg, workers=1, log=print):
             experiments=("A", "B", "C"),
             workers=max(1, min(workers, cfg.dataset.subjects)),
         )
-    return root, read_json(index_path)
+    index = read_json(index_path)
+    check_index(index, index_path)
+    return root, index
 
 
 def enumerate_tasks(cfg, root, index):
@@ -138,6 +149,7 @@ def enumerate_tasks(cfg, root, index):
     list of Task
     """
     root = Path(root)
+    check_index(index, root / "dataset.json")
     subjects = index["subjects"]
     tasks = []
     for exp in cfg.experiments:
@@ -193,6 +205,10 @@ def enumerate_tasks(cfg, root, index):
 def _skull(subject_dir, axes_file):
     from ..io.case import read_skull
 
+    if axes_file is not None and not os.path.isfile(axes_file):
+        # Checked before the run too; a file gone since is an error row, never a success with
+        # the skull's default axes.
+        raise ValueError(f"{axes_file}: perturbed soft-tissue axes not found")
     return read_skull(subject_dir, axes_path=axes_file)
 
 
@@ -315,10 +331,13 @@ def run_task(task):
     return row
 
 
-def _init_worker():
+def _init_worker(parent_pid=None):
+    """Worker set-up: one OpenCV thread; with ``parent_pid``, exit when the parent dies."""
     import cv2
 
     cv2.setNumThreads(1)
+    if parent_pid is not None:
+        exit_with_parent(parent_pid)
 
 
 # -- executors ----------------------------------------------------------------------------------
@@ -344,6 +363,7 @@ def _local_results(tasks, workers):
             max_workers=workers,
             mp_context=multiprocessing.get_context("spawn"),
             initializer=_init_worker,
+            initargs=(os.getpid(),),
         )
     finally:
         for v, value in saved.items():
@@ -459,6 +479,11 @@ class RunSummary:
 def run_experiment(cfg, scheduler=None, workers=None, db=None, progress=True, log=print):
     """Run (or resume) the protocol of ``cfg``.
 
+    Before the first SFO: takes the database's lock (a second run on it is refused), reads and
+    checks the dataset (generating it if allowed), checks every file the tasks read, and checks
+    the database's fingerprints of the settings and of the dataset (a resume against other
+    settings or another dataset is refused).
+
     Parameters
     ----------
     cfg : ExperimentConfig
@@ -476,51 +501,88 @@ def run_experiment(cfg, scheduler=None, workers=None, db=None, progress=True, lo
     Returns
     -------
     RunSummary
+
+    Raises
+    ------
+    ValueError
+        Any of the checks above, or a corrupt or foreign database, with the file and the fix.
     """
     start = time.perf_counter()
     workers = workers if workers is not None else cfg.workers
     workers = workers or os.cpu_count() or 1
-    root, index = load_dataset(cfg, workers=workers, log=log)
-    tasks = enumerate_tasks(cfg, root, index)
     db = Path(db or cfg.db)
-    with ResultStore(db) as store:
-        store.check_fingerprint(cfg.fingerprint(), what="DE settings or seeds")
-        store.set_meta("config", {"name": cfg.name, "dataset": str(root), "de": vars(cfg.de)})
-        done = store.done_keys()
-        todo = [t for t in tasks if t.key not in done]
-        already = len(tasks) - len(todo)
-        where = f"Dask at {scheduler}" if scheduler is not None else f"{workers} local worker(s)"
-        log(
-            f"{cfg.name}: {len(tasks)} SFOs, {already} already in {db}, {len(todo)} to run "
-            f"on {where}"
-        )
-        results = (
-            _dask_results(todo, scheduler)
-            if scheduler is not None
-            else _local_results(todo, workers)
-        )
-        bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=len(tasks), initial=already, unit="SFO", smoothing=0.05, desc=cfg.name)
-        stored, errors = 0, []
+    if db.is_dir():
+        raise ValueError(f"{db}: is a folder; give the results database file (--db)")
+    try:
+        db.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(
+            f"{db}: cannot create its folder ({exc.strerror}); give another --db"
+        ) from None
+    with RunLock(db):
+        root, index = load_dataset(cfg, workers=workers, log=log)
+        tasks = enumerate_tasks(cfg, root, index)
+        check_task_files(tasks)
+        fingerprint = dataset_fingerprint(root, index, tasks)
         try:
-            for task, outcome in results:
-                if isinstance(outcome, BaseException):
-                    errors.append((task.key, f"{type(outcome).__name__}: {outcome}"))
-                    if len(errors) <= 5:
-                        log(f"SFO {task.key} raised {type(outcome).__name__}: {outcome}")
-                else:
-                    stored += store.insert(outcome)
-                if bar is not None:
-                    bar.update(1)
-        finally:
+            with ResultStore(db) as store:
+                return _run(
+                    cfg, store, tasks, root, fingerprint, scheduler, workers, progress, log, start
+                )
+        except sqlite3.DatabaseError as exc:
+            raise database_error(db, exc) from None
+
+
+def _run(cfg, store, tasks, root, fingerprint, scheduler, workers, progress, log, start):
+    """The run itself, once every check has passed (see :func:`run_experiment`)."""
+    db = store.path
+    store.check_fingerprint(cfg.fingerprint(), what="other DE settings or seeds")
+    previous = store.get_meta("config")
+    made_from = previous.get("dataset", "?") if isinstance(previous, dict) else "?"
+    if store.get_meta("dataset_fingerprint") is None and store.count():
+        log(f"{db}: made before dataset fingerprints; recording the fingerprint of {root}")
+    store.check_fingerprint(
+        fingerprint,
+        what="another dataset",
+        key="dataset_fingerprint",
+        fix=(
+            f"{root} is not the dataset the database was made from ({made_from}; other seed, "
+            "ids or files): give a new --db for this dataset, or point dataset.path to the "
+            "database's dataset"
+        ),
+    )
+    store.set_meta("config", {"name": cfg.name, "dataset": str(root), "de": vars(cfg.de)})
+    done = store.done_keys()
+    todo = [t for t in tasks if t.key not in done]
+    already = len(tasks) - len(todo)
+    workers = max(1, min(workers, len(todo)))
+    where = f"Dask at {scheduler}" if scheduler is not None else f"{workers} local worker(s)"
+    log(f"{cfg.name}: {len(tasks)} SFOs, {already} already in {db}, {len(todo)} to run on {where}")
+    results = (
+        _dask_results(todo, scheduler) if scheduler is not None else _local_results(todo, workers)
+    )
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(tasks), initial=already, unit="SFO", smoothing=0.05, desc=cfg.name)
+    stored, errors = 0, []
+    try:
+        for task, outcome in results:
+            if isinstance(outcome, BaseException):
+                errors.append((task.key, f"{type(outcome).__name__}: {outcome}"))
+                if len(errors) <= 5:
+                    log(f"SFO {task.key} raised {type(outcome).__name__}: {outcome}")
+            else:
+                stored += store.insert(outcome)
             if bar is not None:
-                bar.close()
-            close = getattr(results, "close", None)
-            if close is not None:
-                close()
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+        close = getattr(results, "close", None)
+        if close is not None:
+            close()
     summary = RunSummary(len(tasks), already, stored, errors, time.perf_counter() - start, db)
     log(
         f"{cfg.name}: stored {stored} SFOs in {summary.seconds:.1f} s; "

@@ -10,7 +10,9 @@ subject's own soft-tissue axes (Exps. A, B) and ``k`` for ``axes_C<k>.json`` (Ex
 """
 
 import json
+import os
 import sqlite3
+import time
 from pathlib import Path
 
 #: Columns of the unique key, in order.
@@ -70,24 +72,116 @@ CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 """
 
 
+#: ``meta`` row that marks a database as Lilium's (older databases are known by their table).
+FORMAT = "lilium-experiment-results"
+
+
+def database_error(path, exc, fix="give another --db (or restore the file from a copy)"):
+    """The ``ValueError`` for a ``sqlite3.DatabaseError`` on the results database ``path``."""
+    return ValueError(
+        f"{path}: cannot use this results database ({exc}): it is corrupt, truncated, not "
+        f"writable or not a Lilium results database; {fix}"
+    )
+
+
 class ResultStore:
     """The results database (open with ``ResultStore(path)``; a context manager).
 
     Parameters
     ----------
     path : str or Path
-        Created with its parent folders when missing.
+        Created with its parent folders when missing (unless ``read_only``).
+    read_only : bool
+        Open an existing database read-only (a ``file:...?mode=ro`` URI): nothing is created,
+        written or switched to WAL (``lilium report``).
+
+    Raises
+    ------
+    ValueError
+        The file is not a SQLite database, is corrupt, or is a SQLite database of something
+        else (its tables are left untouched).
     """
 
-    def __init__(self, path):
+    def __init__(self, path, read_only=False):
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.conn = sqlite3.connect(self.path, timeout=60.0)
+        self.read_only = read_only
+        self._fix = (
+            "give the database written by lilium experiment (or restore it from a copy)"
+            if read_only
+            else "give another --db (or restore the file from a copy)"
+        )
+        if self.path.is_dir():
+            raise ValueError(f"{self.path}: is a folder; give the results database file (--db)")
+        try:
+            if read_only:
+                if not self.path.is_file():
+                    raise ValueError(
+                        f"{self.path}: database not found; run lilium experiment first"
+                    )
+                uri = self.path.resolve().as_uri() + "?mode=ro"
+                if not self.path.with_name(self.path.name + "-wal").exists():
+                    # No writer at work (a closed WAL database has no -wal file): read it as
+                    # immutable, so that not even the -shm/-wal side files are created.
+                    uri += "&immutable=1"
+                self.conn = sqlite3.connect(uri, uri=True, timeout=60.0)
+            else:
+                try:
+                    self.path.parent.mkdir(parents=True, exist_ok=True)
+                except OSError as exc:
+                    raise ValueError(
+                        f"{self.path}: cannot create its folder ({exc.strerror}); give another --db"
+                    ) from None
+                self.conn = sqlite3.connect(self.path, timeout=60.0)
+        except sqlite3.DatabaseError as exc:
+            raise database_error(self.path, exc, self._fix) from None
+        try:
+            self._open()
+        except sqlite3.DatabaseError as exc:
+            self.conn.close()
+            raise database_error(self.path, exc, self._fix) from None
+        except ValueError:
+            self.conn.close()
+            raise
+
+    def _open(self):
+        tables = {
+            r[0] for r in self.conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")
+        }
+        if tables:
+            self._check_schema(tables)
+        elif self.read_only:
+            raise ValueError(
+                f"{self.path}: an empty database, not a Lilium results database; give the "
+                "database written by lilium experiment"
+            )
+        if self.read_only:
+            return
         self.conn.execute("PRAGMA journal_mode=WAL")
         # In WAL mode NORMAL survives a killed process (only a power cut may lose the last rows).
         self.conn.execute("PRAGMA synchronous=NORMAL")
         self.conn.executescript(_SCHEMA)
         self.conn.commit()
+        if self.get_meta("format") is None:
+            self.set_meta("format", FORMAT)
+
+    def _check_schema(self, tables):
+        """Refuse a SQLite file that is not a Lilium results database (touching nothing)."""
+        columns = set()
+        if "sfo" in tables:
+            columns = {r[1] for r in self.conn.execute("PRAGMA table_info(sfo)")}
+        if "sfo" not in tables or "meta" not in tables or not set(COLUMNS) <= columns:
+            lacking = ["table meta"] if "meta" not in tables else []
+            lacking += sorted(set(COLUMNS) - columns) if "sfo" in tables else ["table sfo"]
+            raise ValueError(
+                f"{self.path}: a SQLite database but not a Lilium results database (it lacks "
+                f"{', '.join(lacking[:3])}{', ...' if len(lacking) > 3 else ''}); it was left "
+                "untouched: "
+                + (
+                    "give the database written by lilium experiment"
+                    if self.read_only
+                    else "give a new file for the results (--db)"
+                )
+            )
 
     def __enter__(self):
         return self
@@ -109,16 +203,27 @@ class ResultStore:
                 "INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)", (key, json.dumps(value))
             )
 
-    def check_fingerprint(self, fingerprint, what="settings"):
-        """Record ``fingerprint`` in a new database, or check that it matches the stored one."""
-        stored = self.get_meta("fingerprint")
+    def check_fingerprint(self, fingerprint, what="other settings", key="fingerprint", fix=None):
+        """Record ``fingerprint`` in a new database, or check that it matches the stored one.
+
+        Parameters
+        ----------
+        fingerprint : str
+        what : str
+            What a mismatch means, for the message ("other DE settings or seeds").
+        key : str
+            ``meta`` key it is kept under.
+        fix : str, optional
+            How to fix a mismatch (default: resume with the same config or another --db).
+        """
+        stored = self.get_meta(key)
         if stored is None:
-            self.set_meta("fingerprint", fingerprint)
+            self.set_meta(key, fingerprint)
         elif stored != fingerprint:
+            fix = fix or "resume with the same config or give another database (--db)"
             raise ValueError(
-                f"{self.path}: this database holds results of other {what} (fingerprint "
-                f"{stored}, the config gives {fingerprint}); resume with the same config or "
-                "give another database (--db)"
+                f"{self.path}: this database holds results of {what} (fingerprint "
+                f"{stored}, now {fingerprint}); {fix}"
             )
 
     # -- rows -------------------------------------------------------------------------------
@@ -151,3 +256,80 @@ class ResultStore:
 def task_key(row):
     """The key tuple of a row or task dict."""
     return tuple(row[c] for c in KEY_COLUMNS)
+
+
+class RunLock:
+    """An exclusive lock on a results database: one ``lilium experiment`` at a time.
+
+    ``fcntl.flock`` on ``<db>.lock`` (next to the database), taken without waiting. The kernel
+    drops the lock when its process ends, however it ends, so a crashed or killed run leaves no
+    stale lock; the file, which names the owner's PID and start time, is removed on release.
+    Where ``fcntl`` does not exist (Windows) no lock is taken.
+
+    Parameters
+    ----------
+    db : str or Path
+        The results database (its folder must exist).
+
+    Raises
+    ------
+    ValueError
+        Another process holds the lock (its PID is in the message).
+    """
+
+    def __init__(self, db):
+        self.db = Path(db)
+        self.path = self.db.with_name(self.db.name + ".lock")
+        self.fd = None
+
+    def acquire(self):
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - Windows
+            return self
+        while True:
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            except OSError as exc:
+                raise ValueError(
+                    f"{self.path}: cannot create the lock file ({exc.strerror}); give a --db in "
+                    "a writable folder"
+                ) from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                owner = os.pread(fd, 200, 0).decode(errors="replace").strip() or "another process"
+                os.close(fd)
+                raise ValueError(
+                    f"{self.db}: in use by another lilium experiment ({owner}); wait for it to "
+                    "finish, stop it, or give another --db"
+                ) from None
+            # The holder before us may have removed the file after we opened it: retry then.
+            try:
+                same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        os.ftruncate(fd, 0)
+        stamp = time.strftime("%Y-%m-%d %H:%M:%S")
+        os.pwrite(fd, f"pid {os.getpid()} on {os.uname().nodename}, since {stamp}".encode(), 0)
+        self.fd = fd
+        return self
+
+    def release(self):
+        if self.fd is None:
+            return
+        try:
+            os.unlink(self.path)  # while still holding the lock, see acquire()
+        except FileNotFoundError:
+            pass
+        os.close(self.fd)
+        self.fd = None
+
+    def __enter__(self):
+        return self.acquire()
+
+    def __exit__(self, *exc):
+        self.release()
