@@ -17,6 +17,15 @@ def exit_with_parent(parent_pid):
     everywhere a daemon thread checks every :data:`PARENT_CHECK_SECONDS` that the parent is still
     the parent (an orphan is adopted by another process) and exits at once otherwise. A worker
     holds nothing to clean up: only the parent writes the database.
+
+    Call it in the pool's initializer. ``PR_SET_PDEATHSIG`` fires when the *thread* that started
+    the worker ends; the runner's pool starts its workers from the thread that runs the
+    experiment, which outlives them.
+
+    Parameters
+    ----------
+    parent_pid : int
+        ``os.getpid()`` of the parent, passed in by it (``initargs``).
     """
     if sys.platform.startswith("linux"):
         try:

@@ -7,6 +7,10 @@ in flight, and running it again skips every key already stored, so nothing is du
 Conventions of the key: ``variant`` is ``""`` for POSEST-SFO; ``axes_set`` is 0 for the
 subject's own soft-tissue axes (Exps. A, B) and ``k`` for ``axes_C<k>.json`` (Exp. C);
 ``repetition`` is the 0-based Lilium run (0 for POSEST-SFO, which is deterministic).
+
+A file that is not a Lilium results database is refused and left untouched; ``lilium report``
+opens the database read-only. :class:`RunLock` keeps a second ``lilium experiment`` off a
+database that one is using.
 """
 
 import json
