@@ -323,6 +323,21 @@ def test_report_out_that_is_a_file(tmp_path, capsys):
     status, err = run_cli(capsys, ["report", str(db), "--out", str(target / "sub")])
     assert status == 2 and "--out" in err and "cannot write there" in err
     assert target.read_text() == "keep me"
+    status, err = run_cli(capsys, ["report", str(tmp_path), "--out", str(tmp_path / "rep")])
+    assert status == 2 and "is a folder; give the results database file" in err
+
+
+def test_db_that_is_a_folder_or_under_a_file(datasets, tmp_path, capsys):
+    config = write_config(tmp_path / "run", datasets[0], experiments=("A",))
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    for db, message in [
+        (tmp_path, "is a folder"),
+        (blocker / "r.sqlite", f"cannot create its folder {blocker}"),
+    ]:
+        argv = ["experiment", str(config), "--db", str(db), "--no-progress"]
+        status, err = run_cli(capsys, argv)
+        assert status == 2 and message in err and "--db" in err
 
 
 # -- processes: one run per database, no orphaned workers

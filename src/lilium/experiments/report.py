@@ -62,6 +62,8 @@ def load_rows(db):
     that is not a Lilium results database, or a corrupt one, is a ``ValueError``.
     """
     db = Path(db)
+    if db.is_dir():
+        raise ValueError(f"{db}: is a folder; give the results database file")
     if not db.is_file():
         raise ValueError(f"{db}: database not found; run lilium experiment first")
     try:

@@ -517,7 +517,7 @@ def run_experiment(cfg, scheduler=None, workers=None, db=None, progress=True, lo
         db.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise ValueError(
-            f"{db}: cannot create its folder ({exc.strerror}); give another --db"
+            f"{db}: cannot create its folder {db.parent} ({exc.strerror}); give another --db"
         ) from None
     with RunLock(db):
         root, index = load_dataset(cfg, workers=workers, log=log)

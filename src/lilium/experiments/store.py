@@ -133,7 +133,8 @@ class ResultStore:
                     self.path.parent.mkdir(parents=True, exist_ok=True)
                 except OSError as exc:
                     raise ValueError(
-                        f"{self.path}: cannot create its folder ({exc.strerror}); give another --db"
+                        f"{self.path}: cannot create its folder {self.path.parent} "
+                        f"({exc.strerror}); give another --db"
                     ) from None
                 self.conn = sqlite3.connect(self.path, timeout=60.0)
         except sqlite3.DatabaseError as exc:
