@@ -14,9 +14,11 @@ import numpy as np
 #: ``byte skip`` or padding); more is an error.
 DECOMPRESS_MARGIN_BYTES = 1 << 20
 
-#: Largest volume read, in voxels (2^30: 2 GiB of int16, 4 GiB as the float32 copy that
-#: marching cubes works on). Crop or downsample larger scans first.
-MAX_VOXELS = 1 << 30
+#: Largest volume read, in voxels (2^29, e.g. 1024 x 1024 x 512). The importer's peak memory
+#: is about the file's size plus 10 bytes per voxel for int16 data (the voxels, the float32 copy
+#: marching cubes works on and its padded copy), so at most about 5.4 GB plus the file; a
+#: 512 x 512 x 400 head CT needs about 1.1 GB. Crop or downsample larger scans first.
+MAX_VOXELS = 1 << 29
 
 _CHUNK = 1 << 24
 

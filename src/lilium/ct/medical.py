@@ -36,11 +36,13 @@ def read_nifti(path):
     except ValueError as exc:
         if str(exc).startswith(str(path)):
             raise
-        raise ValueError(f"{path}: cannot read the NIfTI file ({exc}); export it again") from exc
+        raise ValueError(
+            f"{path}: cannot read the NIfTI file ({_one_line(exc)}); export it again"
+        ) from exc
     except Exception as exc:  # nibabel raises several kinds for corrupt or truncated files
         raise ValueError(
-            f"{path}: cannot read the NIfTI file ({type(exc).__name__}: {exc}); the file is "
-            "truncated or corrupt, export it again"
+            f"{path}: cannot read the NIfTI file ({_one_line(exc)}); the file is truncated or "
+            "corrupt, export it again"
         ) from exc
     if data.ndim == 4 and data.shape[3] == 1:
         data = data[..., 0]
@@ -72,6 +74,18 @@ def _is_dicom_file(path):
     return head[128:132] == b"DICM" or path.suffix.lower() in (".dcm", ".dicom", ".ima")
 
 
+def _is_image_storage(ds):
+    """Whether a dataset's SOP class is an image storage (so it must hold pixel data)."""
+    uid = getattr(getattr(ds, "file_meta", None), "MediaStorageSOPClassUID", None)
+    uid = uid or getattr(ds, "SOPClassUID", None)
+    return uid is not None and "Image Storage" in str(getattr(uid, "name", ""))
+
+
+def _one_line(exc):
+    """An exception's text on one line (messages of the packages may span several)."""
+    return " ".join(f"{type(exc).__name__}: {exc}".split())
+
+
 def read_dicom(path):
     """A DICOM series: every image file of a folder with the same series (needs ``pydicom``).
 
@@ -99,18 +113,23 @@ def read_dicom(path):
         except InvalidDicomError as exc:
             if marked:
                 raise ValueError(
-                    f"{f}: not a readable DICOM file ({exc}); remove it or export again"
+                    f"{f}: not a readable DICOM file ({_one_line(exc)}); remove it or export again"
                 ) from exc
             continue
         except Exception as exc:  # pydicom raises many kinds on truncated headers
             if not marked:
                 continue
             raise ValueError(
-                f"{f}: cannot read the DICOM file ({type(exc).__name__}: {exc}); it is "
+                f"{f}: cannot read the DICOM file ({_one_line(exc)}); it is "
                 "truncated or corrupt: remove it or export the series again"
             ) from exc
         if "PixelData" in ds:
             slices.append((f, ds))
+        elif _is_image_storage(ds):  # pydicom stops quietly at the end of a truncated file
+            raise ValueError(
+                f"{f}: a DICOM image without pixel data (the file is truncated); remove it or "
+                "export the series again"
+            )
     if not slices:
         raise ValueError(f"{path}: no DICOM image with pixel data found")
     series = {getattr(ds, "SeriesInstanceUID", None) for _, ds in slices}
@@ -159,7 +178,7 @@ def read_dicom(path):
             pixels = ds.pixel_array
         except Exception as exc:  # truncated data, missing decoder, bad attributes
             raise ValueError(
-                f"{f}: cannot decode the pixel data ({type(exc).__name__}: {exc}); the file is "
+                f"{f}: cannot decode the pixel data ({_one_line(exc)}); the file is "
                 "truncated or compressed without a decoder (pip install pylibjpeg): export the "
                 "series again, uncompressed"
             ) from exc
