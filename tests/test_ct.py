@@ -232,7 +232,7 @@ def test_bad_inputs_raise_clear_errors(tmp_path):
         volume_to_mesh(data, 5000, spacing=SPACING)
     with pytest.raises(ValueError, match="spacing must be 3 positive"):
         Volume(data, (1.0, 0.0, 1.0))
-    with pytest.raises(ValueError, match="bone iso-value"):
+    with pytest.raises(ValueError, match="bone level"):
         import_ct(Volume(data, SPACING), tmp_path / "o", bone_iso=400, skin_iso=450)
     (tmp_path / "lm.json").write_text('{"landmarks": {"nose_tip": [0, 0, 0]}}')
     with pytest.raises(ValueError, match="unknown cranial landmark 'nose_tip'"):
@@ -250,3 +250,19 @@ def test_headsq_nrrd_and_raw_agree():
     v, f = volume_to_mesh(vol, 1150, target_faces=None)
     assert len(f) > 1000
     assert np.all(np.ptp(v, axis=0) > 100)  # a real skull spans > 10 cm each way
+
+
+@pytest.mark.skipif(not (HEADSQ / "quarter.nhdr").is_file(), reason="shared/data/headsq absent")
+def test_headsq_import_names_its_frame_and_warns(tmp_path, capsys):
+    """The real CT: left-handed space (z negated to LPS), cut vault, 3.2 mm voxels, spine."""
+    assert main(["import-ct", str(HEADSQ / "quarter.nhdr"), "--out", str(tmp_path / "s")]) == 0
+    printed = capsys.readouterr().out
+    record = json.loads((tmp_path / "s" / "ct_import.json").read_text())
+    assert record["frame"] == "LPS" and record["source_space"] == "3d-left-handed"
+    assert record["units"] == "scanner" and record["bone_iso"] == 1150
+    codes = [w["code"] for w in record["warnings"]]
+    for code in ("orientation_assumed", "coarse_voxels", "anisotropic_voxels", "spine_attached"):
+        assert code in codes and f"[{code}]" in printed
+    assert {c["side"] for c in record["border_cuts"]} == {"superior", "inferior"}
+    extent = record["skull_extent_mm"]
+    assert extent["max"][2] <= 1.5 and extent["min"][2] < -130  # slice 1 on top, z up

@@ -98,8 +98,8 @@ def volume_to_mesh(
     if not lo < iso < hi:
         raise ValueError(
             f"{volume.source}: iso-value {iso:g} is outside the volume's range [{lo:g}, {hi:g}], "
-            "so there is no surface; pick an iso-value inside it (CT bone ~1150-1300 in "
-            "scanner units or ~300-700 HU, skin ~500 or ~-300 HU)"
+            "so there is no surface; pick a level inside it (--bone-iso, --skin-iso; defaults "
+            "bone 300 HU or 1150 scanner units, skin -400 HU or 500, see lilium.ct.checks)"
         )
     background = min(lo, iso) - 1.0
     padded = np.pad(np.nan_to_num(data, nan=background), 1, constant_values=background)

@@ -3,16 +3,20 @@
 Every reader returns a :class:`~lilium.ct.volume.Volume` (data ``[slice, row, column]``, spacing
 and origin in (x, y, z) order, direction columns = index axes). NRRD, MetaImage and raw files are
 parsed here without extra packages; DICOM needs ``pydicom`` and NIfTI ``nibabel`` (optional,
-imported only when such a file is read).
+imported only when such a file is read; :mod:`lilium.ct.medical`). Header fields and compressed
+data are checked by :mod:`lilium.ct.decode`: every malformed header, truncated or corrupt
+payload and oversized (bomb) stream is a one-line ``ValueError`` naming the file and the field.
 """
 
-import gzip
+import dataclasses
 import re
-import zlib
 from pathlib import Path
 
 import numpy as np
 
+from .decode import check_voxel_count, floats, inflate, integers
+from .frame import normalise_space, orientation_code_to_direction
+from .medical import read_dicom, read_nifti
 from .volume import Volume, check_spacing
 
 #: Suffixes understood by :func:`read_volume`, per format.
@@ -87,14 +91,20 @@ def read_volume(
             ".mhd/.mha, or raw data with raw_shape, raw_dtype and spacing"
         )
     if spacing is not None or origin is not None:
-        volume = Volume(
-            volume.data,
-            volume.spacing_mm if spacing is None else check_spacing(spacing, str(first)),
-            volume.origin_mm if origin is None else origin,
-            volume.direction,
-            volume.source,
+        volume = dataclasses.replace(
+            volume,
+            spacing_mm=volume.spacing_mm if spacing is None else check_spacing(spacing, str(first)),
+            origin_mm=volume.origin_mm if origin is None else origin,
         )
     return volume
+
+
+def read_bytes(path):
+    """The bytes of a file, or a ``ValueError`` naming it (a folder, no permission, ...)."""
+    try:
+        return Path(path).read_bytes()
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read the file ({exc.strerror or exc})") from exc
 
 
 def _expand(path):
@@ -125,9 +135,14 @@ def _dtype(name, byte_order, source):
     try:
         dt = np.dtype(name)
     except TypeError as exc:
+        dt = None
+        cause = exc
+    else:
+        cause = None
+    if dt is None or dt.kind not in "iuf" or dt.itemsize > 8:
         raise ValueError(
             f"{source}: unknown voxel type {name!r}; use int16, uint16, int32, float32, ..."
-        ) from exc
+        ) from cause
     if byte_order not in ("little", "big"):
         raise ValueError(f"{source}: byte order must be 'little' or 'big', got {byte_order!r}")
     return dt.newbyteorder("<" if byte_order == "little" else ">")
@@ -166,9 +181,12 @@ def read_raw(paths, shape, dtype, spacing, byte_order="little", header_bytes=0):
             f"{source}: {len(paths)} files cannot hold a volume of shape {shape}; "
             "the number of slice files must divide the number of slices"
         )
+    check_voxel_count(shape, source)
+    if int(header_bytes) < 0:
+        raise ValueError(f"{source}: header_bytes must be >= 0, got {header_bytes}")
     chunks = []
     for p in paths:
-        raw = p.read_bytes()[int(header_bytes) :]
+        raw = read_bytes(p)[int(header_bytes) :]
         expected = per_file * dt.itemsize
         if len(raw) != expected:
             raise ValueError(
@@ -223,22 +241,25 @@ _NRRD_TYPES = {
 }
 
 
-def _parse_vector(text):
-    return [float(v) for v in text.strip().strip("()").split(",")]
+def _header_end(blob):
+    """Offset of the blank line ending a text header (``\\n\\n`` or ``\\r\\n\\r\\n``), or -1."""
+    ends = [(i, n) for i, n in ((blob.find(b"\n\n"), 2), (blob.find(b"\r\n\r\n"), 4)) if i >= 0]
+    return min(ends) if ends else (-1, 0)
 
 
 def read_nrrd(path):
     """An NRRD volume (``.nrrd`` with attached data or ``.nhdr`` with detached data files).
 
-    Supports encodings raw and gzip, ``spacings`` or ``space directions``, ``space origin``, and
-    detached ``data file`` given as one name, a ``%d`` pattern with ``min max step``, or
-    ``LIST``.
+    Supports encodings raw, gzip and ascii, ``spacings`` or ``space directions``, ``space
+    origin``, ``space`` (kept as :attr:`Volume.space`, see :mod:`lilium.ct.frame`), and detached
+    ``data file`` given as one name, a ``%d`` pattern with ``min max step``, or ``LIST``.
     """
     path = Path(path)
-    blob = path.read_bytes()
-    if not blob.startswith(b"NRRD"):
+    src = str(path)
+    blob = read_bytes(path)
+    if not re.match(rb"NRRD000\d\r?\n", blob[:10]):
         raise ValueError(f"{path}: not an NRRD file (no 'NRRD000x' magic line)")
-    end = blob.find(b"\n\n")
+    end, sep = _header_end(blob)
     header_text = blob[: end if end >= 0 else len(blob)].decode("latin-1")
     lines = header_text.splitlines()[1:]
     fields = {}
@@ -248,10 +269,14 @@ def read_nrrd(path):
             continue
         if ":=" in line:
             continue  # key/value pairs
-        if ":" not in line:
-            raise ValueError(f"{path}: malformed header line {line!r}")
+        if ": " not in line and not line.rstrip().endswith(":"):
+            raise ValueError(
+                f"{path}: malformed header line {line[:60]!r}; NRRD fields are 'name: value'"
+            )
         key, value = line.split(":", 1)
         key, value = key.strip().lower(), value.strip()
+        if key in fields:
+            raise ValueError(f"{path}: header field '{key}' is given twice; keep one")
         fields[key] = value
         if key in ("data file", "datafile") and value.upper().startswith("LIST"):
             list_files = [ln.strip() for ln in lines[i + 1 :] if ln.strip()]
@@ -262,79 +287,134 @@ def read_nrrd(path):
             raise ValueError(f"{path}: NRRD header lacks the '{key}' field")
         return fields[key]
 
-    dim = int(need("dimension"))
+    (dim,) = integers(need("dimension"), "dimension", src, count=1)
     if dim != 3:
-        raise ValueError(f"{path}: only 3D NRRD volumes are supported, got dimension {dim}")
-    sizes = [int(v) for v in need("sizes").split()]
-    type_name = need("type").lower()
+        raise ValueError(
+            f"{path}: header field 'dimension' is {dim}; only 3D volumes are supported (3)"
+        )
+    sizes = integers(need("sizes"), "sizes", src, count=3, minimum=1)
+    n_voxels = check_voxel_count(sizes, src)
+    type_name = " ".join(need("type").lower().split())
     if type_name not in _NRRD_TYPES:
-        raise ValueError(f"{path}: unsupported NRRD type {type_name!r}")
+        raise ValueError(
+            f"{path}: header field 'type' {type_name!r} is not supported; use short, ushort, "
+            "int, float, ..."
+        )
     encoding = need("encoding").lower()
-    if encoding not in ("raw", "gzip", "gz"):
-        raise ValueError(f"{path}: unsupported NRRD encoding {encoding!r}; use raw or gzip")
+    if encoding not in ("raw", "gzip", "gz", "ascii", "text", "txt"):
+        raise ValueError(
+            f"{path}: header field 'encoding' {encoding!r} is not supported; save the volume "
+            "as raw or gzip"
+        )
     endian = fields.get("endian", "little").lower()
-    dt = _dtype(_NRRD_TYPES[type_name], endian, str(path))
+    if endian not in ("little", "big"):
+        raise ValueError(f"{path}: header field 'endian' must be little or big, got {endian!r}")
+    dt = _dtype(_NRRD_TYPES[type_name], endian, src)
+    space = normalise_space(fields.get("space"), f"{path}: header field 'space'")
+    if "space dimension" in fields:
+        (space_dim,) = integers(fields["space dimension"], "space dimension", src, count=1)
+        if space_dim != 3:
+            raise ValueError(f"{path}: header field 'space dimension' must be 3, got {space_dim}")
 
     direction = np.eye(3)
     if "space directions" in fields:
-        vecs = re.findall(r"\(([^)]*)\)", fields["space directions"])
-        if len(vecs) != 3:
-            raise ValueError(f"{path}: 'space directions' must give 3 vectors for a 3D volume")
-        cols = np.array([_parse_vector(v) for v in vecs]).T
+        text = fields["space directions"]
+        vecs = re.findall(r"\(([^)]*)\)", text)
+        if len(vecs) != 3 or "none" in text.lower():
+            raise ValueError(
+                f"{path}: header field 'space directions' must give 3 vectors '(x,y,z)' for a "
+                f"3D volume, got {text!r}"
+            )
+        cols = np.array([floats(v, "space directions", src, count=3) for v in vecs]).T
         spacing = np.linalg.norm(cols, axis=0)
-        direction = cols / np.where(spacing > 0, spacing, 1.0)
+        if np.any(spacing <= 0):
+            raise ValueError(f"{path}: header field 'space directions' has a zero vector")
+        direction = cols / spacing
     elif "spacings" in fields:
-        spacing = np.array([float(v) for v in fields["spacings"].split()])
+        spacing = floats(fields["spacings"], "spacings", src, count=3)
     else:
         spacing = np.ones(3)
     origin = np.zeros(3)
     if "space origin" in fields:
-        origin = np.array(_parse_vector(fields["space origin"]))
+        origin = floats(fields["space origin"], "space origin", src, count=3)
+    if "line skip" in fields and integers(fields["line skip"], "line skip", src, 1) != [0]:
+        raise ValueError(f"{path}: header field 'line skip' is not supported; remove it")
+    (skip,) = integers(fields.get("byte skip", "0"), "byte skip", src, count=1, minimum=-1)
 
-    n_voxels = int(np.prod(sizes))
     data_file = fields.get("data file", fields.get("datafile"))
-    skip = int(fields.get("byte skip", "0"))
     if data_file is None:
-        payload = [blob[end + 2 :]] if end >= 0 else [b""]
+        if end < 0:
+            raise ValueError(f"{path}: no blank line ends the header, so no data follow it")
+        payload = [blob[end + sep :]]
     else:
-        payload = [
-            (path.parent / name).read_bytes() if (path.parent / name).is_file() else None
-            for name in _nrrd_data_files(data_file, list_files, path)
-        ]
-        missing = [
-            name
-            for name, b in zip(_nrrd_data_files(data_file, list_files, path), payload, strict=True)
-            if b is None
-        ]
-        if missing:
-            raise ValueError(f"{path}: detached data file(s) not found: {missing[:3]}")
+        names = _nrrd_data_files(data_file, list_files, path)
+        payload = []
+        for name in names:
+            target = path.parent / name
+            if not target.is_file():
+                raise ValueError(f"{path}: detached data file {target} not found (data file)")
+            payload.append(read_bytes(target))
+    if encoding in ("ascii", "text", "txt"):
+        values = np.concatenate([floats(b.decode("latin-1"), "data (ascii)", src) for b in payload])
+        if len(values) != n_voxels:
+            raise ValueError(
+                f"{path}: ascii data hold {len(values)} numbers, sizes {sizes} need {n_voxels}"
+            )
+        data = values.astype(dt.newbyteorder("=")).reshape(sizes[::-1])
+        return Volume(data, spacing, origin, direction, src, space=space, space_known=_known(space))
+    per_file = n_voxels * dt.itemsize // len(payload)
     chunks = []
     for b in payload:
         if encoding in ("gzip", "gz"):
-            b = gzip.decompress(b)
-        if skip == -1:
-            b = b[len(b) - (n_voxels // len(payload)) * dt.itemsize :]
-        else:
-            b = b[skip:]
+            b = inflate(b, per_file + max(skip, 0), src, "gzip")
+        b = b[len(b) - per_file :] if skip == -1 else b[skip:]
         chunks.append(b)
     raw = b"".join(chunks)
     if len(raw) < n_voxels * dt.itemsize:
         raise ValueError(
             f"{path}: data hold {len(raw)} bytes, sizes {sizes} of {dt.name} need "
-            f"{n_voxels * dt.itemsize}; check the header's sizes, type and data file"
+            f"{n_voxels * dt.itemsize}; the file is truncated or the header's sizes, type or "
+            "data file are wrong"
         )
     data = np.frombuffer(raw[: n_voxels * dt.itemsize], dtype=dt).reshape(sizes[::-1])
-    return Volume(data.astype(dt.newbyteorder("=")), spacing, origin, direction, str(path))
+    return Volume(
+        data.astype(dt.newbyteorder("=")),
+        spacing,
+        origin,
+        direction,
+        src,
+        space=space,
+        space_known=_known(space),
+    )
+
+
+def _known(space):
+    from .frame import SPACES
+
+    return space is not None and SPACES[space][1]
 
 
 def _nrrd_data_files(spec, list_files, path):
     if spec.upper().startswith("LIST"):
+        if not list_files:
+            raise ValueError(f"{path}: 'data file: LIST' is not followed by any file name")
         return list_files
     parts = spec.split()
     if len(parts) >= 4 and "%" in parts[0]:
-        lo, hi, step = int(parts[1]), int(parts[2]), int(parts[3])
+        lo, hi, step = integers(" ".join(parts[1:4]), "data file", str(path), count=3)
+        if step == 0 or (hi - lo) * step < 0:
+            raise ValueError(
+                f"{path}: header field 'data file' has min {lo}, max {hi}, step {step}, which "
+                "name no file"
+            )
         stop = hi + (1 if step > 0 else -1)
-        return [parts[0] % i for i in range(lo, stop, step)]
+        try:
+            return [parts[0] % i for i in range(lo, stop, step)]
+        except (TypeError, ValueError) as exc:
+            raise ValueError(
+                f"{path}: header field 'data file' pattern {parts[0]!r} is not a printf "
+                "pattern with one %d"
+            ) from exc
     return [spec]
 
 
@@ -357,166 +437,120 @@ _MET_TYPES = {
 }
 
 
-def read_metaimage(path):
-    """A MetaImage volume: ``.mhd`` header with a ``.raw`` file, or a single ``.mha``."""
-    path = Path(path)
-    blob = path.read_bytes()
+def _metaimage_header(path, blob):
+    """Fields of a MetaImage header and the offset where the data of a ``.mha`` start."""
     fields = {}
     offset = 0
-    for raw_line in blob.split(b"\n"):
-        offset += len(raw_line) + 1
-        line = raw_line.decode("latin-1").strip()
+    while offset < len(blob):
+        stop = blob.find(b"\n", offset)
+        stop = len(blob) if stop < 0 else stop
+        line = blob[offset:stop].decode("latin-1").strip()
+        offset = stop + 1
         if not line:
             continue
         if "=" not in line:
-            raise ValueError(f"{path}: malformed MetaImage header line {line!r}")
-        key, value = (s.strip() for s in line.split("=", 1))
+            raise ValueError(
+                f"{path}: malformed MetaImage header line {line[:60]!r}; fields are 'Name = value'"
+            )
+        key, value = (t.strip() for t in line.split("=", 1))
+        if key in fields:
+            raise ValueError(f"{path}: MetaImage header field {key} is given twice; keep one")
         fields[key] = value
         if key == "ElementDataFile":
-            break
-    for key in ("DimSize", "ElementType", "ElementDataFile"):
+            return fields, offset
+    raise ValueError(f"{path}: MetaImage header lacks ElementDataFile (the last header field)")
+
+
+def read_metaimage(path):
+    """A MetaImage volume: ``.mhd`` header with a ``.raw`` file, or a single ``.mha``.
+
+    The world frame is LPS (ITK's). ``TransformMatrix`` (or ``Rotation``/``Orientation``) gives
+    the direction; without it ``AnatomicalOrientation`` (ITK's letters, ``RAI`` = identity) does;
+    with both, the matrix wins and a disagreement is noted.
+    """
+    path = Path(path)
+    src = str(path)
+    blob = read_bytes(path)
+    fields, offset = _metaimage_header(path, blob)
+    for key in ("DimSize", "ElementType"):
         if key not in fields:
             raise ValueError(f"{path}: MetaImage header lacks {key}")
-    ndims = int(fields.get("NDims", "3"))
-    sizes = [int(v) for v in fields["DimSize"].split()]
-    if ndims != 3 or len(sizes) != 3:
-        raise ValueError(f"{path}: only 3D MetaImage volumes are supported (NDims = 3)")
+    (ndims,) = integers(fields.get("NDims", "3"), "NDims", src, count=1)
+    if ndims != 3:
+        raise ValueError(f"{path}: header field 'NDims' is {ndims}; only 3D volumes (NDims = 3)")
+    sizes = integers(fields["DimSize"], "DimSize", src, count=3, minimum=1)
+    n_voxels = check_voxel_count(sizes, src)
+    channels = integers(fields.get("ElementNumberOfChannels", "1"), "ElementNumberOfChannels", src)
+    if channels != [1]:
+        raise ValueError(f"{path}: ElementNumberOfChannels must be 1 for a CT volume")
     if fields["ElementType"] not in _MET_TYPES:
-        raise ValueError(f"{path}: unsupported ElementType {fields['ElementType']!r}")
+        raise ValueError(
+            f"{path}: header field 'ElementType' {fields['ElementType']!r} is not supported; "
+            "use MET_SHORT, MET_USHORT, MET_FLOAT, ..."
+        )
     msb = fields.get("BinaryDataByteOrderMSB", fields.get("ElementByteOrderMSB", "False"))
+    if msb.lower() not in ("true", "false"):
+        raise ValueError(f"{path}: BinaryDataByteOrderMSB must be True or False, got {msb!r}")
     order = "big" if msb.lower() == "true" else "little"
-    dt = _dtype(_MET_TYPES[fields["ElementType"]], order, str(path))
-    spacing = [float(v) for v in fields.get("ElementSpacing", "1 1 1").split()]
-    origin_text = fields.get("Offset", fields.get("Origin", fields.get("Position", "0 0 0")))
-    origin = [float(v) for v in origin_text.split()]
-    matrix = fields.get("TransformMatrix", fields.get("Rotation", fields.get("Orientation")))
-    direction = (
-        np.eye(3)
-        if matrix is None
-        else np.array([float(v) for v in matrix.split()]).reshape(3, 3).T
+    dt = _dtype(_MET_TYPES[fields["ElementType"]], order, src)
+    spacing_key = "ElementSpacing" if "ElementSpacing" in fields else "ElementSize"
+    spacing = floats(fields.get(spacing_key, "1 1 1"), spacing_key, src, count=3)
+    origin_key = next((k for k in ("Offset", "Origin", "Position") if k in fields), "Offset")
+    origin = floats(fields.get(origin_key, "0 0 0"), origin_key, src, count=3)
+    matrix_key = next(
+        (k for k in ("TransformMatrix", "Rotation", "Orientation") if k in fields), None
     )
+    code = fields.get("AnatomicalOrientation")
+    notes = []
+    if code is not None and code.strip().upper() in ("", "?", "???"):
+        code = None
+    from_code = None if code is None else orientation_code_to_direction(code, src)
+    if matrix_key is not None:
+        direction = floats(fields[matrix_key], matrix_key, src, count=9).reshape(3, 3).T
+        if from_code is not None and not np.allclose(np.sign(np.round(direction)), from_code):
+            notes.append(
+                f"{path}: AnatomicalOrientation {code} disagrees with {matrix_key}; the matrix "
+                "is used (as ITK does)"
+            )
+    else:
+        direction = np.eye(3) if from_code is None else from_code
     data_file = fields["ElementDataFile"]
+    (header_size,) = integers(fields.get("HeaderSize", "0"), "HeaderSize", src, 1, minimum=-1)
     if data_file == "LOCAL":
         raw = blob[offset:]
-    elif data_file.upper().startswith("LIST"):
-        raise ValueError(f"{path}: ElementDataFile LIST is not supported; merge the slices")
+    elif data_file.upper().startswith("LIST") or "%" in data_file:
+        raise ValueError(
+            f"{path}: ElementDataFile {data_file.split()[0]} (one file per slice) is not "
+            "supported; save the volume as one .mha or .mhd/.raw"
+        )
     else:
         target = path.parent / data_file
         if not target.is_file():
             raise ValueError(f"{path}: data file {target} not found (ElementDataFile)")
-        raw = target.read_bytes()
-    if fields.get("CompressedData", "False").lower() == "true":
-        raw = zlib.decompress(raw)
-    n = int(np.prod(sizes)) * dt.itemsize
+        raw = read_bytes(target)
+    n = n_voxels * dt.itemsize
+    compressed = fields.get("CompressedData", "False").lower()
+    if compressed not in ("true", "false"):
+        raise ValueError(f"{path}: CompressedData must be True or False, got {compressed!r}")
+    if compressed == "true":
+        raw = inflate(raw, n, src, "zlib")
+    elif header_size == -1:
+        raw = raw[len(raw) - n :] if len(raw) >= n else raw
+    else:
+        raw = raw[header_size:]
     if len(raw) < n:
         raise ValueError(
-            f"{path}: data hold {len(raw)} bytes, DimSize {sizes} of {dt.name} needs {n}"
+            f"{path}: data hold {len(raw)} bytes, DimSize {sizes} of {dt.name} needs {n}; the "
+            "file is truncated or the header's DimSize or ElementType is wrong"
         )
     data = np.frombuffer(raw[:n], dtype=dt).reshape(sizes[::-1])
-    return Volume(data.astype(dt.newbyteorder("=")), spacing, origin, direction, str(path))
-
-
-# --------------------------------------------------------------------------------------------
-# NIfTI (nibabel)
-
-
-def read_nifti(path):
-    """A NIfTI-1/2 volume (needs the optional package ``nibabel``).
-
-    The voxel-to-world affine gives origin, spacing and direction (RAS+ world, mm); the array
-    (i, j, k) is transposed to ``[k, j, i]``.
-    """
-    try:
-        import nibabel
-    except ImportError as exc:
-        raise ValueError(
-            f"{path}: reading NIfTI needs the optional package nibabel (pip install nibabel)"
-        ) from exc
-    try:
-        image = nibabel.load(str(path))
-    except Exception as exc:  # nibabel raises several kinds for corrupt files
-        raise ValueError(f"{path}: cannot read the NIfTI file ({exc})") from exc
-    data = np.asarray(image.dataobj)
-    if data.ndim == 4 and data.shape[3] == 1:
-        data = data[..., 0]
-    if data.ndim != 3:
-        raise ValueError(f"{path}: expected a 3D NIfTI volume, got shape {data.shape}")
-    affine = np.asarray(image.affine, float)
-    cols = affine[:3, :3]
-    spacing = np.linalg.norm(cols, axis=0)
     return Volume(
-        np.ascontiguousarray(data.transpose(2, 1, 0)),
+        data.astype(dt.newbyteorder("=")),
         spacing,
-        affine[:3, 3],
-        cols / spacing,
-        str(path),
+        origin,
+        direction,
+        src,
+        space="lps",
+        space_known=matrix_key is not None or from_code is not None,
+        notes=tuple(notes),
     )
-
-
-# --------------------------------------------------------------------------------------------
-# DICOM (pydicom)
-
-
-def read_dicom(path):
-    """A DICOM series: every image file of a folder with the same series (needs ``pydicom``).
-
-    Slices are ordered by their position along the slice normal; ``RescaleSlope`` and
-    ``RescaleIntercept`` are applied (Hounsfield units for CT). Origin, direction and spacing come
-    from ``ImagePositionPatient``, ``ImageOrientationPatient``, ``PixelSpacing`` and the slice
-    positions (patient frame, mm).
-    """
-    try:
-        import pydicom
-    except ImportError as exc:
-        raise ValueError(
-            f"{path}: reading DICOM needs the optional package pydicom (pip install pydicom)"
-        ) from exc
-    path = Path(path)
-    files = sorted(p for p in path.iterdir() if p.is_file()) if path.is_dir() else [path]
-    slices = []
-    for f in files:
-        try:
-            ds = pydicom.dcmread(str(f))
-        except Exception:  # not a DICOM file: skip (folders often hold DICOMDIR, notes, ...)
-            continue
-        if "PixelData" in ds:
-            slices.append(ds)
-    if not slices:
-        raise ValueError(f"{path}: no DICOM image with pixel data found")
-    series = {getattr(ds, "SeriesInstanceUID", None) for ds in slices}
-    if len(series) > 1:
-        raise ValueError(f"{path}: holds {len(series)} DICOM series; put one series per folder")
-    for ds in slices:
-        for tag in ("ImagePositionPatient", "ImageOrientationPatient", "PixelSpacing"):
-            if tag not in ds:
-                raise ValueError(f"{path}: DICOM slice lacks {tag}; cannot build a volume")
-    iop = np.array(slices[0].ImageOrientationPatient, float)
-    row_dir, col_dir = iop[:3], iop[3:]
-    normal = np.cross(row_dir, col_dir)
-    positions = np.array([np.array(ds.ImagePositionPatient, float) for ds in slices])
-    order = np.argsort(positions @ normal)
-    slices = [slices[i] for i in order]
-    positions = positions[order]
-    dz = np.diff(positions @ normal)
-    if len(slices) > 1 and np.any(np.abs(dz) < 1e-6):
-        raise ValueError(f"{path}: two DICOM slices share a position; remove duplicates")
-    if len(slices) > 1 and np.ptp(dz) > 0.01 * np.abs(dz).mean() + 1e-3:
-        raise ValueError(f"{path}: DICOM slices are not evenly spaced; resample the series")
-    slice_spacing = (
-        float(np.mean(dz)) if len(slices) > 1 else float(getattr(slices[0], "SliceThickness", 1.0))
-    )
-    shapes = {(int(ds.Rows), int(ds.Columns)) for ds in slices}
-    if len(shapes) > 1:
-        raise ValueError(f"{path}: DICOM slices differ in size {sorted(shapes)}")
-    data = np.stack(
-        [
-            ds.pixel_array.astype(np.float32) * float(getattr(ds, "RescaleSlope", 1.0))
-            + float(getattr(ds, "RescaleIntercept", 0.0))
-            for ds in slices
-        ]
-    )
-    row_spacing, col_spacing = (float(v) for v in slices[0].PixelSpacing)
-    # PixelSpacing = (between rows, between columns); columns advance along row_dir.
-    spacing = np.array([col_spacing, row_spacing, abs(slice_spacing)])
-    direction = np.column_stack([row_dir, col_dir, normal])
-    return Volume(data, spacing, positions[0], direction, str(path))

@@ -8,7 +8,10 @@ Convention, written once. ``data`` is indexed ``[k, j, i]`` = ``[slice, row, col
 
 of the volume frame (the scanner's patient frame for DICOM/NIfTI, the file's ``space`` for NRRD),
 so ``spacing_mm`` and ``origin_mm`` are in (x, y, z) order and the columns of ``direction`` are the
-unit directions of the i, j, k index axes. Meshes extracted from a volume are in this frame, in mm.
+unit directions of the i, j, k index axes. :func:`~lilium.ct.mesh.volume_to_mesh` returns meshes in
+this frame, in mm; ``space`` names it (``"LPS"``, ``"RAS"``, an NRRD space such as
+``"3D-left-handed"``, or None when the file names none) and :mod:`lilium.ct.frame` maps it to the
+one right-handed patient frame (LPS) that ``lilium import-ct`` writes.
 """
 
 from dataclasses import dataclass, field
@@ -32,6 +35,19 @@ class Volume:
         Columns: unit directions of the column, row and slice axes in the volume frame.
     source : str
         Where the volume came from (for messages).
+    space : str or None
+        The frame of ``p_mm`` (see :func:`lilium.ct.frame.space_to_lps`): ``"LPS"`` for DICOM
+        and MetaImage, ``"RAS"`` for NIfTI, the ``space`` field of an NRRD header; None when the
+        file names no frame (raw data, NRRD without ``space``).
+    space_known : bool
+        Whether the file states the patient's anatomical axes (DICOM, NIfTI with a qform/sform
+        code, NRRD with an anatomical space, MetaImage with a TransformMatrix or
+        AnatomicalOrientation).
+    units : {"HU", None}
+        ``"HU"`` where the file says so (DICOM after the rescale); None: to be detected.
+    notes : tuple of str
+        Header observations the importer reports as warnings (e.g. a MetaImage
+        ``AnatomicalOrientation`` that contradicts its ``TransformMatrix``).
     """
 
     data: np.ndarray
@@ -39,6 +55,10 @@ class Volume:
     origin_mm: np.ndarray = field(default_factory=lambda: np.zeros(3))
     direction: np.ndarray = field(default_factory=lambda: np.eye(3))
     source: str = "volume"
+    space: str | None = None
+    space_known: bool = False
+    units: str | None = None
+    notes: tuple = ()
 
     def __post_init__(self):
         data = np.asarray(self.data)
