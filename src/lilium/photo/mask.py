@@ -23,6 +23,8 @@ PERSON_THRESHOLD = 0.5
 NECK_BELOW_CHIN = 0.25
 #: Width of the kept neck band below the jaw angles, over the gonion-to-gonion distance.
 NECK_WIDTH = 0.8
+#: Long side (pixels) the mask is computed at, then resized to the photo.
+WORK_SIDE_PX = 1024
 #: Margin added around the mesh outline, in face heights.
 MESH_MARGIN = 0.05
 
@@ -44,30 +46,44 @@ def head_mask(
     mask : ndarray of shape (H, W), bool
     """
     h, w = person_prob.shape
-    mesh = np.asarray(mesh_uv, dtype=float)[:, :2]
+    # Work at most WORK_SIDE_PX on the long side: the person mask comes from 256 x 256 anyway.
+    scale = min(1.0, WORK_SIDE_PX / max(h, w))
+    hs, ws = max(1, round(h * scale)), max(1, round(w * scale))
+    prob = cv2.resize(person_prob.astype(np.float32), (ws, hs), interpolation=cv2.INTER_AREA)
+    mesh = np.asarray(mesh_uv, dtype=float)[:, :2] * scale
     top, chin = mesh[nasion_index], mesh[gnathion_index]
     face_height = float(np.linalg.norm(chin - top))
     down = (chin - top) / face_height
     cut = chin + NECK_BELOW_CHIN * face_height * down
-    vv, uu = np.mgrid[0:h, 0:w]
+    vv = np.arange(hs, dtype=np.float32)[:, None]
+    uu = np.arange(ws, dtype=np.float32)[None, :]
     along = (uu - cut[0]) * down[0] + (vv - cut[1]) * down[1]
     gonion_r, gonion_l = mesh[list(gonion_indices)]
     jaw_level = ((gonion_r + gonion_l) / 2 - cut) @ down
     across = np.abs((uu - chin[0]) * down[1] - (vv - chin[1]) * down[0])
     neck = (along <= jaw_level) | (across <= NECK_WIDTH * np.linalg.norm(gonion_l - gonion_r) / 2)
-    mask = (person_prob > PERSON_THRESHOLD) & (along <= 0) & neck
-    hull = cv2.convexHull(np.round(mesh).astype(np.int32))
-    face = np.zeros((h, w), np.uint8)
-    cv2.fillConvexPoly(face, hull, 1)
-    r = max(1, int(round(MESH_MARGIN * face_height)))
-    face = cv2.dilate(face, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1)))
+    mask = (prob > PERSON_THRESHOLD) & (along <= 0) & neck
+    # The mesh outline grown by the margin: the hull of the mesh points shifted round a disc.
+    r = MESH_MARGIN * face_height
+    disc = r * np.stack(
+        [
+            np.cos(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
+            np.sin(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
+        ],
+        axis=1,
+    )
+    grown = (mesh[:, None, :] + disc[None]).reshape(-1, 2)
+    face = np.zeros((hs, ws), np.uint8)
+    cv2.fillConvexPoly(face, cv2.convexHull(np.round(grown).astype(np.int32)), 1)
     mask |= face.astype(bool)
     # Keep the connected part holding the face (drops stray person blobs, e.g. a hand).
     n, labels = cv2.connectedComponents(mask.astype(np.uint8))
     if n > 2:
         centre = np.round(mesh.mean(axis=0)).astype(int)
-        label = labels[np.clip(centre[1], 0, h - 1), np.clip(centre[0], 0, w - 1)]
+        label = labels[np.clip(centre[1], 0, hs - 1), np.clip(centre[0], 0, ws - 1)]
         mask = labels == label
+    if scale < 1.0:
+        mask = cv2.resize(mask.astype(np.float32), (w, h), interpolation=cv2.INTER_LINEAR) > 0.5
     return mask
 
 

@@ -28,7 +28,8 @@ body{font-family:sans-serif;margin:0;display:flex;gap:1em}
 stroke:#000;stroke-width:2px;pointer-events:none} pre{white-space:pre-wrap;font-size:80%}
 </style></head><body>
 <div id="view"><svg id="svg" viewBox="-0.5 -0.5 __W__ __H__">
-<image href="__IMAGE__" x="-0.5" y="-0.5" width="__W__" height="__H__"/>
+<image href="__IMAGE__" x="-0.5" y="-0.5" width="__W__" height="__H__"
+preserveAspectRatio="none"/>
 <polygon id="outline" points="__OUTLINE__" fill="none" stroke="#0f0" stroke-width="__STROKE__"/>
 <g id="points"></g></svg></div>
 <div id="side"><h3>__TITLE__</h3><p>__MESSAGE__</p>
@@ -108,11 +109,19 @@ if (new URLSearchParams(location.search).has("test")) {
 """
 
 
+#: Long side (pixels) of the picture embedded in the page; the page's coordinates stay the
+#: photo's own pixels (the SVG stretches the picture over them).
+PAGE_SIDE_PX = 2000
+
+
 def _data_url(image):
     from PIL import Image
 
+    picture = Image.fromarray(image)
+    if max(picture.size) > PAGE_SIDE_PX:
+        picture.thumbnail((PAGE_SIDE_PX, PAGE_SIDE_PX), Image.BILINEAR)
     buffer = io.BytesIO()
-    Image.fromarray(image).save(buffer, format="JPEG", quality=90)
+    picture.save(buffer, format="JPEG", quality=90)
     return "data:image/jpeg;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
 
 
