@@ -25,6 +25,7 @@ LAYERS = {
     "ct": 7,
     "casework": 8,
     "report": 8,
+    "photo": 8,
     "experiments": 9,
     "demo": 9,
     "cli": 10,

@@ -19,6 +19,7 @@ COMMANDS = [
     "lilium.cli.import_ct",
     "lilium.cli.experiment",
     "lilium.cli.report",
+    "lilium.cli.photo",
 ]
 
 

@@ -213,6 +213,7 @@ def read_photo(folder, load_image=True):
     if lm_path == meta_path:
         raw = _field(meta_path, meta, "landmarks")
         landmarks = points_from_object(meta_path, "landmarks", raw, "facial")
+        landmarks = _without_unconfirmed_templates(landmarks, meta.get("landmark_sources"))
     else:
         landmarks = read_landmarks(lm_path, "facial")
     check_in_image(lm_path, landmarks, size_wh, image_path.name)
@@ -238,6 +239,25 @@ def read_photo(folder, load_image=True):
         priors,
         image if load_image else None,
     )
+
+
+def _without_unconfirmed_templates(landmarks, sources):
+    """Drop the landmarks ``lilium photo`` placed from its face template (SPEC section 11).
+
+    The rule: a landmark whose ``landmark_sources`` entry says ``"quality": "template"`` is
+    left out unless the entry also says ``"confirmed": true`` (the review page sets it).
+    """
+    if not isinstance(sources, dict):
+        return landmarks
+    return {
+        name: uv
+        for name, uv in landmarks.items()
+        if not (
+            isinstance(sources.get(name), dict)
+            and sources[name].get("quality") == "template"
+            and sources[name].get("confirmed") is not True
+        )
+    }
 
 
 def check_in_image(path, landmarks_uv, image_size_wh, image_name):

@@ -1,0 +1,112 @@
+"""One photograph in, the automatic face analysis out (no files: see :mod:`.prepare`)."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import runtime
+from .headpose import euler_deg, face_rotation_face2cam
+from .landmarks import mesh_to_landmarks
+from .mask import head_mask
+
+#: Smallest face (detection box side, pixels) the mesh model is trusted on.
+MIN_FACE_PX = 40
+#: Beyond this yaw (degrees) the face is called lateral when no view is given.
+LATERAL_YAW_DEG = 30.0
+
+
+@dataclass(frozen=True)
+class FaceAnalysis:
+    """What the models found on one photo; falsy (with a ``message``) when no face was found.
+
+    Attributes
+    ----------
+    message : str
+        Empty on success; otherwise why no face was found and what to do.
+    mesh_xyz : ndarray of shape (468, 3) or None
+        Mesh points (u, v, depth) pixels.
+    landmarks : dict of str -> ndarray of shape (2,)
+    sources : dict of str -> dict
+        ``landmark_sources`` of SPEC section 11.
+    face2cam : ndarray of shape (3, 3) or None
+        Face-frame orientation (:mod:`.headpose`).
+    angles_deg : dict
+        ``yaw``, ``pitch``, ``roll``.
+    iris_diameter_px : float or None
+        Mean of both eyes.
+    mask : ndarray of shape (H, W), bool, or None
+    detection_score : float
+    """
+
+    message: str = ""
+    mesh_xyz: np.ndarray | None = None
+    landmarks: dict = field(default_factory=dict)
+    sources: dict = field(default_factory=dict)
+    face2cam: np.ndarray | None = None
+    angles_deg: dict = field(default_factory=dict)
+    iris_diameter_px: float | None = None
+    mask: np.ndarray | None = None
+    detection_score: float = 0.0
+
+    def __bool__(self):
+        return not self.message
+
+    @property
+    def view(self):
+        """``frontal`` or the lateral view the yaw suggests (SPEC: lateral_left faces -u)."""
+        yaw = self.angles_deg.get("yaw", 0.0)
+        if abs(yaw) < LATERAL_YAW_DEG:
+            return "frontal"
+        return "lateral_left" if yaw > 0 else "lateral_right"
+
+
+def _not_found(why):
+    return FaceAnalysis(
+        message=f"no face found ({why}); the folder is written without automatic landmarks: "
+        "mark them by hand (review.html) and pass the file with --landmarks"
+    )
+
+
+def analyse_face(image):
+    """Run detection, mesh, iris and segmentation on one image.
+
+    Parameters
+    ----------
+    image : ndarray of shape (H, W, 3), uint8 RGB
+        Upright (EXIF orientation applied).
+
+    Returns
+    -------
+    FaceAnalysis
+        Falsy with a message when the detector finds no face (a profile beyond about 60
+        degrees of yaw, a tiny or occluded face) or the mesh model rejects the crop.
+    """
+    detection = runtime.detect_face(image)
+    if detection is None:
+        return _not_found("the detector saw none: a profile, a tiny or an occluded face")
+    score, box, keypoints = detection
+    if np.max(box[2:] - box[:2]) < MIN_FACE_PX:
+        return _not_found(f"the face is under {MIN_FACE_PX} px; use a larger photo or a crop")
+    mesh, presence = runtime.face_mesh(image, runtime.face_crop(box, keypoints))
+    if presence < runtime.MIN_PRESENCE_SCORE:
+        return _not_found("the face-mesh model rejected the detected face")
+    # A second pass on the crop the first mesh gives (MediaPipe's tracking ROI) is steadier.
+    refined, presence = runtime.face_mesh(image, runtime.mesh_crop(mesh))
+    if presence >= runtime.MIN_PRESENCE_SCORE:
+        mesh = refined
+    landmarks, sources = mesh_to_landmarks(mesh)
+    face2cam = face_rotation_face2cam(mesh)
+    yaw, pitch, roll = euler_deg(face2cam)
+    irises = runtime.iris(image, mesh)
+    iris_px = float(np.mean([2 * r for _, r in irises.values()]))
+    mask = head_mask(runtime.person_mask(image), mesh)
+    return FaceAnalysis(
+        mesh_xyz=mesh,
+        landmarks=landmarks,
+        sources=sources,
+        face2cam=face2cam,
+        angles_deg={"yaw": yaw, "pitch": pitch, "roll": roll},
+        iris_diameter_px=iris_px,
+        mask=mask,
+        detection_score=score,
+    )

@@ -1,0 +1,72 @@
+"""SPEC section 2 facial landmarks from MediaPipe's 468-point face mesh.
+
+Each landmark is one mesh vertex, chosen by where the vertex lies on the mesh's own topology
+and checked on real portraits against points placed by hand (``tests/test_photo_accuracy.py``,
+``docs/photo.md``). ``"tracked"`` points sit on image evidence the model follows (eye
+corners, the alar wings, the nostril base, the lip border, the mouth corners);
+``"template"`` points are where the model's face template puts them (nasion, glabella and
+the forehead, the chin, the cheek and jaw contour): plausible, not measured, and not used by
+an SFO until the user confirms them (SPEC section 11).
+"""
+
+import numpy as np
+
+TRACKED = "tracked"
+TEMPLATE = "template"
+
+#: SPEC facial landmark -> (mesh vertex index, quality). ``_r`` is the subject's right, the
+#: image's left in a frontal photo (MediaPipe's "right eye" 33/133 is the subject's right).
+MESH_LANDMARKS = {
+    "exocanthion_r": (33, TRACKED),
+    "endocanthion_r": (133, TRACKED),
+    "exocanthion_l": (263, TRACKED),
+    "endocanthion_l": (362, TRACKED),
+    "alare_r": (64, TRACKED),
+    "alare_l": (294, TRACKED),
+    "subnasale": (2, TRACKED),
+    "labiale_superius": (0, TRACKED),
+    "cheilion_r": (61, TRACKED),
+    "cheilion_l": (291, TRACKED),
+    "nasion": (168, TEMPLATE),
+    "glabella": (9, TEMPLATE),
+    "metopion": (151, TEMPLATE),
+    "pogonion": (175, TEMPLATE),
+    "gnathion": (152, TEMPLATE),
+    "zygion_r": (234, TEMPLATE),
+    "zygion_l": (454, TEMPLATE),
+    "gonion_r": (172, TEMPLATE),
+    "gonion_l": (397, TEMPLATE),
+    "frontotemporale_r": (54, TEMPLATE),
+    "frontotemporale_l": (284, TEMPLATE),
+}
+
+#: Mesh vertices of the jaw line from the right ear lobe over the chin to the left one (the
+#: lower face contour, used to cut the head mask below the chin).
+JAW_LINE = (
+    234, 93, 132, 58, 172, 136, 150, 149, 176, 148, 152,
+    377, 400, 378, 379, 365, 397, 288, 361, 323, 454,
+)  # fmt: skip
+
+
+def mesh_to_landmarks(mesh_uv):
+    """Landmarks (u, v) and their sources from the mesh.
+
+    Parameters
+    ----------
+    mesh_uv : ndarray of shape (468, 2) or (468, 3)
+        Mesh points in image pixels (a third depth column is ignored).
+
+    Returns
+    -------
+    landmarks : dict of str -> ndarray of shape (2,)
+    sources : dict of str -> dict
+        ``{"source": "automatic", "quality": "tracked" | "template"}`` per landmark.
+    """
+    mesh_uv = np.asarray(mesh_uv, dtype=float)
+    if mesh_uv.ndim != 2 or mesh_uv.shape[0] != 468:
+        raise ValueError(f"the face mesh must be (468, 2+) points, got {mesh_uv.shape}")
+    landmarks, sources = {}, {}
+    for name, (index, quality) in MESH_LANDMARKS.items():
+        landmarks[name] = mesh_uv[index, :2].copy()
+        sources[name] = {"source": "automatic", "quality": quality, "mesh_index": index}
+    return landmarks, sources

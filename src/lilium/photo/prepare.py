@@ -1,0 +1,177 @@
+"""``lilium photo``: write a SPEC section 8 photo folder from a plain photograph (SPEC 11).
+
+The folder holds the image (copied unchanged for PNG/JPEG, so its EXIF stays), ``photo.json``
+(landmarks, ``landmark_sources``, priors with their sources), ``face_mask.png`` and
+``review.html``. ``photo.json``'s priors carry, beside the SPEC fields:
+
+- ``"source": "automatic"`` and ``"sources"``: where each prior came from;
+- ``"head_rotation_face2cam"`` (3 x 3) and ``"head_angles_deg"`` (yaw, pitch, roll): the face
+  frame of :mod:`.headpose` in the camera frame. ``head_rotation_skull2cam`` needs a skull:
+  ``lilium case`` (or :func:`lilium.photo.headpose.head_rotation_skull2cam`) converts it
+  once one is paired, so this folder never holds a head prior the SFO would apply to an
+  arbitrary skull frame;
+- ``"scd_mm"`` from the iris (camera-to-eye distance) only when the focal is known (EXIF).
+"""
+
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..io.case import read_image
+from ..io.formats import read_landmarks
+from ..io.jsonio import write_json
+from .analysis import analyse_face
+from .headpose import iris_distance_mm
+from .mask import mask_outline
+from .review import review_page
+
+#: Head-orientation tolerance (degrees) proposed with the automatic orientation.
+HEAD_TOLERANCE_DEG = 15.0
+
+
+@dataclass(frozen=True)
+class PreparedPhoto:
+    """What :func:`prepare_photo` wrote.
+
+    Attributes
+    ----------
+    folder : Path
+    face_found : bool
+    message : str
+        One line for the user (why no face was found, or a summary).
+    view : str
+    n_tracked, n_template : int
+    """
+
+    folder: Path
+    face_found: bool
+    message: str
+    view: str
+    n_tracked: int = 0
+    n_template: int = 0
+
+
+def _copy_image(image_path, image, out):
+    suffix = image_path.suffix.lower()
+    if suffix in (".png", ".jpg", ".jpeg"):
+        target = out / f"image{suffix}"
+        shutil.copyfile(image_path, target)
+        return target
+    from PIL import Image
+
+    target = out / "image.png"
+    Image.fromarray(image).save(target)
+    return target
+
+
+def _priors(image_path, analysis, sensor_width_mm):
+    from ..io.exif import focal_prior_from_exif
+
+    priors, sources = {"source": "automatic"}, {}
+    focal = focal_prior_from_exif(image_path, sensor_width_mm=sensor_width_mm)
+    if focal is not None:
+        priors["focal_px"] = [float(x) for x in focal.focal_px]
+        sources["focal_px"] = f"EXIF: {focal.source}"
+    if analysis:
+        priors["head_rotation_face2cam"] = analysis.face2cam.tolist()
+        priors["head_angles_deg"] = {k: round(v, 2) for k, v in analysis.angles_deg.items()}
+        priors["head_tolerance_face_deg"] = HEAD_TOLERANCE_DEG
+        sources["head_rotation_face2cam"] = (
+            "automatic: face mesh frame (lilium.photo.headpose); convert with a paired skull"
+        )
+        priors["iris_diameter_px"] = round(analysis.iris_diameter_px, 2)
+        if focal is not None:
+            f = float(np.mean(focal.focal_px))
+            distance, interval = iris_distance_mm(f, analysis.iris_diameter_px)
+            priors["scd_mm"] = [round(x, 1) for x in interval]
+            sources["scd_mm"] = (
+                f"automatic: iris {analysis.iris_diameter_px:.1f} px = 11.7 mm at focal "
+                f"{f:.0f} px -> {distance:.0f} mm (camera to eyes)"
+            )
+    priors["sources"] = sources
+    return priors
+
+
+def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_width_mm=None):
+    """Write a photo folder from a photograph.
+
+    Parameters
+    ----------
+    image_path : str or Path
+        PNG or JPEG (any format Pillow reads; others are stored as ``image.png``).
+    out_dir : str or Path
+        The photo folder (created; files of the same names are replaced).
+    view : {"frontal", "lateral_left", "lateral_right"}, optional
+        Default: from the fitted yaw (frontal under 30 degrees).
+    landmarks_path : str or Path, optional
+        Reviewed landmarks (the review page's ``landmarks.json``, or any SPEC facial landmark
+        file): they replace the automatic ones and count as confirmed.
+    sensor_width_mm : float, optional
+        For the EXIF focal (see :mod:`lilium.io.exif`).
+
+    Returns
+    -------
+    PreparedPhoto
+        ``face_found`` is False when the models found no face: the folder then has the image,
+        a ``photo.json`` without automatic landmarks and the review page, to mark by hand.
+    """
+    image_path = Path(image_path)
+    if not image_path.is_file():
+        raise ValueError(f"{image_path}: file not found; check the photo's path")
+    image = read_image(image_path)
+    h, w = image.shape[:2]
+    reviewed = read_landmarks(landmarks_path, "facial") if landmarks_path else None
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"{out}: exists and is not a folder; give a folder for --out")
+    analysis = analyse_face(image)
+    view = view or (analysis.view if analysis else "frontal")
+    landmarks, sources = dict(analysis.landmarks), dict(analysis.sources)
+    if reviewed is not None:
+        for name, uv in reviewed.items():
+            u, v = uv
+            if not (-0.5 <= u <= w - 0.5 and -0.5 <= v <= h - 0.5):
+                raise ValueError(
+                    f"{landmarks_path}: {name} = ({u:g}, {v:g}) lies outside the {w}x{h} "
+                    f"image {image_path.name}; u is the column and v the row, in pixels"
+                )
+        quality = {k: s["quality"] for k, s in sources.items()}
+        landmarks = dict(reviewed)
+        sources = {
+            k: {"source": "reviewed", "quality": quality.get(k, "manual"), "confirmed": True}
+            for k in reviewed
+        }
+    out.mkdir(parents=True, exist_ok=True)
+    _copy_image(image_path, image, out)
+    priors = _priors(image_path, analysis, sensor_width_mm)
+    meta = {
+        "view": view,
+        "landmarks": {k: [round(float(x), 2) for x in v] for k, v in landmarks.items()},
+        "landmark_sources": sources,
+        "priors": priors,
+    }
+    write_json(out / "photo.json", meta)
+    outline = np.zeros((0, 2))
+    if analysis:
+        from PIL import Image
+
+        Image.fromarray(analysis.mask.astype(np.uint8) * 255).save(out / "face_mask.png")
+        outline = mask_outline(analysis.mask)
+    elif (out / "face_mask.png").is_file():
+        (out / "face_mask.png").unlink()  # a stale mask from an earlier run would mislead
+    n_tracked = sum(s["quality"] == "tracked" for s in sources.values())
+    n_template = sum(s["quality"] == "template" for s in sources.values())
+    if analysis:
+        yaw, pitch, roll = (analysis.angles_deg[k] for k in ("yaw", "pitch", "roll"))
+        message = (
+            f"{n_tracked} tracked and {n_template} template landmarks, view {view}, head yaw "
+            f"{yaw:.0f} pitch {pitch:.0f} roll {roll:.0f} deg; review them in "
+            f"{out / 'review.html'}"
+        )
+    else:
+        message = f"{image_path}: {analysis.message}"
+    page = review_page(image, meta["landmarks"], sources, outline, priors, image_path.name, message)
+    (out / "review.html").write_text(page, encoding="utf-8")
+    return PreparedPhoto(out, bool(analysis), message, view, n_tracked, n_template)
