@@ -3,6 +3,7 @@
 from pathlib import Path
 
 from ..io.case import read_depth_table
+from ..io.paths import safe_id
 from ..io.results import write_result
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
@@ -70,7 +71,8 @@ def run_case(
         for method in methods:
             result = run_sfo(method, skull, photo, options, seed)
             tag = method_tag(method, options.variant)
-            folder = out / photo.id / tag if len(methods) > 1 else out / photo.id
+            folder = out / safe_id(photo.id)  # ids read from files are safe already
+            folder = folder / tag if len(methods) > 1 else folder
             write_result(folder, result, result_overlay(result, skull, photo))
             rel = folder.relative_to(out)
             outputs = {"result.json": f"{rel.as_posix()}/result.json"}
