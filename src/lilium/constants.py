@@ -30,3 +30,27 @@ NORMAL_NEIGHBOURHOOD_MM = 4.0
 
 #: MSAC inlier threshold (pixels) of POSEST's RANSAC stage.
 RANSAC_THRESHOLD_PX = 12.0
+
+# -- input limits (docs/checks.md) ---------------------------------------------------------------
+
+#: Most pixels a photo (or mask) may have: 100 megapixels, every camera short of medium format.
+#: An SFO needs no more (landmarks are marked to a pixel); a larger photo is an error that says
+#: how to downscale it, rather than an unbounded decode.
+MAX_PHOTO_PIXELS = 100_000_000
+
+#: Shortest photo side (pixels) an SFO is attempted on.
+MIN_PHOTO_SIDE_PX = 32
+
+#: Smallest extent of a photo's facial landmarks (the longest distance between two of them), as
+#: a fraction of the photo's longer side, and in pixels at least: a smaller face is too small
+#: to superimpose (or the landmarks are all at one place).
+MIN_LANDMARK_EXTENT_FRACTION = 0.01
+MIN_LANDMARK_EXTENT_PX = 16.0
+
+#: Smallest ratio of a landmark configuration's spread across its main direction to its spread
+#: along it (the second to the first singular value of the centred points): below it the
+#: landmarks lie on a line and do not fix a camera (2D) or a pose (3D).
+MIN_LANDMARK_SPREAD_RATIO = 0.02
+
+#: Smallest extent of the cranial landmarks as a fraction of the skull mesh's extent.
+MIN_CRANIAL_EXTENT_FRACTION = 0.05

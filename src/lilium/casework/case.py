@@ -2,13 +2,13 @@
 
 from pathlib import Path
 
-from ..inputs import correspondences
 from ..io.case import read_depth_table
+from ..io.paths import safe_id
 from ..io.results import write_result
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
-from .inputs import load_photos, load_skull
+from .inputs import check_runnable, load_photos, load_skull
 
 
 def run_case(
@@ -64,18 +64,15 @@ def run_case(
 
         options = replace(options, depth_table=read_depth_table(depth_table))
     for photo, inputs, _ in records:  # every problem before any long run
-        try:
-            correspondences(skull, photo)
-        except ValueError as exc:
-            where = inputs.get("facial landmarks") or inputs.get("photo.json")
-            raise ValueError(f"{where}: {exc}") from None
+        check_runnable(skull, photo, methods, options.variant, skull_inputs, inputs)
     out = Path(out)
     entries = []
     for photo, inputs, notes in records:
         for method in methods:
             result = run_sfo(method, skull, photo, options, seed)
             tag = method_tag(method, options.variant)
-            folder = out / photo.id / tag if len(methods) > 1 else out / photo.id
+            folder = out / safe_id(photo.id)  # ids read from files are safe already
+            folder = folder / tag if len(methods) > 1 else folder
             write_result(folder, result, result_overlay(result, skull, photo))
             rel = folder.relative_to(out)
             outputs = {"result.json": f"{rel.as_posix()}/result.json"}

@@ -9,7 +9,14 @@ image's landmark file to ``<stem>.csv``/``.json`` or ``<stem>_landmarks.*`` and 
 from dataclasses import replace
 from pathlib import Path
 
-from ..io.case import IMAGE_NAMES, photo_from_files, read_photo, read_skull, skull_from_files
+from ..io.case import (
+    IMAGE_NAMES,
+    check_axes_file,
+    photo_from_files,
+    read_photo,
+    read_skull,
+    skull_from_files,
+)
 from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
 from ..validation import check_interval
@@ -29,8 +36,15 @@ def load_skull(skull_path, landmarks=None, axes=None):
     skull : Skull
     inputs : dict of str -> Path
         The files used, labelled, for the provenance.
+
+    Raises
+    ------
+    ValueError
+        Also when ``axes`` is given but is not a file (it is never ignored).
     """
     skull_path = Path(skull_path)
+    if axes is not None:
+        check_axes_file(axes)
     if skull_path.is_dir():
         mesh = _first_file(skull_path, [f"skull{s}" for s in MESH_SUFFIXES])
         if landmarks is None:
@@ -215,3 +229,48 @@ def _json_keys(path):
 
     data = read_json(path)
     return data.keys() if isinstance(data, dict) else ()
+
+
+def check_runnable(skull, photo, methods, variant, skull_inputs, photo_inputs):
+    """Raise the ``ValueError`` an SFO of ``photo`` would raise, before any SFO runs.
+
+    Checks that the landmarks pair (:func:`lilium.inputs.correspondences`) and, for Lilium, what
+    ``variant`` needs: a face mask for P_skof; for P_pll the cranial landmarks that cut the
+    region and a facial curve (``face_curve.json`` or one found in the mask). The message starts
+    with the file to fix.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    methods : sequence of str
+    variant : str
+        Lilium's variant.
+    skull_inputs, photo_inputs : dict of str -> Path
+        The labelled files of :func:`load_skull` and :func:`load_photos`.
+    """
+    from ..geometry.camera import principal_point_of
+    from ..inputs import correspondences
+    from ..methods.lilium import VARIANTS
+    from ..methods.lilium_terms import PllTerm
+
+    photo_file = photo_inputs.get("facial landmarks") or photo_inputs.get("photo.json")
+    try:
+        correspondences(skull, photo)
+    except ValueError as exc:
+        raise ValueError(f"{photo_file}: {exc}") from None
+    if "lilium" not in methods:
+        return
+    use_skof, use_pll = VARIANTS[variant]
+    if use_skof and photo.face_mask is None:
+        raise ValueError(
+            f"{photo_inputs.get('photo')}: no face mask for this photo, which Lilium's {variant} "
+            "variant needs (P_skof); give it (--mask FILE, <stem>_mask.png or face_mask.png) or "
+            "choose --variant base or pll"
+        )
+    if use_pll:
+        try:
+            PllTerm(skull, photo, principal_point_of(photo.image_size_wh))
+        except ValueError as exc:
+            where = skull_inputs.get("cranial landmarks") if str(exc).startswith("skull") else None
+            raise ValueError(f"{where or photo_inputs.get('photo')}: {exc}") from None

@@ -22,7 +22,16 @@ from ..casework.case import run_case
 from ..constants import VIEWS
 from ..methods import METHODS
 from ..optimisation.de import DEOptions
-from .sfo import VARIANTS, options_from
+from .argtypes import output_folder, positive_float, seed
+from .sfo import (
+    AXES_FILE,
+    DEPTH_TABLE_FILE,
+    GENERATIONS,
+    MAX_SECONDS,
+    POPULATION,
+    VARIANTS,
+    options_from,
+)
 
 
 def register(subparsers):
@@ -45,7 +54,9 @@ def register(subparsers):
         type=Path,
         help="cranial landmarks: .mrk.json/.fcsv (3D Slicer), .pp (MeshLab), .csv, .json",
     )
-    p.add_argument("--axes", type=Path, help="soft-tissue axes JSON (default: the skull's own)")
+    p.add_argument(
+        "--axes", type=AXES_FILE, help="soft-tissue axes JSON (default: the skull's own)"
+    )
     p.add_argument(
         "--photo",
         required=True,
@@ -77,7 +88,7 @@ def register(subparsers):
             "frontal); photo folders take theirs from photo.json"
         ),
     )
-    p.add_argument("--out", required=True, type=Path, help="output folder")
+    p.add_argument("--out", required=True, type=output_folder, help="output folder")
     p.add_argument(
         "--method",
         action="append",
@@ -86,18 +97,26 @@ def register(subparsers):
         help="method; repeat to run several (default lilium)",
     )
     p.add_argument("--variant", default="skof+pll", choices=list(VARIANTS))
-    p.add_argument("--seed", type=int, default=0, help="Lilium random seed (default 0)")
+    p.add_argument("--seed", type=seed, default=0, help="Lilium random seed (default 0)")
     de = DEOptions()
-    p.add_argument("--generations", type=int, help=f"DE generations (default {de.max_generations})")
-    p.add_argument("--population", type=int, help=f"DE population (default {de.population_size})")
-    p.add_argument("--max-seconds", type=float, help=f"per SFO (default {de.max_seconds:g})")
+    p.add_argument(
+        "--generations", type=GENERATIONS, help=f"DE generations (default {de.max_generations})"
+    )
+    p.add_argument(
+        "--population", type=POPULATION, help=f"DE population (default {de.population_size})"
+    )
+    p.add_argument("--max-seconds", type=MAX_SECONDS, help=f"per SFO (default {de.max_seconds:g})")
     p.add_argument("--focal-px", type=float, nargs=2, metavar=("LO", "HI"), help="focal prior")
     p.add_argument("--scd-mm", type=float, nargs=2, metavar=("LO", "HI"), help="SCD prior (mm)")
     p.add_argument(
-        "--sensor-width-mm", type=float, help="camera sensor width, for the EXIF focal prior"
+        "--sensor-width-mm",
+        type=positive_float(),
+        help="camera sensor width, for the EXIF focal prior",
     )
     p.add_argument("--no-exif", action="store_true", help="do not take a focal prior from EXIF")
-    p.add_argument("--depth-table", type=Path, help="CSV: landmark,mean,sd,min,max (mm)")
+    p.add_argument(
+        "--depth-table", type=DEPTH_TABLE_FILE, help="CSV: landmark,mean,sd,min,max (mm)"
+    )
     p.add_argument("--title", help="report title")
     p.set_defaults(func=run)
 

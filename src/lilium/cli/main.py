@@ -2,10 +2,18 @@
 
 Each module in :data:`COMMANDS` has ``register(subparsers)`` that adds its parser and sets
 ``func(args) -> int``. ``main(argv)`` can be called from tests with a list of strings.
+
+Every failure ends in one line on stderr, ``lilium <command>: error: ...``, and exit status 2:
+an input error (``ValueError``, whose message names the file or option and the fix), a file
+the system refuses (``OSError``: permissions, a full disk, a path under a file), memory running
+out, or, as a last resort, any other exception (a bug: the line asks to report it). Set
+:data:`DEBUG_ENV` (``LILIUM_DEBUG=1``) to get the traceback of anything but an input error
+instead; the test suite does, so real bugs stay visible there.
 """
 
 import argparse
 import importlib
+import os
 import sys
 
 from .. import __version__
@@ -23,8 +31,15 @@ COMMANDS = [
 ]
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (the option, the problem, where to look)."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
+
+
 def build_parser():
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="lilium", description="Automated skull-face overlay (Lilium and POSEST-SFO)."
     )
     parser.add_argument("--version", action="version", version=f"lilium {__version__}")
@@ -34,13 +49,51 @@ def build_parser():
     return parser
 
 
+#: Environment variable that makes unexpected exceptions raise (with their traceback).
+DEBUG_ENV = "LILIUM_DEBUG"
+
+
+def _one_line(text):
+    return " ".join(str(text).split())
+
+
+def _describe(exc):
+    """The one-line message of an exception that is not an input error."""
+    if isinstance(exc, OSError):
+        reason = exc.strerror or _one_line(exc) or type(exc).__name__
+        if exc.filename is not None:
+            return (
+                f"{exc.filename}: {reason}; check the path, its permissions and the free disk space"
+            )
+        return f"{reason} ({type(exc).__name__}); check the paths and the free disk space"
+    if isinstance(exc, MemoryError):
+        return "out of memory; downscale the photo (see docs/checks.md) or free memory"
+    detail = _one_line(exc)
+    return (
+        f"internal error ({type(exc).__name__}{f': {detail}' if detail else ''}); this is a "
+        f"bug: please report it with the command line and the traceback (run again with "
+        f"{DEBUG_ENV}=1 to see it)"
+    )
+
+
 def main(argv=None):
-    """Run the command; returns the exit status. Input errors print one line and return 2."""
-    args = build_parser().parse_args(argv)
+    """Run the command; returns the exit status (2 for any error, with one line on stderr)."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # --help, --version (0) or a bad argument (2, one line printed)
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
     try:
         return int(args.func(args) or 0)
     except ValueError as exc:
-        print(f"lilium {args.command}: error: {exc}", file=sys.stderr)
+        print(f"lilium {args.command}: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"lilium {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # the last resort: never a traceback for the user
+        if os.environ.get(DEBUG_ENV, "") not in ("", "0"):
+            raise
+        print(f"lilium {args.command}: error: {_describe(exc)}", file=sys.stderr)
         return 2
 
 

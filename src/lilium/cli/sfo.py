@@ -6,8 +6,16 @@ from pathlib import Path
 from ..casework.folders import sfo_on_folders
 from ..methods import METHODS, SfoOptions
 from ..optimisation.de import DEOptions
+from .argtypes import existing_file, int_in, output_folder, positive_float, seed
 
 VARIANTS = METHODS["lilium"].variants
+
+#: Argument types shared with ``lilium case`` (a bad value names its option; exit 2).
+GENERATIONS = int_in(1)
+POPULATION = int_in(4, why=" (DE/rand/1 draws three other members)")
+MAX_SECONDS = positive_float(allow_inf=True)
+AXES_FILE = existing_file("soft-tissue axes file")
+DEPTH_TABLE_FILE = existing_file("depth table")
 
 
 def register(subparsers):
@@ -18,7 +26,7 @@ def register(subparsers):
     )
     p.add_argument("--skull", required=True, type=Path, help="subject folder (SPEC section 8)")
     p.add_argument("--photo", required=True, type=Path, help="photo folder (SPEC section 8)")
-    p.add_argument("--out", required=True, type=Path, help="output folder")
+    p.add_argument("--out", required=True, type=output_folder, help="output folder")
     p.add_argument("--method", default="posest-sfo", choices=list(METHODS))
     p.add_argument(
         "--variant",
@@ -26,28 +34,32 @@ def register(subparsers):
         choices=list(VARIANTS),
         help="Lilium fitness variant (default skof+pll)",
     )
-    p.add_argument("--seed", type=int, default=0, help="Lilium random seed (default 0)")
+    p.add_argument("--seed", type=seed, default=0, help="Lilium random seed (default 0)")
     de = DEOptions()
     p.add_argument(
         "--generations",
-        type=int,
+        type=GENERATIONS,
         default=de.max_generations,
         help=f"Lilium: DE generations at most (default {de.max_generations})",
     )
     p.add_argument(
         "--population",
-        type=int,
+        type=POPULATION,
         default=de.population_size,
         help=f"Lilium: DE population size (default {de.population_size})",
     )
     p.add_argument(
         "--max-seconds",
-        type=float,
+        type=MAX_SECONDS,
         default=de.max_seconds,
         help=f"Lilium: wall-clock limit in seconds (default {de.max_seconds:g})",
     )
-    p.add_argument("--axes", type=Path, help="soft-tissue axes JSON to use instead of the skull's")
-    p.add_argument("--depth-table", type=Path, help="CSV: landmark,mean,sd,min,max (mm)")
+    p.add_argument(
+        "--axes", type=AXES_FILE, help="soft-tissue axes JSON to use instead of the skull's"
+    )
+    p.add_argument(
+        "--depth-table", type=DEPTH_TABLE_FILE, help="CSV: landmark,mean,sd,min,max (mm)"
+    )
     p.add_argument("--no-overlay", action="store_true", help="skip overlay.png")
     p.set_defaults(func=run)
 

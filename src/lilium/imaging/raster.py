@@ -311,6 +311,10 @@ def winding_intervals(crossings):
     return np.take(c.member, sel), np.take(c.row, sel), np.take(start, sel), np.take(stop, sel)
 
 
+#: Pixels per block of rows when a union raster is accumulated (bounds its temporaries).
+RASTER_BLOCK_PIXELS = 1 << 20
+
+
 def rasterise_union(uv, topology, shape):
     """Boolean raster of the union of projected triangles.
 
@@ -329,11 +333,22 @@ def rasterise_union(uv, topology, shape):
     uv = np.asarray(uv, dtype=float)[None]
     c = scan_crossings(uv, topology, row_range=(0, height), col_range=(0, width))
     _, row, start, stop = winding_intervals(c)
-    n = height * (width + 1)
-    diff = np.bincount(row * (width + 1) + start, minlength=n) - np.bincount(
-        row * (width + 1) + stop, minlength=n
-    )
-    return np.cumsum(diff.reshape(height, width + 1), axis=1)[:, :width] > 0
+    mask = np.zeros((height, width), bool)
+    if len(row) == 0:
+        return mask
+    # Interval ends counted per row and summed along it, over blocks of rows: the int64
+    # temporaries stay at RASTER_BLOCK_PIXELS whatever the image's size.
+    step = max(1, RASTER_BLOCK_PIXELS // (width + 1))
+    for r0 in range(int(row.min()), int(row.max()) + 1, step):
+        r1 = min(r0 + step, height)
+        sel = (row >= r0) & (row < r1)
+        n = (r1 - r0) * (width + 1)
+        base = (row[sel] - r0) * (width + 1)
+        diff = np.bincount(base + start[sel], minlength=n) - np.bincount(
+            base + stop[sel], minlength=n
+        )
+        mask[r0:r1] = np.cumsum(diff.reshape(r1 - r0, width + 1), axis=1)[:, :width] > 0
+    return mask
 
 
 def _check_uv(uv):

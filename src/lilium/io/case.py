@@ -8,15 +8,39 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import VIEWS
+from ..constants import (
+    MIN_CRANIAL_EXTENT_FRACTION,
+    MIN_LANDMARK_EXTENT_FRACTION,
+    MIN_LANDMARK_EXTENT_PX,
+    MIN_LANDMARK_SPREAD_RATIO,
+    MIN_PHOTO_SIDE_PX,
+    VIEWS,
+)
 from ..inputs import Photo, Priors, Skull
 from ..softtissue.depths import DepthStats, check_depth_table
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from ..softtissue.normals import surface_normals_at
 from ..validation import check_interval
 from .formats import find_landmark_file, points_from_object, read_landmarks
+from .images import image_size_wh, read_image, read_mask
 from .jsonio import read_json
 from .mesh import MESH_SUFFIXES, read_mesh
+from .paths import path_id, safe_id
+
+__all__ = [
+    "IMAGE_NAMES",
+    "check_in_image",
+    "check_landmark_layout",
+    "parse_priors",
+    "photo_from_files",
+    "read_depth_table",
+    "read_face_curve",
+    "read_image",
+    "read_mask",
+    "read_photo",
+    "read_skull",
+    "skull_from_files",
+]
 
 IMAGE_NAMES = ("image.png", "image.jpg", "image.jpeg")
 
@@ -50,12 +74,14 @@ def read_skull(folder, axes_path=None):
         Holds ``skull.ply`` (or ``.obj``/``.stl``), ``cranial_landmarks.json`` and optionally
         ``soft_tissue_axes.json``.
     axes_path : str or Path, optional
-        Soft-tissue axes file to use instead of the folder's own (e.g. a perturbed set).
+        Soft-tissue axes file to use instead of the folder's own (e.g. a perturbed set); it
+        must exist (a missing file is an error, never a silent fall-back to the normals).
 
     Returns
     -------
     Skull
-        Axes missing from the file default to the outward skull-surface normal.
+        Axes missing from the file default to the outward skull-surface normal. Its id is the
+        folder's name (:func:`lilium.io.paths.path_id`).
     """
     folder = _check_folder(folder, "subject")
     mesh_path = _find(
@@ -68,8 +94,25 @@ def read_skull(folder, axes_path=None):
     if not lm_path.is_file():
         # A Slicer / MeshLab / CSV file instead (cranial_landmarks.csv, skull.mrk.json, ...).
         lm_path = find_landmark_file(folder, ["cranial_landmarks", "skull"]) or lm_path
-    axes_path = axes_path or folder / "soft_tissue_axes.json"
-    return skull_from_files(mesh_path, lm_path, axes_path, skull_id=folder.name)
+    if axes_path is not None:
+        check_axes_file(axes_path)
+    else:
+        axes_path = folder / "soft_tissue_axes.json"
+    return skull_from_files(mesh_path, lm_path, axes_path, skull_id=path_id(folder, "skull"))
+
+
+def check_axes_file(axes_path, option="soft-tissue axes file"):
+    """Raise a ``ValueError`` naming ``axes_path`` when an explicitly given axes file is not a file.
+
+    The subject folder's own ``soft_tissue_axes.json`` is optional; a file the user names
+    (``--axes``, an experiment's axis set) is not: ignoring it would silently run the SFO with
+    other directions.
+    """
+    if not Path(axes_path).is_file():
+        raise ValueError(
+            f"{axes_path}: {option} not found; check the path (or leave it out to use the "
+            "subject's soft_tissue_axes.json, or the skull-surface normals)"
+        )
 
 
 def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
@@ -85,11 +128,15 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
     axes_path : str or Path, optional
         ``soft_tissue_axes.json``; absent axes default to the outward skull-surface normal.
     skull_id : str, optional
-        Defaults to the mesh's folder name for ``skull.*`` and to the mesh's stem otherwise.
+        Defaults to the mesh's folder name for ``skull.*`` and to the mesh's stem otherwise;
+        made a safe folder name either way (:func:`lilium.io.paths.safe_id`).
     """
     mesh_path, lm_path = Path(mesh_path), Path(landmarks_path)
     if skull_id is None:
-        skull_id = mesh_path.parent.name if mesh_path.stem == "skull" else mesh_path.stem
+        skull_id = (
+            path_id(mesh_path.parent, "skull") if mesh_path.stem == "skull" else mesh_path.stem
+        )
+    skull_id = safe_id(skull_id, "skull")
     vertices, faces = read_mesh(mesh_path)
     if lm_path.name == "cranial_landmarks.json" or not lm_path.is_file():
         raw = _field(lm_path, read_json(lm_path), "landmarks")
@@ -104,6 +151,7 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
                 f"{lm_path}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
                 "must be in the mesh's frame and units"
             )
+    check_landmark_layout(lm_path, landmarks, extent * MIN_CRANIAL_EXTENT_FRACTION, "mm")
     axes = {}
     axes_path = Path(axes_path) if axes_path else None
     if axes_path is not None and axes_path.is_file():
@@ -155,33 +203,16 @@ def parse_priors(path, priors):
     )
 
 
-def read_image(path):
-    """Read an RGB image as ``(H, W, 3)`` uint8, upright; a corrupt file is a ``ValueError``.
-
-    The EXIF Orientation tag is applied (as image viewers do), so landmarks marked on a
-    phone photo stored sideways match the pixels read here.
-    """
-    from PIL import Image, ImageOps, UnidentifiedImageError
-
-    try:
-        with Image.open(path) as im:
-            return np.asarray(ImageOps.exif_transpose(im).convert("RGB"))
-    except (UnidentifiedImageError, OSError, SyntaxError) as exc:
-        raise ValueError(f"{path}: cannot read the image ({exc}); save it as PNG or JPEG") from exc
-
-
-def read_mask(path, image_size_wh):
-    """Read a face mask (non-zero = face) as ``(H, W)`` bool, checking size and emptiness."""
-    mask = read_image(path).max(axis=2) > 0
-    w, h = image_size_wh
-    if mask.shape != (h, w):
+def _photo_pixels(image_path, load_image):
+    """The photo's pixels (or None) and its ``(width, height)``, checking the smallest size."""
+    image = read_image(image_path) if load_image else None
+    size_wh = (image.shape[1], image.shape[0]) if load_image else image_size_wh(image_path)
+    if min(size_wh) < MIN_PHOTO_SIDE_PX:
         raise ValueError(
-            f"{path}: the mask is {mask.shape[1]}x{mask.shape[0]} px but the photo is {w}x{h}; "
-            "make the mask the photo's size"
+            f"{image_path}: the photo is {size_wh[0]}x{size_wh[1]} px, too small to superimpose "
+            f"a skull on (at least {MIN_PHOTO_SIDE_PX} px a side); use the original photograph"
         )
-    if not mask.any():
-        raise ValueError(f"{path}: the face mask is empty; paint the face/head pixels non-zero")
-    return mask
+    return image, size_wh
 
 
 def read_photo(folder, load_image=True):
@@ -191,16 +222,21 @@ def read_photo(folder, load_image=True):
     ----------
     folder : str or Path
     load_image : bool
-        Keep the pixels (for overlays); the size is always read.
+        Keep the pixels (for overlays); without them only the image's header is read (its size).
 
     Returns
     -------
     Photo
+        Its id is the folder's name (:func:`lilium.io.paths.path_id`).
+
+    Raises
+    ------
+    ValueError
+        Every problem of docs/checks.md, naming the file, the field and the fix.
     """
     folder = _check_folder(folder, "photo")
     image_path = _find(folder, IMAGE_NAMES, "photo image", "put the photograph there")
-    image = read_image(image_path)
-    size_wh = (image.shape[1], image.shape[0])
+    image, size_wh = _photo_pixels(image_path, load_image)
     meta_path = folder / "photo.json"
     meta = read_json(meta_path)
     view = _field(meta_path, meta, "view")
@@ -217,27 +253,21 @@ def read_photo(folder, load_image=True):
     else:
         landmarks = read_landmarks(lm_path, "facial")
     check_in_image(lm_path, landmarks, size_wh, image_path.name)
+    check_landmark_layout(lm_path, landmarks, _min_extent_px(size_wh), "px")
     priors = parse_priors(meta_path, meta.get("priors"))
     mask_path = folder / "face_mask.png"
     mask = read_mask(mask_path, size_wh) if mask_path.is_file() else None
-    curve = None
     curve_path = folder / "face_curve.json"
-    if curve_path.is_file():
-        data = read_json(curve_path)
-        key = "chin_jaw" if view == "frontal" else "forehead"
-        if key in data:
-            curve = np.asarray(data[key], dtype=float)
-            if curve.ndim != 2 or curve.shape[1] != 2 or not np.all(np.isfinite(curve)):
-                raise ValueError(f"{curve_path}: {key} must be a list of finite [u, v] pairs")
+    curve = read_face_curve(curve_path, view, size_wh) if curve_path.is_file() else None
     return Photo(
-        folder.name,
+        path_id(folder),
         size_wh,
         view,
         landmarks,
         mask,
         curve,
         priors,
-        image if load_image else None,
+        image,
     )
 
 
@@ -258,6 +288,114 @@ def _without_unconfirmed_templates(landmarks, sources):
             and sources[name].get("confirmed") is not True
         )
     }
+
+
+def read_face_curve(path, view, image_size_wh):
+    """Read ``face_curve.json``: the view's curve as ``(K, 2)`` pixels (SPEC section 8).
+
+    Parameters
+    ----------
+    path : str or Path
+    view : {"frontal", "lateral_left", "lateral_right"}
+        Frontal photos need ``chin_jaw``, lateral ones ``forehead``.
+    image_size_wh : tuple (width, height)
+
+    Returns
+    -------
+    ndarray of shape (K, 2), K >= 2
+
+    Raises
+    ------
+    ValueError
+        Not an object, without the view's curve, fewer than two finite ``[u, v]`` points, or a
+        point outside the image (the curve is in the photo's pixels; P_pll's nearest-point
+        table spans the curve, so a point far outside would make it huge).
+    """
+    key = "chin_jaw" if view == "frontal" else "forehead"
+    data = read_json(path)
+    if not isinstance(data, dict):
+        raise ValueError(
+            f"{path}: must be a JSON object {{{key!r}: [[u, v], ...]}}, got "
+            f"{type(data).__name__}; fix the file or remove it (the mask gives the curve then)"
+        )
+    if key not in data:
+        other = ", ".join(repr(k) for k in data) or "nothing"
+        raise ValueError(
+            f"{path}: no {key!r} curve, which a {view} photo needs (the file holds {other}); "
+            "add it or remove the file (the mask gives the curve then)"
+        )
+    raw = data[key]
+    try:
+        curve = np.asarray(raw, dtype=float)
+    except (TypeError, ValueError):
+        curve = np.empty((0,))
+    if isinstance(raw, str) or curve.ndim != 2 or curve.shape[1] != 2 or len(curve) < 2:
+        raise ValueError(
+            f"{path}: {key} must be a list of at least two [u, v] points (pixels), got "
+            f"{_short(raw)}"
+        )
+    if not np.all(np.isfinite(curve)):
+        raise ValueError(f"{path}: {key} must be a list of finite [u, v] pairs (no NaN)")
+    w, h = image_size_wh
+    outside = ~((curve >= -0.5) & (curve <= np.array([w, h]) - 0.5)).all(axis=1)
+    if outside.any():
+        k = int(np.argmax(outside))
+        raise ValueError(
+            f"{path}: {key}[{k}] = ({curve[k, 0]:g}, {curve[k, 1]:g}) lies outside the {w}x{h} "
+            f"photo ({int(outside.sum())} of {len(curve)} points do); the curve is in the "
+            "photo's pixels, u = column, v = row"
+        )
+    return curve
+
+
+def _short(value, limit=40):
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _min_extent_px(image_size_wh):
+    return max(MIN_LANDMARK_EXTENT_PX, MIN_LANDMARK_EXTENT_FRACTION * max(image_size_wh))
+
+
+def check_landmark_layout(path, landmarks, min_extent, unit):
+    """Raise a ``ValueError`` naming ``path`` when landmarks are tiny, coincident or collinear.
+
+    A camera (from 2D landmarks) or a pose (from 3D ones) needs landmarks spread in two
+    directions: all of them at one place, or on one line, fit a camera at any distance with an
+    excellent score. Checked only with at least :data:`~lilium.constants.MIN_CORRESPONDENCES`
+    landmarks (fewer are reported as too few to pair).
+
+    Parameters
+    ----------
+    path : path
+        The landmark file, for the message.
+    landmarks : dict of str -> ndarray of shape (2,) or (3,)
+    min_extent : float
+        Smallest allowed longest distance between two landmarks (the photo's: 1 % of its longer
+        side, at least 16 px; the skull's: 5 % of the mesh's extent).
+    unit : str
+        ``"px"`` or ``"mm"``.
+    """
+    from ..constants import MIN_CORRESPONDENCES
+
+    if len(landmarks) < MIN_CORRESPONDENCES:
+        return
+    points = np.array(list(landmarks.values()), dtype=float)
+    extent = float(np.max(np.linalg.norm(points[:, None] - points[None], axis=-1)))
+    if extent < min_extent:
+        raise ValueError(
+            f"{path}: the {len(points)} landmarks lie within {extent:.3g} {unit} of each other "
+            f"(at least {min_extent:.3g} {unit} is needed); they are all at one place: check "
+            "their coordinates and units"
+        )
+    spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+    if spread[1] < MIN_LANDMARK_SPREAD_RATIO * spread[0]:
+        raise ValueError(
+            f"{path}: the {len(points)} landmarks lie on one line (spread across it "
+            f"{spread[1] / spread[0]:.1%} of that along it, at least "
+            f"{MIN_LANDMARK_SPREAD_RATIO:.0%} is needed), which fixes no camera; add landmarks "
+            "off that line or check their coordinates"
+        )
 
 
 def check_in_image(path, landmarks_uv, image_size_wh, image_name):
@@ -294,31 +432,32 @@ def photo_from_files(
         Face mask PNG (non-zero = face), the photo's size.
     priors : Priors, optional
     photo_id : str, optional
-        Defaults to the image's stem.
+        Defaults to the image's stem; made a safe folder name either way
+        (:func:`lilium.io.paths.safe_id`).
     """
     image_path = Path(image_path)
     if not image_path.is_file():
         raise ValueError(f"{image_path}: file not found; check the photo's path")
     if view not in VIEWS:
         raise ValueError(f"{image_path}: view must be one of {', '.join(VIEWS)}, got {view!r}")
-    image = read_image(image_path)
-    size_wh = (image.shape[1], image.shape[0])
+    image, size_wh = _photo_pixels(image_path, load_image)
     landmarks = read_landmarks(landmarks_path, "facial")
     check_in_image(landmarks_path, landmarks, size_wh, image_path.name)
+    check_landmark_layout(landmarks_path, landmarks, _min_extent_px(size_wh), "px")
     mask = None
     if mask_path is not None:
         if not Path(mask_path).is_file():
             raise ValueError(f"{mask_path}: file not found; check the face mask's path")
         mask = read_mask(mask_path, size_wh)
     return Photo(
-        photo_id or image_path.stem,
+        safe_id(photo_id or image_path.stem),
         size_wh,
         view,
         landmarks,
         mask,
         None,
         priors or Priors(),
-        image if load_image else None,
+        image,
     )
 
 

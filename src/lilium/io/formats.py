@@ -230,14 +230,42 @@ def name_error(path, where, name, kind):
             f"{_at(path, where)}: {name!r} is a {other} landmark ({elsewhere}) but this file "
             f"holds {kind} landmarks; use the {kind} name (see SPEC section 2) or the other file"
         )
-    choices = list(names) + list(table)
-    close = difflib.get_close_matches(key, choices, n=1, cutoff=0.6)
-    if close:
-        guess = close[0] if close[0] in names else table[close[0]]
-        hint = f"did you mean {guess!r}?"
+    guess = suggest_name(key, kind)
+    if guess:
+        hint = f"did you mean {guess}?"
     else:
         hint = f"use a {kind} name of SPEC section 2 (e.g. {names[0]!r})"
     return ValueError(f"{_at(path, where)}: unknown {kind} landmark {name!r}; {hint}")
+
+
+def suggest_name(key, kind):
+    """The closest known landmark to a normalised unknown name, quoted, keeping its side.
+
+    A misspelt bilateral name keeps the side it was written with (``exocanthoin_L`` ->
+    ``'exocanthion_l'``, ``l_exocantion`` -> ``'exocanthion_l'``); when its side cannot be read
+    both are offered (``'exocanthion_l' or 'exocanthion_r'``), never the other side alone.
+
+    Returns
+    -------
+    str or None
+        ``None`` when nothing is close.
+    """
+    names, _ = _known(kind)
+    table, sided = _TABLES[kind], _SIDED[kind]
+    for base, s in _side_splits(key):
+        if kind == "facial":
+            base = _strip_facial_decorations(base)
+        close = difflib.get_close_matches(base, list(table), n=1, cutoff=0.6)
+        if close and table[close[0]] in sided:
+            return repr(f"{table[close[0]]}_{s}")
+    close = difflib.get_close_matches(key, list(names) + list(table), n=1, cutoff=0.6)
+    if not close:
+        return None
+    guess = close[0] if close[0] in names else table[close[0]]
+    if side(guess) or guess in sided:
+        base = base_name(guess)
+        return f"{base + '_l'!r} or {base + '_r'!r} (the subject's left or right)"
+    return repr(guess)
 
 
 def canonical_points(path, entries, kind, dim=None, allow_empty=False, finite=True):

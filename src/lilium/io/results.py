@@ -19,6 +19,9 @@ def write_png(path, rgb):
 def write_result(out_dir, result, overlay_rgb=None):
     """Write ``out_dir/result.json`` and, when given, ``out_dir/overlay.png``.
 
+    Without an overlay, an ``overlay.png`` left in ``out_dir`` by an earlier run is removed: it
+    would show another camera than the ``result.json`` beside it.
+
     Returns
     -------
     Path
@@ -26,9 +29,12 @@ def write_result(out_dir, result, overlay_rgb=None):
     """
     out_dir = Path(out_dir)
     path = out_dir / "result.json"
+    overlay = out_dir / "overlay.png"
+    if overlay_rgb is None and (overlay.is_file() or overlay.is_symlink()):
+        overlay.unlink()
     write_json(path, result.to_dict())
     if overlay_rgb is not None:
-        write_png(out_dir / "overlay.png", overlay_rgb)
+        write_png(overlay, overlay_rgb)
     return path
 
 

@@ -21,6 +21,7 @@ pictures are base64 ``data:`` URIs, styles and script are inline.
 import base64
 import functools
 import html
+import urllib.parse
 from importlib import resources
 from pathlib import Path
 from string import Template
@@ -251,11 +252,21 @@ def _files_table(sfo):
     return _table(["input", "file", "size", "SHA-256"], rows, "files")
 
 
+def relative_href(path):
+    """A link to a file beside the report: the path percent-encoded, so it can only be relative.
+
+    A folder named ``javascript:alert(1)`` or ``https:x`` must stay a folder, not become a
+    scheme: ``:`` and every other reserved character are encoded (``/`` kept between parts), and
+    leading slashes are dropped (no absolute or ``//host`` links).
+    """
+    return urllib.parse.quote(str(path).replace("\\", "/").lstrip("/"), safe="/")
+
+
 def _outputs(sfo):
     if not sfo.outputs:
         return ""
     links = " &middot; ".join(
-        f'<a href="{_e(href)}">{_e(label)}</a>' for label, href in sfo.outputs
+        f'<a href="{_e(relative_href(href))}">{_e(label)}</a>' for label, href in sfo.outputs
     )
     return f"<p>Outputs: {links}</p>"
 
