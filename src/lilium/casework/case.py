@@ -5,6 +5,7 @@ from pathlib import Path
 from ..inputs import correspondences
 from ..io.case import read_depth_table
 from ..io.results import write_result
+from ..methods.lilium_terms import check_variant_inputs
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
@@ -36,8 +37,10 @@ def run_case(
         Photo folders or images; ``photo_options`` go to
         :func:`~lilium.casework.inputs.load_photos`.
     out : path
-        Output folder: ``report.html`` and, per photo, ``<photo>/result.json`` and
-        ``overlay.png`` (``<photo>/<method tag>/`` when several methods run).
+        Output folder: ``report.html`` and, per photo and method, one folder
+        ``<photo>/<method tag>/`` (:func:`~lilium.methods.method_tag`: ``posest-sfo``,
+        ``lilium-skof+pll``, ...) with ``result.json`` and ``overlay.png``, however many
+        methods run: one layout for scripts to read.
     landmarks, axes : path, optional
     methods : sequence of str
     options : SfoOptions
@@ -46,7 +49,7 @@ def run_case(
     title, command : str, optional
         Report title and the equivalent command line (provenance).
     log : callable
-        Receives one line per SFO.
+        Receives one line per sidecar file found beside a mesh or an image, and one per SFO.
 
     Returns
     -------
@@ -57,8 +60,8 @@ def run_case(
     methods = list(dict.fromkeys(methods)) or ["lilium"]
     for method in methods:
         check_method(method, options.variant)
-    skull, skull_inputs = load_skull(skull_path, landmarks, axes)
-    records = load_photos(photos, **photo_options)
+    skull, skull_inputs = load_skull(skull_path, landmarks, axes, log=log)
+    records = load_photos(photos, log=log, **photo_options)
     if depth_table:
         from dataclasses import replace
 
@@ -69,13 +72,15 @@ def run_case(
         except ValueError as exc:
             where = inputs.get("facial landmarks") or inputs.get("photo.json")
             raise ValueError(f"{where}: {exc}") from None
+        if "lilium" in methods:
+            check_variant_inputs(skull, photo, options.variant)
     out = Path(out)
     entries = []
     for photo, inputs, notes in records:
         for method in methods:
             result = run_sfo(method, skull, photo, options, seed)
             tag = method_tag(method, options.variant)
-            folder = out / photo.id / tag if len(methods) > 1 else out / photo.id
+            folder = out / photo.id / tag
             write_result(folder, result, result_overlay(result, skull, photo))
             rel = folder.relative_to(out)
             outputs = {"result.json": f"{rel.as_posix()}/result.json"}

@@ -14,6 +14,7 @@ from ..softtissue.depths import DepthStats, check_depth_table
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from ..softtissue.normals import surface_normals_at
 from ..validation import check_interval
+from .curves import read_face_curve
 from .formats import find_landmark_file, points_from_object, read_landmarks
 from .jsonio import read_json
 from .mesh import MESH_SUFFIXES, read_mesh
@@ -219,15 +220,8 @@ def read_photo(folder, load_image=True):
     priors = parse_priors(meta_path, meta.get("priors"))
     mask_path = folder / "face_mask.png"
     mask = read_mask(mask_path, size_wh) if mask_path.is_file() else None
-    curve = None
     curve_path = folder / "face_curve.json"
-    if curve_path.is_file():
-        data = read_json(curve_path)
-        key = "chin_jaw" if view == "frontal" else "forehead"
-        if key in data:
-            curve = np.asarray(data[key], dtype=float)
-            if curve.ndim != 2 or curve.shape[1] != 2 or not np.all(np.isfinite(curve)):
-                raise ValueError(f"{curve_path}: {key} must be a list of finite [u, v] pairs")
+    curve = read_face_curve(curve_path, view, size_wh) if curve_path.is_file() else None
     return Photo(
         folder.name,
         size_wh,

@@ -28,7 +28,7 @@ from string import Template
 import numpy as np
 
 from .records import ReportEntry, report_record
-from .svg import curve_svg, marks_svg
+from .svg import curve_svg, marks_svg, skull_view_defs, skull_view_svg
 
 #: Initial skull-layer opacity (percent).
 DEFAULT_OPACITY_PCT = 60
@@ -125,6 +125,18 @@ def _layers(sfo):
         )
     out.append(marks_svg(sfo.landmarks, pics.box))
     return "".join(out)
+
+
+def _skull_views(sfo):
+    if not sfo.skull_views:
+        return (
+            "<p class='muted'>No skull-alone views: the cranial landmarks cannot orient the "
+            "skull (give porion_l, porion_r and an orbitale, or upper and lower midline "
+            "landmarks).</p>"
+        )
+    numbers = dict(sfo.cranial_numbers)
+    figures = "".join(f"<figure>{skull_view_svg(p, numbers)}</figure>" for p in sfo.skull_views)
+    return _fill("skull_views.html", figures=figures)
 
 
 def _controls(sfo):
@@ -298,6 +310,7 @@ def format_sfo(sfo):
         box_h=box_h,
         layers=_layers(sfo),
         controls=_controls(sfo),
+        skull_views=_skull_views(sfo),
         landmarks=_landmark_table(sfo),
         camera=_camera_table(sfo),
         terms=_terms_table(sfo),
@@ -306,6 +319,12 @@ def format_sfo(sfo):
         files=_files_table(sfo),
         outputs=_outputs(sfo),
     )
+
+
+def _skull_view_defs(page):
+    """The page's skull-alone pictures, embedded once (each SFO's views refer to them)."""
+    unique = {p.key: p for sfo in page.sfos for p in sfo.skull_views}
+    return skull_view_defs(unique.values(), _data_uri)
 
 
 def format_report(page):
@@ -326,14 +345,14 @@ def format_report(page):
     return _fill(
         "report.html",
         title=_e(page.title),
-        css=template_text("report.css"),
+        css=template_text("report.css") + template_text("pictures.css"),
         js=template_text("report.js"),
         version=_e(page.lilium_version),
         date=_e(page.date),
         count=len(page.sfos),
         skulls=_e(", ".join(page.skull_ids)),
         summary=_table(SUMMARY_HEADER, [_summary_row(s) for s in page.sfos], "num"),
-        sections="\n".join(format_sfo(s) for s in page.sfos),
+        sections=_skull_view_defs(page) + "\n".join(format_sfo(s) for s in page.sfos),
         provenance=_table(["", ""], provenance, "kv"),
     )
 
