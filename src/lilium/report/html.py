@@ -1,14 +1,19 @@
 """A self-contained HTML report of one case: one skull, one or more photos, one or more methods.
 
 Formats the plain records of :mod:`lilium.report.records` into the templates shipped in
-``lilium/report/templates/`` (``report.html``, ``sfo.html``, ``controls.html``, ``report.css``,
-``report.js``), filled with :class:`string.Template`. Each SFO gets a section with
+``lilium/report/templates/`` (``report.html``, ``sfo.html``, ``controls.html``,
+``skull_views.html``, ``report.css``, ``pictures.css``, ``report.js``), filled with
+:class:`string.Template`. Each SFO gets a section with
 
 - the overlay as two stacked pictures (the photo, and the shaded skull as an RGBA layer that is
   transparent off the skull), an opacity slider for the skull layer and a wipe (slider, or drag
   on the picture) that shows the skull only left of a position, by CSS ``clip-path``; the
   landmarks as an SVG layer (photo landmark: ring, estimate: dot, joined by a line) and, with a
   face mask, the skull pixels outside it;
+- the skull alone in a frontal and a lateral view with its cranial landmarks marked and
+  labelled (numbered as in the landmark table where the SFO used them), so a misplaced or
+  mislabelled landmark shows; each view's picture is embedded once per page (an SVG
+  ``<image>`` that every SFO's view ``<use>``-s);
 - the landmark table (photo point, projected estimate, error in pixels), the camera (focal
   length, subject-to-camera distance, rotation, ``skull2cam``), each fitness term, the fitness
   curve (inline SVG);
