@@ -51,9 +51,11 @@ def test_folders_two_photos_one_report(case, tmp_path, capsys):
     code, stdout, err = _run(argv + ["--method", "posest-sfo", "--out", out], capsys)
     assert code == 0, err
     for photo_id in ("standin_frontal", "standin_frontal_2"):
-        result = json.loads((out / photo_id / "result.json").read_text())
+        # One layout whatever the number of methods: OUT/<photo>/<method>[-<variant>]/.
+        assert not (out / photo_id / "result.json").exists()
+        result = json.loads((out / photo_id / "posest-sfo" / "result.json").read_text())
         assert result["method"] == "posest-sfo" and result["camera"]["focal_px"] > 0
-        assert (out / photo_id / "overlay.png").is_file()
+        assert (out / photo_id / "posest-sfo" / "overlay.png").is_file()
     text = (out / "report.html").read_text()
     assert 'id="sfo-1"' in text and 'id="sfo-2"' in text and "standin_frontal_2" in text
     assert "2470-2730 px (photo.json)" in text
@@ -65,8 +67,12 @@ def test_plain_files_with_aliases_and_both_methods(files, tmp_path, capsys):
     argv = ["case", "--skull", files / "skull.ply", "--photo", files / "front.png"]
     argv += ["--method", "posest-sfo", "--method", "lilium", "--variant", "base"]
     argv += ["--generations", "3", "--population", "12", "--scd-mm", "800", "1000"]
-    code, _, err = _run(argv + ["--focal-px", "2400", "2800", "--out", out], capsys)
+    code, stdout, err = _run(argv + ["--focal-px", "2400", "2800", "--out", out], capsys)
     assert code == 0, err
+    # Every sidecar file picked up is said, with its name.
+    assert "skull: using cranial landmarks skull.fcsv (found beside the mesh)" in stdout
+    assert "front: using facial landmarks front.csv (found beside the photo)" in stdout
+    assert "front: using mask front_mask.png (found beside the photo)" in stdout
     posest = json.loads((out / "front" / "posest-sfo" / "result.json").read_text())
     lilium = json.loads((out / "front" / "lilium-base" / "result.json").read_text())
     assert (
@@ -213,3 +219,105 @@ def test_command_line_mistakes(files, case, tmp_path, capsys):
     _, photo_dir = case
     argv = _argv(files, tmp_path) + ["--photo", photo_dir, "--photo-landmarks", files / "x.csv"]
     _one_line_error(capsys, argv, "--photo-landmarks given 2 times for 1 photo", "once per")
+
+
+def _add_mandible_landmarks(files):
+    """Give the stand-in skull the landmarks of the chin-jaw region (pll, frontal)."""
+    from standin_case import SKULL_RADII_MM, _direction, _surface_point
+
+    lines = (files / "skull.fcsv").read_text().splitlines()
+    for k, (name, az) in enumerate(
+        (("infradentale", 0), ("mental_foramen_l", 25), ("mental_foramen_r", -25))
+    ):
+        p, _ = _surface_point(_direction(az, -40), SKULL_RADII_MM)
+        lines.append(f"vtkMRMLMarkupsFiducialNode_m{k},{p[0]},{p[1]},{p[2]},0,0,0,1,1,1,0,{name},,")
+    (files / "skull.fcsv").write_text("\n".join(lines) + "\n")
+
+
+def _chin_curve(files):
+    """A chin-jaw curve for the stand-in photo: the mask's lowest row, left to right."""
+    mask = np.asarray(Image.open(files / "front_mask.png").convert("L")) > 0
+    rows, cols = np.nonzero(mask)
+    bottom = rows.max()
+    us = np.arange(cols[rows == bottom].min(), cols[rows == bottom].max() + 1, 4.0)
+    return [[float(u), float(bottom)] for u in us] + [[float(us[-1]) + 2, float(bottom) - 2]]
+
+
+def test_face_curve_option_and_sidecar(files, tmp_path, capsys):
+    _add_mandible_landmarks(files)
+    curve = {"chin_jaw": _chin_curve(files)}
+    (files / "chin.json").write_text(json.dumps(curve))
+    base = ["case", "--skull", files / "skull.ply", "--photo", files / "front.png"]
+    base += ["--method", "lilium", "--variant", "pll", "--generations", "2", "--population", "8"]
+    out = tmp_path / "out"
+    code, stdout, err = _run(base + ["--face-curve", files / "chin.json", "--out", out], capsys)
+    assert code == 0, err
+    assert "using face curve" not in stdout  # named on the command line: nothing to announce
+    text = (out / "report.html").read_text()
+    assert "chin.json" in text and "--face-curve" in text
+    assert (out / "front" / "lilium-pll" / "result.json").is_file()
+    # The same file beside the image is picked up, and said.
+    (files / "chin.json").rename(files / "front_face_curve.json")
+    code, stdout, err = _run(base + ["--out", tmp_path / "out2"], capsys)
+    assert code == 0, err
+    assert "front: using face curve front_face_curve.json (found beside the photo)" in stdout
+    # A curve file without the photo's view's curve is an error naming it, not ignored.
+    (files / "front_face_curve.json").write_text(json.dumps({"forehead": [[1, 2], [3, 4]]}))
+    _one_line_error(
+        capsys,
+        base + ["--out", tmp_path / "out3"],
+        "front_face_curve.json",
+        "no 'chin_jaw' curve for this frontal photo",
+        "forehead",
+    )
+    (files / "front_face_curve.json").write_text(json.dumps({"chin_jaw": [[1, 2], [5000, 4]]}))
+    _one_line_error(
+        capsys, base + ["--out", tmp_path / "out4"], "front_face_curve.json", "outside the"
+    )
+    argv = base + ["--face-curve", files / "a.json", "--face-curve", files / "b.json"]
+    _one_line_error(capsys, argv + ["--out", tmp_path], "--face-curve given 2 times for 1 photo")
+
+
+def test_missing_input_messages_suggest_only_variants_that_run(files, tmp_path, capsys):
+    _add_mandible_landmarks(files)
+    chin = _chin_curve(files)
+    (files / "front_mask.png").unlink()
+    base = ["case", "--skull", files / "skull.ply", "--photo", files / "front.png"]
+    base += ["--method", "lilium", "--generations", "2", "--population", "8"]
+    out = tmp_path / "out"
+    # No mask, no curve: only base runs (pll would fail for want of a curve).
+    line = _one_line_error(
+        capsys, base + ["--variant", "skof", "--out", out], "front", "needs a face mask"
+    )
+    assert "--variant base" in line and "--variant pll" not in line
+    line = _one_line_error(
+        capsys, base + ["--variant", "pll", "--out", out], "a face curve or a face mask"
+    )
+    assert "--variant base" in line and "skof" not in line.split("missing,")[1]
+    assert not (out / "front").exists(), "checked before any SFO runs"
+    # With a curve, pll runs: the skof message now suggests it too.
+    (files / "front_face_curve.json").write_text(json.dumps({"chin_jaw": chin}))
+    line = _one_line_error(capsys, base + ["--variant", "skof+pll", "--out", out], "face mask")
+    assert "--variant base or --variant pll" in line
+    # Without the mandible landmarks, pll cannot run even with a curve.
+    lines = (files / "skull.fcsv").read_text().splitlines()
+    keep = [ln for ln in lines if ",infradentale," not in ln]
+    assert len(keep) == len(lines) - 1
+    (files / "skull.fcsv").write_text("\n".join(keep) + "\n")
+    line = _one_line_error(capsys, base + ["--variant", "pll", "--out", out], "infradentale")
+    assert "--variant base" in line and "--variant pll" not in line.split("missing,")[1]
+
+
+def test_help_defines_the_face_mask_and_the_sidecars(capsys):
+    assert main(["case", "--help"]) == 0
+    text = capsys.readouterr().out
+    for needle in (
+        "face, the\n  forehead, the hair and the ears",
+        "upper neck",
+        "not the shoulders" if "not the shoulders" in text else "zero\n  on the shoulders",
+        "NAME_mask.png",
+        "NAME_face_curve.json",
+        "--face-curve",
+        "DIR/<photo>/<method>[-<variant>]/result.json",
+    ):
+        assert needle in text, needle

@@ -228,3 +228,20 @@ def test_exif_orientation_is_applied(tmp_path):
     upright = read_image(tmp_path / "phone.jpg")
     assert upright.shape == (40, 20, 3)
     assert upright[2, 10, 2] > 150 and upright[-3, 10, 0] > 150  # blue band now on top
+
+
+def test_face_curve_of_a_photo_folder(case):
+    _, photo_dir = case
+    curve = [[500.0, 600.0], [600.0, 640.0], [700.0, 600.0]]
+    (photo_dir / "face_curve.json").write_text(json.dumps({"chin_jaw": curve}))
+    assert np.allclose(read_photo(photo_dir).face_curve_uv, curve)
+    # A curve for the other view is an error naming the file, not silently ignored.
+    (photo_dir / "face_curve.json").write_text(json.dumps({"forehead": curve}))
+    with pytest.raises(ValueError, match=r"face_curve.json: no 'chin_jaw' curve .* forehead"):
+        read_photo(photo_dir)
+    (photo_dir / "face_curve.json").write_text(json.dumps({"chin_jaw": [[1, "a"]]}))
+    with pytest.raises(ValueError, match="chin_jaw must be a list of at least two"):
+        read_photo(photo_dir)
+    (photo_dir / "face_curve.json").write_text(json.dumps({"chin_jaw": [[1, 2]]}))
+    with pytest.raises(ValueError, match="chin_jaw must be a list of at least two"):
+        read_photo(photo_dir)

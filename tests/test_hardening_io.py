@@ -312,10 +312,9 @@ def test_photo_path_with_dot_dot_stays_inside_out(case, tmp_path, capsys):
     code, _, err = _run(argv + ["--method", "posest-sfo", "--out", out], capsys)
     assert code == 0, err
     assert sorted(p.name for p in work.iterdir()) == ["out"]
-    assert (out / "standin_frontal" / "result.json").is_file()
-    assert json.loads((out / "standin_frontal" / "result.json").read_text())["photo"] == (
-        "standin_frontal"
-    )
+    result = out / "standin_frontal" / "posest-sfo" / "result.json"
+    assert result.is_file()
+    assert json.loads(result.read_text())["photo"] == "standin_frontal"
 
 
 def test_report_links_cannot_become_scripts(case, tmp_path, capsys):
@@ -328,8 +327,8 @@ def test_report_links_cannot_become_scripts(case, tmp_path, capsys):
     assert code == 0, err
     text = (out / "report.html").read_text()
     assert 'href="javascript:' not in text.lower()
-    assert 'href="javascript_alert%281%29/result.json"' in text
-    assert (out / "javascript_alert(1)" / "result.json").is_file()
+    assert 'href="javascript_alert%281%29/posest-sfo/result.json"' in text
+    assert (out / "javascript_alert(1)" / "posest-sfo" / "result.json").is_file()
     assert (
         relative_href("javascript:alert(1)/overlay.png") == "javascript%3Aalert%281%29/overlay.png"
     )
@@ -439,7 +438,7 @@ def test_bad_third_photo_fails_before_any_sfo(case, tmp_path, capsys, monkeypatc
     calls = []
     monkeypatch.setattr(case_module, "run_sfo", lambda *a, **k: calls.append(a))
     argv = ["case", "--skull", subject_dir, *photos, "--method", "lilium", "--variant", "skof"]
-    _one_line_error(capsys, argv + ["--out", tmp_path / "out"], "photo2", "no face mask")
+    _one_line_error(capsys, argv + ["--out", tmp_path / "out"], "photo2", "needs a face mask")
     assert calls == [] and not (tmp_path / "out").exists()
     # The pll variants need cranial landmarks the stand-in lacks: named before any SFO too.
     argv[argv.index("skof")] = "pll"

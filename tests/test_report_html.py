@@ -13,7 +13,13 @@ from lilium.io.case import read_photo, read_skull
 from lilium.io.provenance import sha256_of
 from lilium.methods.posest_sfo import posest_sfo
 from lilium.report import ReportEntry, build_report, skull_layer_rgba, write_report
-from lilium.report.pictures import view_box
+from lilium.report.pictures import (
+    MIN_ACROSS_PX,
+    picture_scale,
+    picture_size,
+    sfo_pictures,
+    view_box,
+)
 
 CHROMIUM = next(
     (shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)),
@@ -80,6 +86,41 @@ def test_skull_layer_is_transparent_off_the_skull(report):
     assert agree.mean() > 0.995
 
 
+def test_skull_views_beside_every_sfo_embedded_once(report):
+    path, entries = report
+    text = path.read_text()
+    # Frontal photo: a frontal and a left lateral view per SFO, each picture embedded once.
+    assert text.count('<image id="skv1-frontal"') == 1
+    assert text.count('<image id="skv1-lateral_left"') == 1
+    assert text.count('href="#skv1-frontal"') == 2 and text.count('href="#skv1-lateral_left"') == 2
+    assert text.count('class="skull-view"') == 4
+    # The cranial counterparts of the landmark table's rows carry its numbers.
+    assert ">1 ectoconchion_l</text>" in text or ">2 ectoconchion_l</text>" in text
+    assert "subject&#x27;s left" in text and "subject's left" in text
+
+
+def test_small_face_is_pictured_at_least_1000_px_across(report):
+    _, entries = report
+    e = entries[0]
+    for box in [(500, 300, 650, 480), (0, 0, 1200, 900), (10, 10, 4010, 3010)]:
+        w, h = picture_size(box, picture_scale(box))
+        assert min(w, h) >= MIN_ACROSS_PX
+        assert max(w, h) <= max(2000, MIN_ACROSS_PX * max(w, h) / min(w, h)) + 1
+    # A face of 150 x 180 photo pixels: photo (upscaled) and skull layer share one large size.
+    from io import BytesIO
+
+    from PIL import Image
+
+    box = (520, 330, 670, 510)
+    pictures = sfo_pictures(e.result, e.skull, e.photo, box, show_outside=False)
+    photo = Image.open(BytesIO(pictures.photo_jpeg))
+    layer = Image.open(BytesIO(pictures.skull_png))
+    assert photo.size == layer.size and photo.size[0] >= 1000
+    assert layer.mode == "P" and layer.info.get("transparency") is not None
+    rgba = np.asarray(layer.convert("RGBA"))
+    assert set(np.unique(rgba[..., 3])) <= {0, 255} and (rgba[..., 3] == 255).mean() > 0.5
+
+
 def test_view_box_frames_the_skull_and_landmarks():
     covered = np.zeros((900, 1200), dtype=bool)
     covered[300:500, 500:650] = True
@@ -117,6 +158,9 @@ window.addEventListener('load', function () {
     r.drag75 = style(); r.drag75.wipe = wipe.value;
     const box2 = skull.getBoundingClientRect();
     r.layerBox = [box2.width, box2.height, box.width, box.height];
+    r.views = [...sec.querySelectorAll('svg.skull-view')].map(function (v) {
+      return [v.getBoundingClientRect().width, v.querySelector('use').getBBox().width];
+    });
     r.dataBox = stage.dataset.box.split(' ').map(Number);
     const toggle = sec.querySelector('input.show-marks');
     toggle.checked = false; toggle.dispatchEvent(new Event('change'));
@@ -171,7 +215,10 @@ def test_controls_change_what_is_shown_in_headless_chromium(report, tmp_path):
         assert float(r["wipe40"]["opacity"]) == pytest.approx(0.25)
         assert r["drag75"]["wipe"] == "75" and "25%" in r["drag75"]["clip"]
         w, h, sw, sh = r["layerBox"]
-        assert w == pytest.approx(sw) and h == pytest.approx(sh) and w > 300
+        assert w == pytest.approx(sw) and h == pytest.approx(sh) and w >= 1000  # 1,000 px across
+        # Both skull-alone views drawn, each showing its picture (embedded once, used twice).
+        assert len(r["views"]) == 2
+        assert all(width > 300 and used > 0 for width, used in r["views"])
         u0, v0, u1, v1 = r["dataBox"]
         assert h == pytest.approx(w * (v1 - v0) / (u1 - u0), rel=0.01)  # the region's aspect
         assert before["marks"] == "block" and r["noMarks"]["marks"] == "none"

@@ -36,8 +36,10 @@ def run_case(
         Photo folders or images; ``photo_options`` go to
         :func:`~lilium.casework.inputs.load_photos`.
     out : path
-        Output folder: ``report.html`` and, per photo, ``<photo>/result.json`` and
-        ``overlay.png`` (``<photo>/<method tag>/`` when several methods run).
+        Output folder: ``report.html`` and, per photo and method, one folder
+        ``<photo>/<method tag>/`` (:func:`~lilium.methods.method_tag`: ``posest-sfo``,
+        ``lilium-skof+pll``, ...) with ``result.json`` and ``overlay.png``, however many
+        methods run: one layout for scripts to read.
     landmarks, axes : path, optional
     methods : sequence of str
     options : SfoOptions
@@ -46,7 +48,7 @@ def run_case(
     title, command : str, optional
         Report title and the equivalent command line (provenance).
     log : callable
-        Receives one line per SFO.
+        Receives one line per sidecar file found beside a mesh or an image, and one per SFO.
 
     Returns
     -------
@@ -57,8 +59,8 @@ def run_case(
     methods = list(dict.fromkeys(methods)) or ["lilium"]
     for method in methods:
         check_method(method, options.variant)
-    skull, skull_inputs = load_skull(skull_path, landmarks, axes)
-    records = load_photos(photos, **photo_options)
+    skull, skull_inputs = load_skull(skull_path, landmarks, axes, log=log)
+    records = load_photos(photos, log=log, **photo_options)
     if depth_table:
         from dataclasses import replace
 
@@ -71,8 +73,7 @@ def run_case(
         for method in methods:
             result = run_sfo(method, skull, photo, options, seed)
             tag = method_tag(method, options.variant)
-            folder = out / safe_id(photo.id)  # ids read from files are safe already
-            folder = folder / tag if len(methods) > 1 else folder
+            folder = out / safe_id(photo.id) / tag  # ids read from files are safe already
             write_result(folder, result, result_overlay(result, skull, photo))
             rel = folder.relative_to(out)
             outputs = {"result.json": f"{rel.as_posix()}/result.json"}

@@ -1,9 +1,14 @@
 """A user's skull and photos, from SPEC section 8 folders or the files a practitioner has.
 
-A mesh's landmark file defaults to a sibling with the mesh's stem (``skull.fcsv``, ...); an
-image's landmark file to ``<stem>.csv``/``.json`` or ``<stem>_landmarks.*`` and its mask to
-``<stem>_mask.png``. Priors: the command line's ``--focal-px``/``--scd-mm`` override
-``photo.json``; without either, the focal prior comes from the photo's EXIF when it has one.
+Sidecar files, used when the command line does not name the file (each one found is logged,
+e.g. ``front: using mask front_mask.png (found beside the photo)``): a mesh's landmark file is
+a sibling with the mesh's stem (``skull.fcsv``, ``skull.mrk.json``, ...); beside an image
+``<stem>.png``/``.jpg``, its facial landmarks ``<stem>.csv``/``.json``/``.tsv``/``.txt`` or
+``<stem>_landmarks.*``, its face mask ``<stem>_mask.png`` and its facial curve
+``<stem>_face_curve.json``. A photo folder holds its own ``face_mask.png`` and
+``face_curve.json`` (SPEC section 8). Priors: the command line's ``--focal-px``/``--scd-mm``
+override ``photo.json``; without either, the focal prior comes from the photo's EXIF when it
+has one.
 """
 
 from dataclasses import replace
@@ -17,6 +22,7 @@ from ..io.case import (
     read_skull,
     skull_from_files,
 )
+from ..io.curves import read_face_curve
 from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
 from ..validation import check_interval
@@ -28,8 +34,10 @@ def _first_file(folder, names):
     return next((folder / n for n in names if (folder / n).is_file()), None)
 
 
-def load_skull(skull_path, landmarks=None, axes=None):
+def load_skull(skull_path, landmarks=None, axes=None, log=None):
     """Read the skull from a subject folder or a mesh file.
+
+    ``log`` (a callable, optional) receives one line for a landmark file found beside a mesh.
 
     Returns
     -------
@@ -74,6 +82,7 @@ def load_skull(skull_path, landmarks=None, axes=None):
                     f"{skull_path}: no cranial landmark file next to the mesh; give it with "
                     "--landmarks FILE (.mrk.json, .fcsv, .pp, .csv or .json)"
                 )
+            _found(log, skull_path.stem, "cranial landmarks", landmarks, "the mesh")
         skull = skull_from_files(mesh, landmarks, axes)
     else:
         raise ValueError(
@@ -107,6 +116,11 @@ def _sibling(image_path, stems, suffixes):
     return None
 
 
+def _found(log, owner, what, path, beside):
+    if log is not None:
+        log(f"{owner}: using {what} {Path(path).name} (found beside {beside})")
+
+
 def _check_interval(values, option):
     return None if values is None else check_interval(values, f"command line: {option}")
 
@@ -120,6 +134,8 @@ def load_photos(
     scd_mm=None,
     use_exif=True,
     sensor_width_mm=None,
+    face_curves=(),
+    log=None,
 ):
     """Read every photo (folders and image files) with its priors.
 
@@ -127,9 +143,10 @@ def load_photos(
     ----------
     photos : list of path
         Photo folders (SPEC section 8) or PNG/JPEG images.
-    photo_landmarks, masks : list of path
+    photo_landmarks, masks, face_curves : list of path
         Per image file (not folder), in order; landmark files default to a sibling
-        ``<stem>.csv``/``.json``/``<stem>_landmarks.*``, masks to ``<stem>_mask.png``.
+        ``<stem>.csv``/``.json``/``<stem>_landmarks.*``, masks to ``<stem>_mask.png``, facial
+        curves (``face_curve.json`` format) to ``<stem>_face_curve.json``.
     views : list of str
         Once for all images, or once per image (default frontal).
     focal_px, scd_mm : (lo, hi), optional
@@ -137,6 +154,9 @@ def load_photos(
         photo's EXIF gives one when ``use_exif``.
     sensor_width_mm : float, optional
         For the EXIF focal prior.
+    log : callable, optional
+        Receives one line per sidecar file found beside an image (not named on the command
+        line), e.g. ``"front: using mask front_mask.png (found beside the photo)"``.
 
     Returns
     -------
@@ -147,6 +167,7 @@ def load_photos(
     image_files = [p for p in photos if not p.is_dir()]
     lm_files = _per_photo(list(photo_landmarks), len(image_files), "--photo-landmarks")
     masks = _per_photo(list(masks), len(image_files), "--mask")
+    curves = _per_photo(list(face_curves), len(image_files), "--face-curve")
     views = _per_photo(list(views), len(image_files), "--view", allow_one=True)
     focal_cli = _check_interval(focal_px, "--focal-px")
     scd_cli = _check_interval(scd_mm, "--scd-mm")
@@ -180,9 +201,16 @@ def load_photos(
                     f"{path}: no facial landmark file for this photo; give it with "
                     "--photo-landmarks FILE (CSV name,u,v or JSON), once per --photo image"
                 )
+            if lm_files[k_file] is None:
+                _found(log, path.stem, "facial landmarks", lm_file, "the photo")
             mask = masks[k_file] or _sibling(
                 path, [f"{path.stem}_mask", f"{path.stem}.mask"], (".png",)
             )
+            if mask is not None and masks[k_file] is None:
+                _found(log, path.stem, "mask", mask, "the photo")
+            curve = curves[k_file] or _sibling(path, [f"{path.stem}_face_curve"], (".json",))
+            if curve is not None and curves[k_file] is None:
+                _found(log, path.stem, "face curve", curve, "the photo")
             view = views[k_file] or "frontal"
             k_file += 1
             photo = photo_from_files(path, lm_file, view, mask)
@@ -190,6 +218,11 @@ def load_photos(
             inputs["facial landmarks"] = lm_file
             if mask is not None:
                 inputs["face mask"] = mask
+            if curve is not None:
+                photo = replace(
+                    photo, face_curve_uv=read_face_curve(curve, view, photo.image_size_wh)
+                )
+                inputs["face curve"] = curve
         priors = photo.priors
         if focal_cli is not None:
             priors = replace(priors, focal_px=focal_cli)
@@ -252,7 +285,7 @@ def check_runnable(skull, photo, methods, variant, skull_inputs, photo_inputs):
     from ..geometry.camera import principal_point_of
     from ..inputs import correspondences
     from ..methods.lilium import VARIANTS
-    from ..methods.lilium_terms import PllTerm
+    from ..methods.lilium_terms import PllTerm, check_variant_inputs, missing_inputs
 
     photo_file = photo_inputs.get("facial landmarks") or photo_inputs.get("photo.json")
     try:
@@ -262,12 +295,15 @@ def check_runnable(skull, photo, methods, variant, skull_inputs, photo_inputs):
     if "lilium" not in methods:
         return
     use_skof, use_pll = VARIANTS[variant]
-    if use_skof and photo.face_mask is None:
-        raise ValueError(
-            f"{photo_inputs.get('photo')}: no face mask for this photo, which Lilium's {variant} "
-            "variant needs (P_skof); give it (--mask FILE, <stem>_mask.png or face_mask.png) or "
-            "choose --variant base or pll"
-        )
+    missing = missing_inputs(skull, photo, variant)
+    if missing:
+        # Name the file to fix: the skull's landmarks when only cranial landmarks are missing.
+        cranial = all(m.startswith("the cranial landmarks") for m in missing)
+        where = skull_inputs.get("cranial landmarks") if cranial else photo_inputs.get("photo")
+        try:
+            check_variant_inputs(skull, photo, variant)
+        except ValueError as exc:
+            raise ValueError(f"{where}: {exc}") from None
     if use_pll:
         try:
             PllTerm(skull, photo, principal_point_of(photo.image_size_wh))

@@ -4,17 +4,19 @@ Inputs are SPEC section 8 folders or the files a practitioner already has::
 
     lilium case --skull SUBJECT_DIR --photo PHOTO_DIR [--photo PHOTO_DIR ...] --out DIR
     lilium case --skull skull.stl --landmarks skull.mrk.json \\
-        --photo front.jpg --photo-landmarks front.csv [--mask front_mask.png] --out DIR
+        --photo front.jpg --photo-landmarks front.csv [--mask front_mask.png] \\
+        [--face-curve front_face_curve.json] --out DIR
 
-A mesh's landmark file defaults to a sibling with the mesh's stem (``skull.fcsv``, ...); an
-image's landmark file to ``<stem>.csv``/``.json`` or ``<stem>_landmarks.*`` and its mask to
-``<stem>_mask.png``. Priors: ``--focal-px``/``--scd-mm`` override ``photo.json``; without
-either, the focal prior comes from the photo's EXIF when it has one.
+Sidecar files stand in for an option that is not given, and each one found is printed
+(:data:`EPILOG`). Priors: ``--focal-px``/``--scd-mm`` override ``photo.json``; without either,
+the focal prior comes from the photo's EXIF when it has one.
 
-Writes ``DIR/report.html`` and, per photo, ``DIR/<photo>/result.json`` and ``overlay.png``
-(``DIR/<photo>/<method>/`` when several methods run).
+Writes ``DIR/report.html`` and, per photo and method, ``DIR/<photo>/<method>[-<variant>]/``
+with ``result.json`` and ``overlay.png`` (:func:`lilium.methods.method_tag`), whatever the
+number of methods.
 """
 
+import argparse
 import shlex
 from pathlib import Path
 
@@ -33,6 +35,35 @@ from .sfo import (
     options_from,
 )
 
+#: What ``lilium case --help`` says after the options: the face mask, the sidecar files and
+#: the output layout (docs/conventions.md says the same, with a picture).
+EPILOG = """\
+face mask (--mask FILE, NAME_mask.png beside an image, face_mask.png in a photo folder):
+  a PNG of the photo's size, non-zero on the head as seen in the photo: the face, the
+  forehead, the hair and the ears, down to the upper neck just below the chin and jaw; zero
+  on the shoulders, the clothes and the background. Hair makes the mask larger than the
+  skull, and that is intended: the vault under the hair is inside the head. A mask drawn
+  from the hairline to the chin makes the vault count as "skull outside the face" (P_skof,
+  the report's outside figure). Picture: docs/images/face_mask.png (docs/conventions.md).
+
+sidecar files (used when the option is not given; each one found is printed, e.g.
+"front: using mask front_mask.png (found beside the photo)"):
+  beside a mesh SKULL.ply   SKULL.mrk.json/.fcsv/.pp/.csv/.tsv/.txt/.json or
+                            SKULL_landmarks.* (cranial landmarks, --landmarks)
+  beside an image NAME.png  NAME.csv/.json/.tsv/.txt or NAME_landmarks.* (facial
+                            landmarks, --photo-landmarks), NAME_mask.png (face mask,
+                            --mask), NAME_face_curve.json (facial curve, --face-curve)
+  in a photo folder         image.png/.jpg, photo.json, face_mask.png, face_curve.json
+
+facial curve (face_curve.json format): {"chin_jaw": [[u, v], ...]} for a frontal photo,
+  {"forehead": [[u, v], ...]} for a lateral one (pixels); without one, the pll variants
+  derive it from the face mask.
+
+outputs: DIR/report.html, and one folder per photo and method whatever their number,
+  DIR/<photo>/<method>[-<variant>]/result.json and overlay.png, e.g. DIR/front/posest-sfo/
+  and DIR/front/lilium-skof+pll/.
+"""
+
 
 def register(subparsers):
     p = subparsers.add_parser(
@@ -40,8 +71,10 @@ def register(subparsers):
         help="superimpose a skull on one or more photos; HTML report",
         description=(
             "Run the SFO of one skull against each photo and write DIR/report.html with "
-            "DIR/<photo>/result.json and overlay.png."
+            "DIR/<photo>/<method>[-<variant>]/result.json and overlay.png."
         ),
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
         "--skull",
@@ -76,7 +109,20 @@ def register(subparsers):
         action="append",
         type=Path,
         default=[],
-        help="face mask PNG of each photo image, in --photo order",
+        help=(
+            "face mask PNG of each photo image, in --photo order: the head as seen (face, "
+            "forehead, hair, ears, down to the upper neck), see below"
+        ),
+    )
+    p.add_argument(
+        "--face-curve",
+        action="append",
+        type=Path,
+        default=[],
+        help=(
+            "facial curve JSON (face_curve.json format) of each photo image, in --photo order; "
+            "default NAME_face_curve.json beside the image, else derived from the mask"
+        ),
     )
     p.add_argument(
         "--view",
@@ -129,7 +175,7 @@ def command_line(args, methods):
             parts += [f"--{option.replace('_', '-')}", str(getattr(args, option))]
     for photo in args.photo:
         parts += ["--photo", str(photo)]
-    for option in ("photo_landmarks", "mask", "view"):
+    for option in ("photo_landmarks", "mask", "face_curve", "view"):
         for value in getattr(args, option):
             parts += [f"--{option.replace('_', '-')}", str(value)]
     for method in methods:
@@ -166,6 +212,7 @@ def run(args):
         command=command_line(args, methods),
         photo_landmarks=args.photo_landmarks,
         masks=args.mask,
+        face_curves=args.face_curve,
         views=args.view,
         focal_px=args.focal_px,
         scd_mm=args.scd_mm,

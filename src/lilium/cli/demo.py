@@ -14,6 +14,7 @@ def register(subparsers):
 
 def run(args):
     from ..demo import build_demo_case, ground_truth_bpe
+    from ..methods import method_tag
     from .main import main
 
     start = time.perf_counter()
@@ -39,13 +40,15 @@ def run(args):
     ]
     code = main(argv)
     print("\nAgainst the known truth (back-projection error, mm; lower is better):")
+    tags = (method_tag("posest-sfo"), method_tag("lilium", args.variant))
     for photo in photo_dirs:
-        for tag in ("posest-sfo", f"lilium-{args.variant}"):
+        for tag in tags:
             result = out / "case" / photo.name / tag / "result.json"
             if result.is_file():
                 bpe = ground_truth_bpe(result, subject_dir, photo)
                 print(f"  {photo.name:<10} {tag:<18} {bpe:6.2f}")
     print(f"\n  report:  {out / 'case' / 'report.html'}  (open it in a browser)")
+    print(f"  results: {out / 'case'}/<photo>/<method>[-<variant>]/result.json, overlay.png")
     print(f"  data:    {out / 'data'}")
     print(f"  total {time.perf_counter() - start:.0f} s")
     return code

@@ -21,6 +21,7 @@ from ..softtissue.depths import DepthStats, check_depth_table
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from ..softtissue.normals import surface_normals_at
 from ..validation import check_interval
+from .curves import read_face_curve
 from .formats import find_landmark_file, points_from_object, read_landmarks
 from .images import image_size_wh, read_image, read_mask
 from .jsonio import read_json
@@ -288,69 +289,6 @@ def _without_unconfirmed_templates(landmarks, sources):
             and sources[name].get("confirmed") is not True
         )
     }
-
-
-def read_face_curve(path, view, image_size_wh):
-    """Read ``face_curve.json``: the view's curve as ``(K, 2)`` pixels (SPEC section 8).
-
-    Parameters
-    ----------
-    path : str or Path
-    view : {"frontal", "lateral_left", "lateral_right"}
-        Frontal photos need ``chin_jaw``, lateral ones ``forehead``.
-    image_size_wh : tuple (width, height)
-
-    Returns
-    -------
-    ndarray of shape (K, 2), K >= 2
-
-    Raises
-    ------
-    ValueError
-        Not an object, without the view's curve, fewer than two finite ``[u, v]`` points, or a
-        point outside the image (the curve is in the photo's pixels; P_pll's nearest-point
-        table spans the curve, so a point far outside would make it huge).
-    """
-    key = "chin_jaw" if view == "frontal" else "forehead"
-    data = read_json(path)
-    if not isinstance(data, dict):
-        raise ValueError(
-            f"{path}: must be a JSON object {{{key!r}: [[u, v], ...]}}, got "
-            f"{type(data).__name__}; fix the file or remove it (the mask gives the curve then)"
-        )
-    if key not in data:
-        other = ", ".join(repr(k) for k in data) or "nothing"
-        raise ValueError(
-            f"{path}: no {key!r} curve, which a {view} photo needs (the file holds {other}); "
-            "add it or remove the file (the mask gives the curve then)"
-        )
-    raw = data[key]
-    try:
-        curve = np.asarray(raw, dtype=float)
-    except (TypeError, ValueError):
-        curve = np.empty((0,))
-    if isinstance(raw, str) or curve.ndim != 2 or curve.shape[1] != 2 or len(curve) < 2:
-        raise ValueError(
-            f"{path}: {key} must be a list of at least two [u, v] points (pixels), got "
-            f"{_short(raw)}"
-        )
-    if not np.all(np.isfinite(curve)):
-        raise ValueError(f"{path}: {key} must be a list of finite [u, v] pairs (no NaN)")
-    w, h = image_size_wh
-    outside = ~((curve >= -0.5) & (curve <= np.array([w, h]) - 0.5)).all(axis=1)
-    if outside.any():
-        k = int(np.argmax(outside))
-        raise ValueError(
-            f"{path}: {key}[{k}] = ({curve[k, 0]:g}, {curve[k, 1]:g}) lies outside the {w}x{h} "
-            f"photo ({int(outside.sum())} of {len(curve)} points do); the curve is in the "
-            "photo's pixels, u = column, v = row"
-        )
-    return curve
-
-
-def _short(value, limit=40):
-    text = repr(value)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _min_extent_px(image_size_wh):

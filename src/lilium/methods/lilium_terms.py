@@ -22,6 +22,94 @@ from ..geometry.mesh import decimate
 #: Faces of the skull used for P_skof (decimated when larger).
 SKOF_FACES = 5000
 
+#: Cranial landmarks the P_pll region needs, per view kind.
+PLL_LANDMARKS = {
+    "frontal": ("infradentale", "mental_foramen_l", "mental_foramen_r"),
+    "lateral": ("glabella", "metopion"),
+}
+
+
+def _pll_landmarks_missing(skull, view):
+    need = PLL_LANDMARKS["frontal" if view == "frontal" else "lateral"]
+    return [n for n in need if n not in skull.landmarks_mm]
+
+
+def missing_inputs(skull, photo, variant):
+    """What a Lilium variant needs and this skull and photo lack.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    variant : str
+        A key of :data:`lilium.methods.lilium.VARIANTS`.
+
+    Returns
+    -------
+    list of str
+        Plain-words descriptions (empty when the variant can run).
+    """
+    from .lilium import VARIANTS  # the one table (that module imports this one)
+
+    use_skof, use_pll = VARIANTS[variant]
+    missing = []
+    if use_skof and photo.face_mask is None:
+        missing.append("a face mask (face_mask.png in a photo folder, --mask or <stem>_mask.png)")
+    if use_pll:
+        if photo.face_curve_uv is None and photo.face_mask is None:
+            missing.append(
+                "a face curve or a face mask (face_curve.json / --face-curve / "
+                "<stem>_face_curve.json, or a mask to derive it from)"
+            )
+        lm = _pll_landmarks_missing(skull, photo.view)
+        if lm:
+            missing.append(f"the cranial landmarks {', '.join(lm)}")
+    return missing
+
+
+def runnable_variants(skull, photo):
+    """The Lilium variants this skull and photo have every input for, in table order."""
+    from .lilium import VARIANTS
+
+    return tuple(v for v in VARIANTS if not missing_inputs(skull, photo, v))
+
+
+def _missing_message(skull, photo, what, missing, exclude):
+    others = [v for v in runnable_variants(skull, photo) if v not in exclude]
+    suggest = (
+        f"or run --variant {' or --variant '.join(others)}, which these inputs allow"
+        if others
+        else "no Lilium variant runs without them (POSEST-SFO does: --method posest-sfo)"
+    )
+    return (
+        f"skull {skull.id!r}, photo {photo.id!r}: {what} {'; and '.join(missing)}; add what "
+        f"is missing, {suggest}"
+    )
+
+
+def check_variant_inputs(skull, photo, variant):
+    """Raise a ``ValueError`` when ``variant`` lacks an input, suggesting variants that run.
+
+    The suggestion is checked against what is there (mask, curve, mandible or forehead
+    landmarks), so it never proposes a variant that would fail in turn.
+    """
+    missing = missing_inputs(skull, photo, variant)
+    if missing:
+        what = f"Lilium variant {variant!r} needs"
+        raise ValueError(_missing_message(skull, photo, what, missing, (variant,)))
+
+
+def _check_term_inputs(skull, photo, term):
+    """As :func:`check_variant_inputs` for every variant using ``term`` (``skof``/``pll``)."""
+    from .lilium import VARIANTS
+
+    missing = missing_inputs(skull, photo, term)
+    if missing:
+        index = ("skof", "pll").index(term)
+        using = [v for v, terms in VARIANTS.items() if terms[index]]
+        what = f"the {term} variants ({', '.join(using)}) need"
+        raise ValueError(_missing_message(skull, photo, what, missing, using))
+
 
 def decimated(vertices_mm, faces, target_faces):
     """The mesh with at most about ``target_faces`` faces (quadric decimation)."""
@@ -45,11 +133,7 @@ class SkofTerm:
     """
 
     def __init__(self, skull, photo, centre, target_faces=None):
-        if photo.face_mask is None:
-            raise ValueError(
-                f"photo {photo.id!r} has no face_mask.png; the skof variants need the face mask "
-                "(or use the base or pll variant)"
-            )
+        _check_term_inputs(skull, photo, "skof")
         target_faces = SKOF_FACES if target_faces is None else target_faces
         self.vertices_mm, faces = decimated(skull.vertices_mm, skull.faces, target_faces)
         self.context = prepare_skof(faces, photo.face_mask)
@@ -85,18 +169,7 @@ class PllTerm:
     def __init__(self, skull, photo, centre):
         view = photo.view
         lm = skull.landmarks_mm
-        need = (
-            ("infradentale", "mental_foramen_l", "mental_foramen_r")
-            if view == "frontal"
-            else ("glabella", "metopion")
-        )
-        missing = [n for n in need if n not in lm]
-        if missing:
-            raise ValueError(
-                f"skull {skull.id!r}: the pll variants need the cranial landmarks "
-                f"{', '.join(missing)} (in cranial_landmarks.json) to cut the "
-                f"{'chin-jaw' if view == 'frontal' else 'forehead'} region"
-            )
+        _check_term_inputs(skull, photo, "pll")
         frame = anatomical_frame(lm)
         if view == "frontal":
             region = chin_jaw_region(skull.vertices_mm, skull.faces, lm, frame)
@@ -104,13 +177,8 @@ class PllTerm:
             region = forehead_region(skull.vertices_mm, skull.faces, lm, frame)
         if photo.face_curve_uv is not None:
             face_curve = photo.face_curve_uv
-        elif photo.face_mask is not None:
+        else:  # check_variant_inputs: a mask is there
             face_curve = face_curve_from_mask(photo.face_mask, view, photo.landmarks_uv)
-        else:
-            raise ValueError(
-                f"photo {photo.id!r} has neither face_curve.json nor face_mask.png; the pll "
-                "variants need one of them"
-            )
         if len(face_curve) < 2:
             raise ValueError(
                 f"photo {photo.id!r}: the facial {'chin-jaw' if view == 'frontal' else 'forehead'}"

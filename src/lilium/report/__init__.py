@@ -9,12 +9,15 @@ The report is built in two steps, computing first and formatting second:
 - :mod:`~lilium.report.record_types`: the frozen records, of numbers, strings and encoded
   pictures (summary row, landmark rows, camera facts, fitness terms, outside pixels, input
   fingerprints; a page adds the software versions, date and command).
-- :mod:`~lilium.report.pictures`: the pictured region of the photo and its layers (photo
-  JPEG, shaded and outlined skull RGBA PNG, skull-outside-the-face PNG).
+- :mod:`~lilium.report.pictures`: the pictured region of the photo and its layers, at least
+  1,000 px across (photo JPEG upscaled with Lanczos, detailed skull layer as a palette PNG,
+  skull-outside-the-face PNG), and the skull alone in a frontal and a lateral view (JPEG,
+  embedded once per page).
 - :mod:`~lilium.report.html`: formats records into the templates of
   ``lilium/report/templates/`` (HTML, CSS and JS, read with :mod:`importlib.resources`);
   :func:`build_report` and :func:`write_report` do both steps.
-- :mod:`~lilium.report.svg`: the inline SVGs (landmark marks, fitness curve).
+- :mod:`~lilium.report.svg`: the inline SVGs (landmark marks, fitness curve, the skull-alone
+  views with their labelled cranial landmarks).
 
 Input hashing and software versions come from :mod:`lilium.io.provenance`.
 """

@@ -1,14 +1,19 @@
 """A self-contained HTML report of one case: one skull, one or more photos, one or more methods.
 
 Formats the plain records of :mod:`lilium.report.records` into the templates shipped in
-``lilium/report/templates/`` (``report.html``, ``sfo.html``, ``controls.html``, ``report.css``,
-``report.js``), filled with :class:`string.Template`. Each SFO gets a section with
+``lilium/report/templates/`` (``report.html``, ``sfo.html``, ``controls.html``,
+``skull_views.html``, ``report.css``, ``pictures.css``, ``report.js``), filled with
+:class:`string.Template`. Each SFO gets a section with
 
 - the overlay as two stacked pictures (the photo, and the shaded skull as an RGBA layer that is
   transparent off the skull), an opacity slider for the skull layer and a wipe (slider, or drag
   on the picture) that shows the skull only left of a position, by CSS ``clip-path``; the
   landmarks as an SVG layer (photo landmark: ring, estimate: dot, joined by a line) and, with a
   face mask, the skull pixels outside it;
+- the skull alone in a frontal and a lateral view with its cranial landmarks marked and
+  labelled (numbered as in the landmark table where the SFO used them), so a misplaced or
+  mislabelled landmark shows; each view's picture is embedded once per page (an SVG
+  ``<image>`` that every SFO's view ``<use>``-s);
 - the landmark table (photo point, projected estimate, error in pixels), the camera (focal
   length, subject-to-camera distance, rotation, ``skull2cam``), each fitness term, the fitness
   curve (inline SVG);
@@ -29,7 +34,7 @@ from string import Template
 import numpy as np
 
 from .records import ReportEntry, report_record
-from .svg import curve_svg, marks_svg
+from .svg import curve_svg, marks_svg, skull_view_defs, skull_view_svg
 
 #: Initial skull-layer opacity (percent).
 DEFAULT_OPACITY_PCT = 60
@@ -126,6 +131,18 @@ def _layers(sfo):
         )
     out.append(marks_svg(sfo.landmarks, pics.box))
     return "".join(out)
+
+
+def _skull_views(sfo):
+    if not sfo.skull_views:
+        return (
+            "<p class='muted'>No skull-alone views: the cranial landmarks cannot orient the "
+            "skull (give porion_l, porion_r and an orbitale, or upper and lower midline "
+            "landmarks).</p>"
+        )
+    numbers = dict(sfo.cranial_numbers)
+    figures = "".join(f"<figure>{skull_view_svg(p, numbers)}</figure>" for p in sfo.skull_views)
+    return _fill("skull_views.html", figures=figures)
 
 
 def _controls(sfo):
@@ -309,6 +326,7 @@ def format_sfo(sfo):
         box_h=box_h,
         layers=_layers(sfo),
         controls=_controls(sfo),
+        skull_views=_skull_views(sfo),
         landmarks=_landmark_table(sfo),
         camera=_camera_table(sfo),
         terms=_terms_table(sfo),
@@ -317,6 +335,12 @@ def format_sfo(sfo):
         files=_files_table(sfo),
         outputs=_outputs(sfo),
     )
+
+
+def _skull_view_defs(page):
+    """The page's skull-alone pictures, embedded once (each SFO's views refer to them)."""
+    unique = {p.key: p for sfo in page.sfos for p in sfo.skull_views}
+    return skull_view_defs(unique.values(), _data_uri)
 
 
 def format_report(page):
@@ -337,14 +361,14 @@ def format_report(page):
     return _fill(
         "report.html",
         title=_e(page.title),
-        css=template_text("report.css"),
+        css=template_text("report.css") + template_text("pictures.css"),
         js=template_text("report.js"),
         version=_e(page.lilium_version),
         date=_e(page.date),
         count=len(page.sfos),
         skulls=_e(", ".join(page.skull_ids)),
         summary=_table(SUMMARY_HEADER, [_summary_row(s) for s in page.sfos], "num"),
-        sections="\n".join(format_sfo(s) for s in page.sfos),
+        sections=_skull_view_defs(page) + "\n".join(format_sfo(s) for s in page.sfos),
         provenance=_table(["", ""], provenance, "kv"),
     )
 

@@ -8,7 +8,7 @@ of the full photo; vectors are tuples of floats, matrices tuples of row tuples.
 from dataclasses import dataclass
 
 from ..io.provenance import InputFile
-from .pictures import Pictures
+from .pictures import Pictures, SkullViewPicture
 
 
 @dataclass(frozen=True)
@@ -138,6 +138,12 @@ class SfoRecord:
     outputs : tuple of (str, str)
         Label and link (relative to the report).
     pictures : Pictures
+    skull_views : tuple of SkullViewPicture
+        The skull alone, frontal and lateral, with its cranial landmarks (shared by the SFOs
+        of one skull on a page); empty when the landmarks cannot orient the skull.
+    cranial_numbers : tuple of (str, int)
+        Cranial landmark and the number of its facial counterpart in ``landmarks`` (1-based),
+        for the landmarks this SFO used.
     """
 
     index: int
@@ -164,6 +170,8 @@ class SfoRecord:
     inputs: tuple
     outputs: tuple
     pictures: Pictures
+    skull_views: tuple = ()
+    cranial_numbers: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -207,5 +215,6 @@ __all__ = [
     "Pictures",
     "ReportRecord",
     "SfoRecord",
+    "SkullViewPicture",
     "Summary",
 ]

@@ -17,7 +17,8 @@ import numpy as np
 from ..evaluation.metrics import outside_face
 from ..geometry.rotations import geodesic_angle_deg, matrix_to_rotvec
 from ..io.provenance import input_files, software_versions
-from .pictures import sfo_pictures, view_box
+from ..softtissue.landmarks import FACIAL_TO_CRANIAL
+from .pictures import sfo_pictures, skull_view_pictures, skull_views_for, view_box
 from .record_types import CameraFacts, LandmarkRow, ReportRecord, SfoRecord, Summary
 
 #: Extra run facts of ``SfoResult.extra`` the report lists, in this order.
@@ -136,7 +137,36 @@ def _skull_uv_in_image(camera, skull, size_wh):
     return np.clip(uv, 0, np.array(size_wh, dtype=float) - 1)
 
 
-def sfo_record(entry, index=1, hash_cache=None):
+def skull_views(skull, view, cache=None):
+    """The skull-alone pictures shown beside an SFO of a photo in ``view`` (frontal and the
+    photo's lateral side, :func:`lilium.report.pictures.skull_views_for`).
+
+    Parameters
+    ----------
+    skull : Skull
+    view : str
+        The photo's view.
+    cache : dict, optional
+        Pictures already rendered on this page, reused (one render per skull and view).
+
+    Returns
+    -------
+    tuple of SkullViewPicture
+    """
+    cache = {} if cache is None else cache
+    prefixes = cache.setdefault("prefixes", {})
+    prefix = prefixes.setdefault(id(skull), f"skv{len(prefixes) + 1}")
+    pictures = []
+    for v in skull_views_for(view):
+        if (prefix, v) not in cache:
+            found = skull_view_pictures(skull, (v,), key_prefix=prefix)
+            cache[(prefix, v)] = found[0] if found else None
+        if cache[(prefix, v)] is not None:
+            pictures.append(cache[(prefix, v)])
+    return tuple(pictures)
+
+
+def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
     """The plain record of one SFO.
 
     Parameters
@@ -146,6 +176,8 @@ def sfo_record(entry, index=1, hash_cache=None):
         1-based position on the page.
     hash_cache : dict, optional
         Digests of input files already hashed (see :func:`lilium.io.provenance.input_files`).
+    view_cache : dict, optional
+        Skull-alone pictures already rendered on this page (see :func:`skull_views`).
 
     Returns
     -------
@@ -201,6 +233,12 @@ def sfo_record(entry, index=1, hash_cache=None):
         inputs=input_files(entry.inputs, hash_cache),
         outputs=tuple((str(k), str(v)) for k, v in entry.outputs.items()),
         pictures=pictures,
+        skull_views=skull_views(skull, photo.view, view_cache),
+        cranial_numbers=tuple(
+            (FACIAL_TO_CRANIAL[r.name], k)
+            for k, r in enumerate(rows, start=1)
+            if r.name in FACIAL_TO_CRANIAL and FACIAL_TO_CRANIAL[r.name] in skull.landmarks_mm
+        ),
     )
 
 
@@ -227,8 +265,8 @@ def report_record(entries, title=None, command=None, date=None):
     date = date or _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
     skull_ids = tuple(sorted({str(e.skull.id) for e in entries}))
     title = title or f"Skull-face overlay: skull {', '.join(skull_ids)}"
-    cache = {}
-    sfos = tuple(sfo_record(e, i, cache) for i, e in enumerate(entries, start=1))
+    cache, views = {}, {}
+    sfos = tuple(sfo_record(e, i, cache, views) for i, e in enumerate(entries, start=1))
     versions = tuple(software_versions().items())
     return ReportRecord(title, date, command, skull_ids, versions, sfos)
 
@@ -240,4 +278,5 @@ __all__ = [
     "method_label",
     "report_record",
     "sfo_record",
+    "skull_views",
 ]
