@@ -5,9 +5,11 @@ from pathlib import Path
 from ..inputs import correspondences
 from ..io.case import read_depth_table
 from ..io.results import write_result
+from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
+from .folders import labelled_skull
 from .inputs import load_photos, load_skull
 
 
@@ -46,7 +48,7 @@ def run_case(
     title, command : str, optional
         Report title and the equivalent command line (provenance).
     log : callable
-        Receives one line per SFO.
+        Receives one line per SFO, and one per warning of that SFO.
 
     Returns
     -------
@@ -58,6 +60,7 @@ def run_case(
     for method in methods:
         check_method(method, options.variant)
     skull, skull_inputs = load_skull(skull_path, landmarks, axes)
+    skull = labelled_skull(skull, skull_inputs)
     records = load_photos(photos, **photo_options)
     if depth_table:
         from dataclasses import replace
@@ -69,6 +72,7 @@ def run_case(
         except ValueError as exc:
             where = inputs.get("facial landmarks") or inputs.get("photo.json")
             raise ValueError(f"{where}: {exc}") from None
+        check_inputs(skull, photo)  # left/right of skull and photo (names the file)
     out = Path(out)
     entries = []
     for photo, inputs, notes in records:
@@ -88,6 +92,8 @@ def run_case(
                 else f"FAILED ({result.error})"
             )
             log(f"{photo.id}: {name}: {status}, {result.seconds:.2f} s -> {folder}")
+            for warning in result.warnings:
+                log(f"  warning {warning.code}: {warning.message}")
             entries.append(
                 ReportEntry(skull, photo, result, {**skull_inputs, **inputs}, notes, outputs)
             )
