@@ -79,6 +79,7 @@ def main(argv=None):
                     d = skull_directions(skull.landmarks_mm, skull.vertices_mm)
                     angle = float(facing_angle_deg(d, truth.R, truth.t)[0])
                     angles["frontal" if photo.view == "frontal" else "lateral"].append(angle)
+                    true_angle = angle
                     if angle > FACING_MAX_DEG:
                         counts["error: true camera fails skull-faces-camera"] += 1
                     if view_warning(skull, photo, truth) is not None:
@@ -99,7 +100,9 @@ def main(argv=None):
                     found = float(facing_angle_deg(d, result.camera.R, result.camera.t)[0])
                     estimated["frontal" if photo.view == "frontal" else "lateral"].append(found)
                     if any(w.code == "view_mismatch" for w in result.warnings):
-                        mismatches.append((rel, axes.name if axes else "true axes", found))
+                        mismatches.append(
+                            (rel, axes.name if axes else "true axes", found, true_angle)
+                        )
     print(
         f"dataset {args.dataset}: {len(index['photos'])} photos x {len(index['experiments'])} "
         f"experiments, {len(subjects)} subjects"
@@ -115,8 +118,11 @@ def main(argv=None):
     for view, a in estimated.items():
         a = np.array(a)
         print(f"  POSEST-SFO camera angle, {view}: min {a.min():.1f}, max {a.max():.1f} deg")
-    for rel, axes, found in mismatches:
-        print(f"  view_mismatch: {rel} ({axes}): POSEST-SFO camera at {found:.1f} deg")
+    for rel, axes, found, true_angle in mismatches:
+        print(
+            f"  view_mismatch: {rel} ({axes}): POSEST-SFO camera at {found:.1f} deg, "
+            f"true camera at {true_angle:.1f} deg"
+        )
     for key, text in examples.items():
         print(f"  e.g. {key}: {text}")
     errors = sum(v for k, v in counts.items() if k.startswith("error"))
