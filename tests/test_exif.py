@@ -84,3 +84,21 @@ def test_corrupt_image(tmp_path):
     path.write_bytes(b"\xff\xd8 not a jpeg")
     with pytest.raises(ValueError, match=r"bad.jpg: cannot read the image"):
         focal_prior_from_exif(path)
+
+
+def test_a_focal_length_that_cannot_be_converted_says_so(tmp_path):
+    from lilium.io.exif import exif_focal
+
+    path = _jpeg(tmp_path / "b.jpg", model="Unknown", focal_mm=50.0)
+    prior, unusable = exif_focal(path)
+    assert prior is None
+    assert "EXIF FocalLength 50 mm cannot be converted to pixels" in unusable
+    assert "camera 'Unknown' is not in the built-in sensor table" in unusable
+    assert "--sensor-width-mm" in unusable and "--focal-px" in unusable
+    # The option it names fixes it.
+    prior, unusable = exif_focal(path, sensor_width_mm=36.0)
+    assert unusable is None and prior.estimate_px == pytest.approx(50 * 600 / 36)
+    # No FocalLength at all: nothing to say.
+    plain = tmp_path / "plain.png"
+    Image.new("RGB", (50, 40)).save(plain)
+    assert exif_focal(plain) == (None, None)

@@ -1,5 +1,6 @@
 """Experiment runner: config, task enumeration, SQLite store, resume after a kill, Dask."""
 
+import json
 import os
 import signal
 import sqlite3
@@ -192,6 +193,16 @@ def test_run_resume_and_report_cli(dataset, tmp_path):
     assert all(r["bpe_mm"] is None for r in rows if not r["positive"])
     scored = [r for r in rows if r["success"]]
     assert all(r["skull_px"] > 0 and 0 <= r["percent_outside"] <= 100 for r in scored)
+    # SPEC section 10 in every row's result JSON: warnings, priors and their source, landmark
+    # error; the generated photos have every prior, so no missing-prior warning.
+    for r in ResultStore(db).rows(["success", "result"]):
+        if not r["success"]:
+            continue
+        stored = json.loads(r["result"])
+        assert stored["priors"]["focal_px"]["source"] == "photo.json"
+        assert stored["landmark_error"]["mean_mm"] > 0
+        codes = {w["code"] for w in stored["warnings"]}
+        assert not codes & {"no_focal_prior", "no_scd_prior"}
     # Resume: nothing left to do, nothing duplicated.
     summary = run_experiment(cfg, progress=False, log=lambda *_: None)
     assert (summary.already_done, summary.stored, summary.complete) == (total, 0, True)

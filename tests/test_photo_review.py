@@ -33,7 +33,8 @@ def test_drag_save_and_read_back(tmp_path):
     assert main(["photo", str(tmp_path / "a.png"), "--out", str(out)]) == 0
     before = json.loads((out / "photo.json").read_text())
     dom = subprocess.run(
-        [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--dump-dom",
+        [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+         f"--user-data-dir={tmp_path / 'chromium-profile'}", "--dump-dom",
          (out / "review.html").as_uri() + "?test"],
         capture_output=True, text=True, timeout=120, check=True,
     ).stdout  # fmt: skip

@@ -97,3 +97,24 @@ def test_templates_ship_with_the_package():
     for name in ("report.html", "sfo.html", "controls.html", "report.css", "report.js"):
         assert template_text(name).strip()
     assert "$sections" in template_text("report.html")
+
+
+@pytest.mark.parametrize("method", ["posest-sfo", "lilium"])
+def test_skull_outside_the_mask_is_implausible_whatever_the_method(sfo, method):
+    from lilium.methods import SfoOptions, run_sfo
+    from lilium.report.html import format_report
+
+    skull, photo, _, _ = sfo
+    options = SfoOptions(variant="base").with_de(max_generations=2, population_size=6)
+    result = run_sfo(method, skull, photo, options)
+    ok = sfo_record(ReportEntry(skull, photo, result))
+    assert ok.summary.status == "ok" and ok.summary.implausible is False
+    assert ok.summary.mean_error_px == pytest.approx(result.landmark_error["mean_px"])
+    assert ok.summary.mean_error_mm == pytest.approx(result.landmark_error["mean_mm"])
+    expected_label = "mean landmark error, px" if method == "posest-sfo" else "fitness"
+    assert ok.summary.score_label == expected_label
+    moved = sfo_record(ReportEntry(skull, photo, _shifted(result, 15.0)))
+    assert moved.summary.status == "implausible" and moved.summary.implausible
+    page = format_report(report_record([ReportEntry(skull, photo, _shifted(result, 15.0))]))
+    assert ">implausible</span>" in page and "lie outside the face mask" in page
+    assert f"({expected_label})" in page

@@ -31,6 +31,46 @@ NORMAL_NEIGHBOURHOOD_MM = 4.0
 #: MSAC inlier threshold (pixels) of POSEST's RANSAC stage.
 RANSAC_THRESHOLD_PX = 12.0
 
+#: Largest angle (degrees) between the skull's anterior direction (porion midpoint -> nasion)
+#: and the direction from the skull to the camera for the camera to see the front of the skull
+#: (SPEC section 10; a lateral view is about 90). A camera beyond it sees the back of the skull:
+#: treated as no solution. SPEC section 10 says 110; measured on generated data
+#: (benchmarks/check_rules.py, 6 subjects x 12 photos), true lateral cameras reach 112.7 deg
+#: (yaw up to 105 deg and pitch 10 deg, against an anterior axis tilted about 14 deg above the
+#: mesh horizontal), so 110 refuses real lateral views; 120 keeps a margin above every generated
+#: camera and still refuses a camera behind the head (about 180).
+FACING_MAX_DEG = 120.0
+
+#: The view check (SPEC section 10): a frontal camera lies at most this far (degrees) from the
+#: skull's anterior direction, a lateral one at least this far, on the declared side.
+VIEW_SPLIT_DEG = 45.0
+
+
+def focal_cap_px(focal_prior_px=None):
+    """Largest focal length (pixels) accepted as a camera (SPEC section 4, focal cap).
+
+    :data:`FOCAL_MAX_PX` unless a focal prior reaches above it; then twice the prior's upper
+    bound (a long lens on a large sensor: 200 mm full-frame on a 6,000 px photo is 33,000 px).
+
+    Parameters
+    ----------
+    focal_prior_px : (float, float) or None
+        The photo's focal prior interval (pixels).
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> focal_cap_px(None), focal_cap_px((2000.0, 2400.0)), focal_cap_px((31000.0, 35000.0))
+    (10000.0, 10000.0, 70000.0)
+    """
+    if focal_prior_px is None or float(focal_prior_px[1]) <= FOCAL_MAX_PX:
+        return FOCAL_MAX_PX
+    return 2.0 * float(focal_prior_px[1])
+
+
 # -- input limits (docs/checks.md) ---------------------------------------------------------------
 
 #: Most pixels a photo (or mask) may have: 100 megapixels, every camera short of medium format.

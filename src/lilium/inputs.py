@@ -15,6 +15,29 @@ from .softtissue.landmarks import CRANIAL_TO_FACIAL
 #: tolerance; each optional): the same object P_cam takes.
 Priors = CameraPriors
 
+#: Where a prior came from (SPEC section 10, ``result.json``'s ``"priors"``).
+PRIOR_SOURCES = ("command line", "photo.json", "exif", "automatic", "none")
+
+
+@dataclass(frozen=True)
+class CaseWarning:
+    """A warning about an input or a result (SPEC section 10): a stable code and a sentence.
+
+    Attributes
+    ----------
+    code : str
+        ``view_mismatch``, ``no_focal_prior``, ``no_scd_prior``, ``outside_prior``,
+        ``exif_focal_unusable``, ``focal_cap``.
+    message : str
+        What is wrong and what fixes it.
+    """
+
+    code: str
+    message: str
+
+    def to_dict(self):
+        return {"code": self.code, "message": self.message}
+
 
 @dataclass(frozen=True)
 class Skull:
@@ -30,6 +53,9 @@ class Skull:
     axes : dict of str -> ndarray of shape (3,)
         Unit soft-tissue directions (cone axes); every correspondence landmark has one (given,
         or the skull-surface normal by default).
+    landmarks_file : str or None
+        The cranial landmark file, named in the messages about its labels (None: unknown, the
+        messages then name the skull).
     """
 
     id: str
@@ -37,6 +63,7 @@ class Skull:
     faces: np.ndarray
     landmarks_mm: dict
     axes: dict
+    landmarks_file: str | None = None
 
 
 @dataclass(frozen=True)
@@ -56,6 +83,16 @@ class Photo:
     priors : Priors
     image : ndarray of shape (H, W, 3), uint8, or None
         The picture itself, for overlays.
+    landmarks_file : str or None
+        The facial landmark file (``photo.json`` or the user's file), named in the messages
+        about its labels.
+    prior_sources : dict of str -> str
+        Where each prior came from, keyed ``focal_px``, ``scd_mm``, ``head_rotation``, values
+        among :data:`PRIOR_SOURCES`. A prior given without a source is taken as from
+        ``photo.json`` (what :func:`lilium.io.case.read_photo` reads).
+    warnings : tuple of CaseWarning
+        Found while reading the photo (e.g. ``exif_focal_unusable``); every result of the photo
+        carries them.
     """
 
     id: str
@@ -66,6 +103,9 @@ class Photo:
     face_curve_uv: np.ndarray | None = None
     priors: Priors = field(default_factory=Priors)
     image: np.ndarray | None = None
+    landmarks_file: str | None = None
+    prior_sources: dict = field(default_factory=dict)
+    warnings: tuple = ()
 
 
 @dataclass(frozen=True)

@@ -5,9 +5,11 @@ from pathlib import Path
 from ..io.case import read_depth_table
 from ..io.paths import safe_id
 from ..io.results import write_result
+from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
+from .folders import labelled_skull
 from .inputs import check_runnable, load_photos, load_skull
 
 
@@ -48,7 +50,8 @@ def run_case(
     title, command : str, optional
         Report title and the equivalent command line (provenance).
     log : callable
-        Receives one line per sidecar file found beside a mesh or an image, and one per SFO.
+        Receives one line per sidecar file found beside a mesh or an image, one per SFO
+        and one per warning of that SFO.
 
     Returns
     -------
@@ -60,6 +63,7 @@ def run_case(
     for method in methods:
         check_method(method, options.variant)
     skull, skull_inputs = load_skull(skull_path, landmarks, axes, log=log)
+    skull = labelled_skull(skull, skull_inputs)
     records = load_photos(photos, log=log, **photo_options)
     if depth_table:
         from dataclasses import replace
@@ -67,6 +71,7 @@ def run_case(
         options = replace(options, depth_table=read_depth_table(depth_table))
     for photo, inputs, _ in records:  # every problem before any long run
         check_runnable(skull, photo, methods, options.variant, skull_inputs, inputs)
+        check_inputs(skull, photo)  # left/right of skull and photo (names the file)
     out = Path(out)
     entries = []
     for photo, inputs, notes in records:
@@ -86,6 +91,8 @@ def run_case(
                 else f"FAILED ({result.error})"
             )
             log(f"{photo.id}: {name}: {status}, {result.seconds:.2f} s -> {folder}")
+            for warning in result.warnings:
+                log(f"  warning {warning.code}: {warning.message}")
             entries.append(
                 ReportEntry(skull, photo, result, {**skull_inputs, **inputs}, notes, outputs)
             )

@@ -14,6 +14,7 @@ has one.
 from dataclasses import replace
 from pathlib import Path
 
+from ..inputs import CaseWarning
 from ..io.case import (
     IMAGE_NAMES,
     check_axes_file,
@@ -161,7 +162,9 @@ def load_photos(
     Returns
     -------
     list of (Photo, dict inputs, dict notes)
-        ``inputs``: the files used, labelled (provenance); ``notes``: where each prior came from.
+        ``inputs``: the files used, labelled (provenance); ``notes``: where each prior came from,
+        as text for the report. Each photo carries its priors' sources (``prior_sources``), its
+        ``landmarks_file`` and its input warnings (:func:`with_priors`).
     """
     photos = [Path(p) for p in photos]
     image_files = [p for p in photos if not p.is_dir()]
@@ -223,31 +226,13 @@ def load_photos(
                     photo, face_curve_uv=read_face_curve(curve, view, photo.image_size_wh)
                 )
                 inputs["face curve"] = curve
-        priors = photo.priors
-        if focal_cli is not None:
-            priors = replace(priors, focal_px=focal_cli)
-            notes["focal prior"] = "command line --focal-px"
-        elif priors.focal_px is not None:
-            notes["focal prior"] = "photo.json"
-        elif use_exif:
-            from ..io.exif import focal_prior_from_exif
-
-            exif = focal_prior_from_exif(image, sensor_width_mm=sensor_width_mm)
-            if exif is not None:
-                priors = replace(priors, focal_px=exif.focal_px)
-                notes["focal prior"] = exif.source
-        if scd_cli is not None:
-            priors = replace(priors, scd_mm=scd_cli)
-            notes["SCD prior"] = "command line --scd-mm"
-        elif priors.scd_mm is not None:
-            notes["SCD prior"] = "photo.json"
-        for key, value in (("focal prior", priors.focal_px), ("SCD prior", priors.scd_mm)):
-            if value is not None:
-                unit = "px" if key == "focal prior" else "mm"
-                notes[key] = f"{value[0]:.0f}-{value[1]:.0f} {unit} ({notes[key]})"
-            else:
-                notes[key] = "none (penalty off)"
-        records.append((replace(photo, priors=priors), inputs, notes))
+        photo, notes = with_priors(
+            photo, image, focal_cli, scd_cli, use_exif=use_exif, sensor_width_mm=sensor_width_mm
+        )
+        photo = replace(
+            photo, landmarks_file=str(inputs.get("facial landmarks") or inputs["photo.json"])
+        )
+        records.append((photo, inputs, notes))
     seen = {}
     for i, (photo, inputs, notes) in enumerate(records):  # unique photo ids for the outputs
         n = seen.get(photo.id, 0)
@@ -255,6 +240,62 @@ def load_photos(
         if n:
             records[i] = (replace(photo, id=f"{photo.id}_{n + 1}"), inputs, notes)
     return records
+
+
+def with_priors(photo, image, focal_px=None, scd_mm=None, use_exif=True, sensor_width_mm=None):
+    """A photo with its priors by precedence (command line > ``photo.json`` > EXIF) and sources.
+
+    Parameters
+    ----------
+    photo : Photo
+        As read (its priors from ``photo.json``).
+    image : Path
+        The image file (for its EXIF).
+    focal_px, scd_mm : (lo, hi), optional
+        From the command line (checked intervals).
+    use_exif : bool
+    sensor_width_mm : float, optional
+
+    Returns
+    -------
+    photo : Photo
+        With ``priors``, ``prior_sources`` (values among :data:`lilium.inputs.PRIOR_SOURCES`)
+        and, when the EXIF focal length cannot be converted, warning ``exif_focal_unusable``.
+    notes : dict of str -> str
+        The same as text for the report (``"focal prior": "1900-2100 px (photo.json)"``).
+    """
+    priors, sources, details, warnings = photo.priors, {}, {}, list(photo.warnings)
+    if focal_px is not None:
+        priors, sources["focal_px"] = replace(priors, focal_px=focal_px), "command line"
+        details["focal_px"] = "command line --focal-px"
+    elif priors.focal_px is not None:
+        sources["focal_px"] = "photo.json"
+    elif use_exif and image is not None:
+        from ..io.exif import exif_focal
+
+        exif, unusable = exif_focal(image, sensor_width_mm=sensor_width_mm)
+        if exif is not None:
+            priors, sources["focal_px"] = replace(priors, focal_px=exif.focal_px), "exif"
+            details["focal_px"] = exif.source
+        elif unusable:
+            warnings.append(CaseWarning("exif_focal_unusable", unusable))
+    if scd_mm is not None:
+        priors, sources["scd_mm"] = replace(priors, scd_mm=scd_mm), "command line"
+        details["scd_mm"] = "command line --scd-mm"
+    elif priors.scd_mm is not None:
+        sources["scd_mm"] = "photo.json"
+    if priors.uses_head:
+        sources["head_rotation"] = "photo.json"
+    notes = {}
+    for key, label, unit in (("focal_px", "focal prior", "px"), ("scd_mm", "SCD prior", "mm")):
+        value = getattr(priors, key)
+        if value is None:
+            notes[label] = "none (penalty off)"
+        else:
+            where = details.get(key, sources[key])
+            notes[label] = f"{value[0]:.0f}-{value[1]:.0f} {unit} ({where})"
+    photo = replace(photo, priors=priors, prior_sources=sources, warnings=tuple(warnings))
+    return photo, notes
 
 
 def _json_keys(path):

@@ -85,6 +85,8 @@ def run(args):
         depth_table=args.depth_table,
         overlay=not args.no_overlay,
     )
+    for warning in result.warnings:
+        print(f"warning {warning.code}: {warning.message}", file=sys.stderr)
     if not result:
         print(
             f"SFO failed: {result.error} (written to {args.out / 'result.json'})", file=sys.stderr

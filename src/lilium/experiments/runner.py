@@ -243,8 +243,15 @@ def _photo(photo_dir):
 
 
 def _run_method(task, skull, photo):
+    """Run the task's SFO; its SPEC section 10 warnings land in the row's ``result`` JSON.
+
+    The left/right checks run first (:func:`lilium.methods.run_sfo`); a broken rule is a
+    ``ValueError`` naming the subject's or the photo's landmark file (an error row).
+    """
     from ..methods import SfoOptions, run_sfo
 
+    skull = replace(skull, landmarks_file=str(Path(task.subject_dir) / "cranial_landmarks.json"))
+    photo = replace(photo, landmarks_file=str(Path(task.photo_dir) / "photo.json"))
     options = SfoOptions(variant=task.variant or None, de=task.de)
     return run_sfo(task.method, skull, photo, options, task.seed)
 

@@ -1,11 +1,13 @@
 """P_cam, the camera-plausibility term of SPEC section 5, over a whole population at once.
 
-``P_cam = C_INF * [no solution or f <= 0 or f > FOCAL_MAX_PX]
+``P_cam = C_INF * [no solution or f <= 0 or f > focal cap]
 + max(0, fmin - f)^2 + max(0, f - fmax)^2
 + max(0, SCDmin - SCD)^2 + max(0, SCD - SCDmax)^2
 + max(0, dbeta - beta_tol)^2``
 
-with f in pixels, SCD in mm and dbeta in degrees. A prior that is ``None`` switches its terms
+with f in pixels, SCD in mm and dbeta in degrees. The focal cap is
+:data:`~lilium.constants.FOCAL_MAX_PX` unless the focal prior reaches above it
+(:func:`~lilium.constants.focal_cap_px`). A prior that is ``None`` switches its terms
 off. A quantity that is NaN while its prior is on (a camera that could not be measured) counts
 as a failure; the terms of a failed camera that are finite are still added, as the formula says,
 so failures stay ordered among themselves.
@@ -15,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX
+from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX, focal_cap_px
 from ..geometry.rotations import geodesic_angle_deg
 from ..validation import check_interval
 
@@ -96,6 +98,7 @@ def camera_penalty(
     focal_interval_px=None,
     scd_interval_mm=None,
     tolerance_deg=None,
+    focal_max_px=FOCAL_MAX_PX,
 ):
     """P_cam of a population of cameras.
 
@@ -114,6 +117,9 @@ def camera_penalty(
         Admissible intervals; None switches the term off.
     tolerance_deg : float, optional
         Head orientation tolerance; None switches the head term off.
+    focal_max_px : float, optional
+        The focal cap: a larger focal length is a failure (default
+        :data:`~lilium.constants.FOCAL_MAX_PX`; see :func:`~lilium.constants.focal_cap_px`).
 
     Returns
     -------
@@ -128,7 +134,7 @@ def camera_penalty(
     ok = np.ones(f.shape, bool) if success is None else np.asarray(success, dtype=bool)
     if ok.shape != f.shape:
         raise ValueError(f"success has shape {ok.shape}, focal_px has shape {f.shape}")
-    fail = ~ok | ~np.isfinite(f) | (f < FOCAL_MIN_PX) | (f > FOCAL_MAX_PX)
+    fail = ~ok | ~np.isfinite(f) | (f < FOCAL_MIN_PX) | (f > focal_max_px)
     terms = np.zeros(f.shape)
 
     def add(x, name, penalty):
@@ -162,6 +168,7 @@ def camera_penalty_from_priors(focal_px, scd_mm, R, success, priors):
         Head orientations (rotation of each ``skull2cam``); NaN where none.
     success : array_like of shape (S,) of bool
     priors : CameraPriors
+        Its focal interval also sets the focal cap (:func:`~lilium.constants.focal_cap_px`).
 
     Returns
     -------
@@ -178,4 +185,5 @@ def camera_penalty_from_priors(focal_px, scd_mm, R, success, priors):
         focal_interval_px=priors.focal_px,
         scd_interval_mm=priors.scd_mm,
         tolerance_deg=priors.head_tolerance_deg if priors.uses_head else None,
+        focal_max_px=focal_cap_px(priors.focal_px),
     )

@@ -12,6 +12,10 @@ The focal length in pixels is ``focal_mm * pixels_per_mm_on_the_sensor``. In ord
 
 ``DigitalZoomRatio`` > 1 multiplies the focal length of 1 and 2. The interval is the estimate
 ``+- tolerance`` (5 % by default: the SPEC's focal prior width).
+
+A ``FocalLength`` that none of these converts (no 35 mm value, no pixel pitch, an unknown camera)
+is not dropped silently: :func:`exif_focal` says why, with the options that fix it (warning
+``exif_focal_unusable`` of SPEC section 10).
 """
 
 from dataclasses import dataclass
@@ -149,6 +153,35 @@ def focal_prior_from_exif(path, sensor_width_mm=None, tolerance=FOCAL_TOLERANCE)
     """
     info = read_exif(path)
     return focal_prior_from_fields(info, sensor_width_mm, tolerance)
+
+
+def exif_focal(path, sensor_width_mm=None, tolerance=FOCAL_TOLERANCE):
+    """The EXIF focal prior of a photo, or why its EXIF focal length cannot be used.
+
+    Parameters
+    ----------
+    path : str or Path
+    sensor_width_mm : float, optional
+    tolerance : float
+
+    Returns
+    -------
+    prior : FocalPrior or None
+    unusable : str or None
+        When the photo has a ``FocalLength`` but no way to convert it to pixels: what is missing
+        and the options that fix it (``--sensor-width-mm``, ``--focal-px``); None otherwise.
+    """
+    info = read_exif(path)
+    prior = focal_prior_from_fields(info, sensor_width_mm, tolerance)
+    if prior is not None or "focal_mm" not in info:
+        return prior, None
+    model = info.get("model")
+    camera = f"camera {model!r} is not in the built-in sensor table" if model else "no camera model"
+    return None, (
+        f"{path}: EXIF FocalLength {info['focal_mm']:g} mm cannot be converted to pixels (no "
+        f"FocalLengthIn35mmFilm, no FocalPlaneXResolution, {camera}); give --sensor-width-mm MM "
+        "(the sensor's long side) or --focal-px LO HI"
+    )
 
 
 def focal_prior_from_fields(info, sensor_width_mm=None, tolerance=FOCAL_TOLERANCE):

@@ -12,13 +12,20 @@ Its fitness (SPEC section 5) is ``MSE_pix + P_cam [+ P_skof] [+ P_pll]``:
    skull pixels outside the face mask, chin-jaw/forehead curve parallelism.
 
 The whole population is evaluated at once (batched LM, batched projections).
+
+A camera that sees the back of the skull (SPEC section 10) or whose focal length exceeds the
+photo's focal cap (SPEC section 4) is "no solution" (P_cam's C_INF). When the best member has
+no camera for one of those reasons the SFO fails with a message that says which and what to
+fix. Without a focal prior, warning ``focal_cap`` when members fitted the landmarks better than
+the result but exceeded the cap, or when the mean soft tissue fits a focal length above the cap
+(:func:`~lilium.methods.posest_sfo.long_lens_focal_px`: a long lens the cap hides).
 """
 
 import time
 
 import numpy as np
 
-from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX
+from ..constants import C_INF, FOCAL_MIN_PX, focal_cap_px
 from ..fitness.camera_penalty import camera_penalty_from_priors
 from ..geometry.camera import Camera, Cameras, principal_point_of
 from ..inputs import correspondences
@@ -28,8 +35,15 @@ from ..pose.refine import refine_batch
 from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
+from .checks import facing_check, facing_failure
 from .lilium_terms import PllTerm, SkofTerm
-from .options import SfoOptions
+from .options import SfoOptions, with_focal_cap
+from .posest_sfo import (
+    RUN_OFF_FACTOR,
+    focal_cap_message,
+    focal_cap_warning,
+    long_lens_focal_px,
+)
 from .result import SfoResult
 
 #: Variants: which optional penalties are on, (P_skof, P_pll).
@@ -74,7 +88,10 @@ class LiliumProblem:
             raise ValueError(
                 f"unknown Lilium variant {options.variant!r}; use one of {', '.join(VARIANTS)}"
             )
-        self.skull, self.photo, self.options = skull, photo, options
+        self.skull, self.photo = skull, photo
+        self.options = with_focal_cap(options, photo.priors.focal_px)
+        self.focal_cap_px = focal_cap_px(photo.priors.focal_px)
+        self.facing = facing_check(skull)
         self.use_skof, self.use_pll = VARIANTS[options.variant]
         self.corr = correspondences(skull, photo)
         self.cones = build_cones(skull, self.corr, options.depth_table)
@@ -90,6 +107,8 @@ class LiliumProblem:
         if self.use_pll:
             self.pll = PllTerm(self.skull, self.photo, self.centre)
         self.n_fallbacks = 0  # statistics only
+        # Lowest MSE (px^2) of a camera refused for the focal cap, and its focal length.
+        self.capped_mse, self.capped_focal_px = np.inf, None
 
     # -- evaluation -------------------------------------------------------------------------
     def facial_landmarks(self, genes):
@@ -98,7 +117,14 @@ class LiliumProblem:
 
     def _posest(self, facial_mm):
         """Full POSEST for one member's facial landmarks: ``(R, t, focal_px)`` or None."""
-        pose = posest(self.corr.uv_px, facial_mm, self.centre, self.options.posest, rng=self.rng)
+        pose = posest(
+            self.corr.uv_px,
+            facial_mm,
+            self.centre,
+            self.options.posest,
+            rng=self.rng,
+            camera_check=self.facing,
+        )
         if not pose:
             return None
         return pose.camera.R, pose.camera.t, pose.camera.focal_px
@@ -152,10 +178,27 @@ class LiliumProblem:
             self.n_fallbacks += 1
             camera = self._posest(facial_mm[i])
             R[i], t[i], f[i] = camera if camera is not None else (R[i], t[i], np.nan)
-        ok = (f >= FOCAL_MIN_PX) & (f <= FOCAL_MAX_PX)
+        ok = (f >= FOCAL_MIN_PX) & (f <= self.focal_cap_px)
+        if self.facing is not None:
+            ok &= self.facing(R, t)
         sq = reprojection_sq_errors(self.uv_c, facial_mm, R, t, np.where(ok, f, 1.0))
+        self._note_capped(facial_mm, R, t, f)
         sq[~ok] = np.inf
         return R, t, f, ok, sq
+
+    def _note_capped(self, facial_mm, R, t, f):
+        """Remember the best fit refused only for its focal length (the cap was hit; a fit
+        that ran off towards an orthographic camera does not count)."""
+        capped = (f > self.focal_cap_px) & (f <= RUN_OFF_FACTOR * self.focal_cap_px)
+        if self.facing is not None:
+            capped &= self.facing(R, t)
+        if not capped.any():
+            return
+        sq = reprojection_sq_errors(self.uv_c, facial_mm[capped], R[capped], t[capped], f[capped])
+        mse = np.mean(sq, axis=1)
+        k = int(np.argmin(mse))
+        if mse[k] < self.capped_mse:
+            self.capped_mse, self.capped_focal_px = float(mse[k]), float(f[capped][k])
 
     def evaluate(self, genes, members=None, thresholds=None):
         """All fitness terms of a population.
@@ -256,6 +299,14 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         for k in ("mse_pix", "p_cam", "p_skof", "p_pll")
     }
     facial = problem.facial_landmarks(de.x)[0]
+    error, warnings = "", ()
+    if not ok:
+        error = _failure_message(problem, best)
+    elif photo.priors.focal_px is None:
+        if problem.capped_mse < terms["mse_pix"]:
+            warnings = (focal_cap_warning(problem.capped_focal_px, photo),)
+        elif (long_lens := long_lens_focal_px(skull, photo, options, seed)) is not None:
+            warnings = (focal_cap_warning(long_lens, photo),)
     return SfoResult(
         method="lilium",
         variant=options.variant,
@@ -267,7 +318,8 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         terms=terms,
         facial_landmarks_mm=dict(zip(problem.corr.facial_names, facial, strict=True)),
         seconds=time.perf_counter() - start,
-        error="" if ok else "no camera found for the best soft-tissue estimate",
+        error=error,
+        warnings=warnings,
         extra={
             "history": de.history.tolist(),
             "generations": de.nit,
@@ -277,3 +329,17 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
             "fallbacks": problem.n_fallbacks,
         },
     )
+
+
+def _failure_message(problem, best):
+    """Why the best member has no camera: behind the skull, over the focal cap, or neither."""
+    R, t, f = np.asarray(best["R"]), np.asarray(best["t"]), float(best["focal_px"])
+    finite = np.isfinite(f) and np.all(np.isfinite(R)) and np.all(np.isfinite(t))
+    if finite and problem.facing is not None and not problem.facing(R[None], t[None])[0]:
+        return facing_failure(problem.skull, problem.photo)
+    if finite and f > problem.focal_cap_px:
+        return (
+            f"no camera found: the best soft-tissue estimate needs a focal length of {f:.0f} px; "
+            + focal_cap_message(problem.photo, f)
+        )
+    return "no camera found for the best soft-tissue estimate"

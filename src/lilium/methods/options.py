@@ -2,6 +2,7 @@
 
 from dataclasses import dataclass, field, replace
 
+from ..constants import focal_cap_px
 from ..optimisation.de import DEOptions
 from ..pose.posest import PosestOptions
 from ..pose.refine import RefineOptions
@@ -39,3 +40,40 @@ class SfoOptions:
         """A copy with the given :class:`DEOptions` fields changed (``None`` values ignored)."""
         changes = {k: v for k, v in changes.items() if v is not None}
         return replace(self, de=replace(self.de, **changes))
+
+
+#: How far past the focal cap (factor) the inner Levenberg-Marquardt may run before it stops.
+FOCAL_STOP_FACTOR = 100.0
+
+
+def with_focal_cap(options, focal_prior_px):
+    """``options`` with the focal cap of a photo's focal prior (SPEC section 4).
+
+    POSEST's ``focal_max_px`` becomes :func:`lilium.constants.focal_cap_px` of the prior
+    (10,000 px, or twice the prior's upper bound when the prior reaches above that), and each
+    Levenberg-Marquardt stops a run-off fit no earlier than :data:`FOCAL_STOP_FACTOR` times the
+    cap. Unchanged (the same object) for a prior below 10,000 px.
+
+    Parameters
+    ----------
+    options : SfoOptions
+    focal_prior_px : (float, float) or None
+
+    Returns
+    -------
+    SfoOptions
+    """
+    return with_cap_px(options, focal_cap_px(focal_prior_px))
+
+
+def with_cap_px(options, cap_px):
+    """``options`` with POSEST's focal cap at ``cap_px`` (see :func:`with_focal_cap`)."""
+    cap = float(cap_px)
+    if cap == options.posest.focal_max_px:
+        return options
+
+    def lifted(refine):
+        return replace(refine, focal_stop_px=max(refine.focal_stop_px, FOCAL_STOP_FACTOR * cap))
+
+    posest = replace(options.posest, focal_max_px=cap, refine=lifted(options.posest.refine))
+    return replace(options, posest=posest, refine=lifted(options.refine))

@@ -7,6 +7,7 @@ runs a method through :func:`run_sfo` with one :class:`~lilium.methods.options.S
 
 from dataclasses import dataclass
 
+from .checks import check_inputs, finish_result
 from .lilium import VARIANTS, lilium_sfo
 from .options import SfoOptions
 from .posest_sfo import posest_sfo
@@ -84,11 +85,16 @@ def run_sfo(method, skull, photo, options=SfoOptions(), seed=0):
     Returns
     -------
     SfoResult
+        With its warnings, priors' provenance and landmark error (SPEC section 10,
+        :func:`~lilium.methods.checks.finish_result`).
 
     Raises
     ------
     ValueError
-        Unknown method or variant, or a case the method cannot run (too few landmarks, ...).
+        Unknown method or variant, mirrored skull or photo labels
+        (:func:`~lilium.methods.checks.check_inputs`), or a case the method cannot run (too
+        few landmarks, ...).
     """
     m = check_method(method, options.variant)
-    return m.run(skull, photo, options, seed)
+    check_inputs(skull, photo)
+    return finish_result(m.run(skull, photo, options, seed), skull, photo)

@@ -20,8 +20,8 @@ class SfoResult:
     camera : Camera or None
         The estimated camera; None when the SFO failed.
     fitness : float
-        The method's score (lower is better): mean pixel error for POSEST-SFO, the fitness for
-        Lilium.
+        The method's own score (lower is better): mean pixel error for POSEST-SFO, the fitness
+        for Lilium; not comparable across methods (``landmark_error`` is).
     terms : dict of str -> float
         ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (``None`` when switched off).
     facial_landmarks_mm : dict of str -> ndarray of shape (3,)
@@ -31,6 +31,17 @@ class SfoResult:
         Why it failed ("" on success).
     extra : dict
         Method-specific additions (e.g. the fitness history).
+    warnings : tuple of lilium.inputs.CaseWarning
+        SPEC section 10 warnings (``view_mismatch``, ``no_focal_prior``, ...).
+    priors : dict or None
+        The priors used and where each came from
+        (:func:`lilium.methods.checks.priors_record`).
+    landmark_error : dict or None
+        ``mean_px``, ``mean_mm``, ``per_landmark_px``
+        (:func:`lilium.methods.checks.landmark_error`); None when the SFO failed.
+
+    :func:`lilium.methods.run_sfo` fills ``warnings``, ``priors`` and ``landmark_error`` for
+    every method (:func:`lilium.methods.checks.finish_result`).
     """
 
     method: str
@@ -45,6 +56,9 @@ class SfoResult:
     seconds: float
     error: str = ""
     extra: dict = field(default_factory=dict)
+    warnings: tuple = ()
+    priors: dict | None = None
+    landmark_error: dict | None = None
 
     def __bool__(self):
         return self.camera is not None
@@ -65,7 +79,11 @@ class SfoResult:
                 k: [float(x) for x in v] for k, v in self.facial_landmarks_mm.items()
             },
             "seconds": float(self.seconds),
+            "landmark_error": self.landmark_error,
+            "warnings": [w.to_dict() for w in self.warnings],
         }
+        if self.priors is not None:
+            out["priors"] = self.priors
         if self.error:
             out["error"] = self.error
         out.update(self.extra)

@@ -4,8 +4,9 @@ As in Lourakis & Terzakis' POSEST: MSAC over P4Pf samples, then Levenberg-Marqua
 seven parameters on the inliers. The few best MSAC hypotheses are refined together (one batched
 call), each re-fitted to its own inlier set until that set settles (local optimisation, as in
 LO-RANSAC), and the refined camera with the lowest MSAC cost wins. A failure (fewer than four
-points, no real sample, focal length out of range, a point behind the camera) is a falsy
-:class:`PoseResult` carrying a message, not an exception.
+points, no real sample, focal length out of range, a point behind the camera, a camera the
+caller's ``camera_check`` rejects) is a falsy :class:`PoseResult` carrying a message and a
+code, not an exception.
 """
 
 from dataclasses import dataclass, field
@@ -30,7 +31,8 @@ class PosestOptions:
     refine_on : {"inliers", "all"}
         Points the Levenberg-Marquardt stage fits: MSAC's inliers (POSEST) or all points.
     focal_max_px : float
-        Largest acceptable focal length; larger is a failure.
+        Largest acceptable focal length; larger is a failure (the SFO methods set it from the
+        photo's focal prior, :func:`lilium.constants.focal_cap_px`).
     local_rounds : int
         Refinements at most per hypothesis; after each, its inliers are re-classified with the
         refined camera and, if they changed, it is refined again on the new set.
@@ -56,12 +58,22 @@ class PoseResult:
     inliers : ndarray of shape (N,), bool
     message : str
         Why it failed, or "" on success.
+    code : str
+        Why it failed, for callers: ``"focal_cap"`` (focal length above ``focal_max_px``),
+        ``"rejected"`` (``camera_check`` refused every camera that was otherwise valid),
+        ``"other"``; "" on success.
+    capped_focal_px : float or None
+        On success: the focal length of a camera that fitted better than the one returned but
+        was refused for exceeding ``focal_max_px`` (the cap was hit; None when not). On a
+        ``"focal_cap"`` failure: the focal length refused.
     """
 
     camera: Camera | None
     errors_px: np.ndarray | None = None
     inliers: np.ndarray | None = None
     message: str = ""
+    code: str = ""
+    capped_focal_px: float | None = None
 
     def __bool__(self):
         return self.camera is not None
@@ -77,9 +89,13 @@ class PoseResult:
         return float(np.mean(self.errors_px))
 
 
-def failure(message):
-    """A falsy :class:`PoseResult` with ``message``."""
-    return PoseResult(None, message=message)
+def failure(message, code="other", capped_focal_px=None):
+    """A falsy :class:`PoseResult` with ``message`` (and a ``code``)."""
+    return PoseResult(None, message=message, code=code, capped_focal_px=capped_focal_px)
+
+
+#: Message of a camera refused by the caller's ``camera_check``.
+REJECTED_MESSAGE = "the camera was rejected by the caller's check"
 
 
 def check_camera(R, t, focal_px, sq_err_px2, focal_max_px=FOCAL_MAX_PX):
@@ -93,7 +109,7 @@ def check_camera(R, t, focal_px, sq_err_px2, focal_max_px=FOCAL_MAX_PX):
     return ""
 
 
-def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0):
+def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0, camera_check=None):
     """Estimate rotation, translation and focal length from 2D-3D correspondences.
 
     Parameters
@@ -107,11 +123,14 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0)
     options : PosestOptions
     rng : seed or numpy Generator
         RANSAC sampling; the default seed makes POSEST deterministic.
+    camera_check : callable, optional
+        ``camera_check(R (K, 3, 3), t (K, 3)) -> (K,) bool``: False refuses a camera like no
+        solution (the SFO methods pass the skull-faces-camera rule).
 
     Returns
     -------
     PoseResult
-        Falsy, with a message, on failure.
+        Falsy, with a message and a code, on failure.
 
     Examples
     --------
@@ -158,13 +177,26 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0)
             break
     score = cost if not on_inliers else np.minimum(sq, tau_sq).sum(axis=1)
     why = [check_camera(R[k], t[k], f[k], sq[k], options.focal_max_px) for k in range(len(f))]
+    if camera_check is not None:
+        accepted = np.asarray(camera_check(R, t), dtype=bool)
+        why = [w or ("" if accepted[k] else REJECTED_MESSAGE) for k, w in enumerate(why)]
     valid = np.array([not w for w in why])
     if not valid.any():
-        return failure(why[int(np.argmin(score))])
+        k = int(np.argmin(score))
+        if any(w == REJECTED_MESSAGE for w in why):  # would have fitted, but refused
+            k = min((j for j, w in enumerate(why) if w == REJECTED_MESSAGE), key=score.__getitem__)
+            return failure(why[k], "rejected")
+        if f[k] > options.focal_max_px:
+            return failure(why[k], "focal_cap", float(f[k]))
+        return failure(why[k])
     k = int(np.argmin(np.where(valid, score, np.inf)))
     errors = np.sqrt(sq[k])
     camera = Camera.from_rt(R[k], t[k], f[k], c)
-    return PoseResult(camera, errors, errors < options.ransac.threshold_px)
+    capped = np.isfinite(f) & (f > options.focal_max_px) & (score < score[k])
+    capped_focal = float(f[np.argmin(np.where(capped, score, np.inf))]) if capped.any() else None
+    return PoseResult(
+        camera, errors, errors < options.ransac.threshold_px, capped_focal_px=capped_focal
+    )
 
 
 def _used_points(sq_err_px2, tau_sq):

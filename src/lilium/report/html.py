@@ -19,7 +19,11 @@ Formats the plain records of :mod:`lilium.report.records` into the templates shi
   curve (inline SVG);
 - the inputs' provenance (SHA-256 of each file, software versions, seed, method, date).
 
-A summary table on top lists every SFO of the page. Nothing is fetched from the network: the
+A summary table on top lists every SFO of the page: the landmark error in pixels and in
+millimetres at the landmarks' depth for every method side by side (comparable), each method's
+own score in a column of its own (not comparable across methods), "implausible" for any camera
+with skull pixels outside the face mask whatever its method, and the SPEC section 10 warnings,
+which each SFO's section lists in full. Nothing is fetched from the network: the
 pictures are base64 ``data:`` URIs, styles and script are inline.
 """
 
@@ -56,9 +60,11 @@ SUMMARY_HEADER = (
     "status",
     "focal px",
     "SCD mm",
-    "mean landmark error px",
-    "fitness / score",
+    "mean error px",
+    "mean error mm",
+    "method's own score (not comparable across methods)",
     "skull outside face %",
+    "warnings",
     "time s",
 )
 
@@ -96,21 +102,53 @@ def _data_uri(data, fmt):
     return f"data:image/{fmt};base64," + base64.b64encode(data).decode("ascii")
 
 
+def _warning_codes(warnings):
+    return " ".join(
+        f'<span class="warn" title="{_e(message)}">{_e(code)}</span>' for code, message in warnings
+    )
+
+
 def _summary_row(sfo):
     s = sfo.summary
+    status = _e(s.status)
+    if s.implausible:
+        status = (
+            '<span class="fail" title="skull pixels outside the face mask (SPEC section 7)">'
+            "implausible</span>"
+        )
     return [
         f'<a href="#sfo-{sfo.index}">{sfo.index}</a>',
         _e(sfo.photo_id),
         _e(sfo.view),
         _e(sfo.method_label),
-        _e(s.status),
+        status,
         _num(s.focal_px, "{:.0f}"),
         _num(s.scd_mm, "{:.0f}"),
         _num(s.mean_error_px, "{:.2f}"),
-        _num(s.fitness, "{:.4g}"),
+        _num(s.mean_error_mm, "{:.2f}"),
+        f"{_num(s.fitness, '{:.4g}')} <span class='muted'>({_e(s.score_label)})</span>",
         _num(s.outside_pct, "{:.2f}"),
+        _warning_codes(s.warnings),
         f"{s.seconds:.2f}",
     ]
+
+
+def _alerts(sfo):
+    """The failure, the implausible mark and every warning of an SFO, above its pictures."""
+    out = []
+    if not sfo.ok:
+        out.append(f"<p class='fail'>The SFO failed: {_e(sfo.error)}</p>")
+    if sfo.summary.implausible:
+        out.append(
+            f"<p class='fail'>Implausible: {sfo.outside.outside_px} skull pixels "
+            f"({sfo.outside.percent_outside:.2f} %) lie outside the face mask.</p>"
+        )
+    if sfo.warnings:
+        items = "".join(
+            f"<li><code>{_e(code)}</code>: {_e(message)}</li>" for code, message in sfo.warnings
+        )
+        out.append(f"<div class='warnings'><b>Warnings</b><ul>{items}</ul></div>")
+    return "\n".join(out)
 
 
 def _layers(sfo):
@@ -228,6 +266,10 @@ def _camera_table(sfo):
         )
         rows.append(["skull2cam (mm)", f"<code>{matrix}</code>"])
     rows += [[_e(key), _e(value)] for key, value in sfo.notes]
+    rows += [
+        [f"prior: {_e(name)}", f"{_e(value)} (source: {_e(source)})"]
+        for name, value, source in sfo.priors
+    ]
     return _table(["", ""], rows, "kv")
 
 
@@ -236,8 +278,17 @@ def _terms_table(sfo):
         [TERM_LABELS.get(k, _e(k)), _num(v, "{:.4g}", "off") if sfo.ok else "&ndash;"]
         for k, v in sfo.terms
     ]
-    score = "fitness" if sfo.method != "posest-sfo" else "score (mean landmark error, px)"
+    score = f"method's own score ({_e(sfo.summary.score_label)})"
     rows.append([f"<b>{score}</b>", f"<b>{_num(sfo.fitness, '{:.4g}')}</b>"])
+    s = sfo.summary
+    if s.mean_error_px is not None:
+        rows.append(
+            [
+                "mean landmark error (comparable across methods)",
+                f"{s.mean_error_px:.2f} px = {_num(s.mean_error_mm, '{:.2f}')} mm at the "
+                "landmarks' depth",
+            ]
+        )
     if sfo.outside is not None:
         o = sfo.outside
         rows.append(
@@ -305,7 +356,7 @@ def format_sfo(sfo):
     shown = ""
     if (box_w, box_h) != (width, height):
         shown = f"; shown: columns {u0}&ndash;{u1 - 1}, rows {v0}&ndash;{v1 - 1}"
-    failure = "" if sfo.ok else f"<p class='fail'>The SFO failed: {_e(sfo.error)}</p>"
+    failure = _alerts(sfo)
     return _fill(
         "sfo.html",
         anchor=f"sfo-{sfo.index}",

@@ -88,7 +88,27 @@ class CameraFacts:
 
 @dataclass(frozen=True)
 class Summary:
-    """The summary-table row of one SFO (None where not defined)."""
+    """The summary-table row of one SFO (None where not defined).
+
+    Attributes
+    ----------
+    status : str
+        ``"ok"``, ``"implausible"`` (a camera with skull pixels outside the face mask, whatever
+        the method: SPEC section 7) or ``"failed: ..."``.
+    focal_px, scd_mm : float or None
+    mean_error_px, mean_error_mm : float or None
+        ``landmark_error`` of the result (SPEC section 10): comparable across methods.
+    fitness : float
+        The method's own score (lower is better), not comparable across methods.
+    score_label : str
+        What that score is (``"mean landmark error, px"``, ``"fitness"``).
+    outside_pct : float or None
+    implausible : bool or None
+        Whether skull pixels fall outside the face mask (None: failed, or no mask).
+    warnings : tuple of (str, str)
+        The result's warnings, ``(code, message)``.
+    seconds : float
+    """
 
     status: str
     focal_px: float | None
@@ -97,6 +117,10 @@ class Summary:
     fitness: float
     outside_pct: float | None
     seconds: float
+    mean_error_mm: float | None = None
+    score_label: str = "fitness"
+    implausible: bool | None = None
+    warnings: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -134,6 +158,10 @@ class SfoRecord:
     seconds : float
     run_extra : tuple of (str, str)
         Run facts (generations, evaluations, ...).
+    warnings : tuple of (str, str)
+        SPEC section 10 warnings of the result, ``(code, message)``.
+    priors : tuple of (str, str, str)
+        Each prior: name, value (text) and where it came from.
     inputs : tuple of InputFile
     outputs : tuple of (str, str)
         Label and link (relative to the report).
@@ -172,6 +200,8 @@ class SfoRecord:
     pictures: Pictures
     skull_views: tuple = ()
     cranial_numbers: tuple = ()
+    warnings: tuple = ()
+    priors: tuple = ()
 
 
 @dataclass(frozen=True)

@@ -24,6 +24,9 @@ from .record_types import CameraFacts, LandmarkRow, ReportRecord, SfoRecord, Sum
 #: Extra run facts of ``SfoResult.extra`` the report lists, in this order.
 RUN_EXTRAS = ("generations", "evaluations", "stop", "fallbacks")
 
+#: What each method's own score is (its ``fitness``; other methods: "fitness").
+SCORE_LABELS = {"posest-sfo": "mean landmark error, px"}
+
 
 @dataclass(frozen=True)
 class ReportEntry:
@@ -130,6 +133,34 @@ def camera_facts(result, photo):
     )
 
 
+def score_label(method):
+    """What a method's own score (``SfoResult.fitness``) is, for the report."""
+    return SCORE_LABELS.get(method, "fitness")
+
+
+def prior_rows(result):
+    """The priors of a result as ``(name, value, source)`` text rows (``result.priors``)."""
+    priors = result.priors or {}
+    rows = []
+    for key, label, unit in (("focal_px", "focal length", "px"), ("scd_mm", "SCD", "mm")):
+        entry = priors.get(key)
+        if entry is None:
+            continue
+        value = (
+            "none" if entry["range"] is None else "{:.0f}-{:.0f} {}".format(*entry["range"], unit)
+        )
+        rows.append((label, value, entry["source"]))
+    head = priors.get("head_rotation")
+    if head is not None:
+        value = (
+            "none"
+            if head["skull2cam"] is None
+            else f"given, tolerance {head['tolerance_deg']:g} deg"
+        )
+        rows.append(("head orientation", value, head["source"]))
+    return tuple(rows)
+
+
 def _skull_uv_in_image(camera, skull, size_wh):
     """Projected skull vertices (V, 2) clipped to the image: the skull's extent in the photo."""
     uv = camera.project(skull.vertices_mm)
@@ -199,14 +230,24 @@ def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
     box = view_box(photo.image_size_wh, None, photo.face_mask, points)
     pictures = sfo_pictures(result, skull, photo, box, outside is not None and outside.implausible)
     history = result.extra.get("history")
+    implausible = None if outside is None else bool(outside.implausible)
+    warnings = tuple((w.code, w.message) for w in result.warnings)
+    error = result.landmark_error or {}
+    status = "ok" if result else f"failed: {result.error}"
+    if implausible:
+        status = "implausible"
     summary = Summary(
-        status="ok" if result else f"failed: {result.error}",
+        status=status,
         focal_px=camera.focal_px if camera else None,
         scd_mm=camera.scd_mm if camera else None,
-        mean_error_px=mean_err,
+        mean_error_px=error.get("mean_px", mean_err),
         fitness=result.fitness,
         outside_pct=None if outside is None else outside.percent_outside,
         seconds=float(result.seconds),
+        mean_error_mm=error.get("mean_mm"),
+        score_label=score_label(result.method),
+        implausible=implausible,
+        warnings=warnings,
     )
     return SfoRecord(
         index=index,
@@ -239,6 +280,8 @@ def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
             for k, r in enumerate(rows, start=1)
             if r.name in FACIAL_TO_CRANIAL and FACIAL_TO_CRANIAL[r.name] in skull.landmarks_mm
         ),
+        warnings=warnings,
+        priors=prior_rows(result),
     )
 
 
@@ -276,7 +319,9 @@ __all__ = [
     "camera_facts",
     "landmark_rows",
     "method_label",
+    "prior_rows",
     "report_record",
+    "score_label",
     "sfo_record",
     "skull_views",
 ]

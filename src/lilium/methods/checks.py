@@ -1,0 +1,514 @@
+"""What is checked before and after an SFO (SPEC section 10), as pure functions.
+
+Anatomical directions of a skull, from its landmarks (:func:`skull_directions`):
+
+- **origin**: the porion midpoint, or the mesh centroid (mean vertex) when a porion is missing;
+- **anterior**: from the origin to nasion; without nasion, to the first present of
+  :data:`ANTERIOR_TARGETS`, else to the mean midpoint of the orbital and nasal pairs
+  (:data:`ANTERIOR_PAIRS`); no direction (no check) without any of them;
+- **right** (towards the subject's right): the mean unit ``_r - _l`` of the bilateral pairs;
+- **superior**: nasion minus prosthion; without one of them, the mean of the upper midline
+  landmarks (nasion, glabella, metopion, bregma) minus the mean of the lower ones (prosthion,
+  subspinale, infradentale, pogonion, gnathion).
+
+Rules (each one skipped, never guessed, when the landmarks it needs are absent):
+
+- **skull faces the camera** (:func:`facing_angle_deg`): the angle between the anterior
+  direction and the direction from the origin to the camera centre is at most
+  :data:`~lilium.constants.FACING_MAX_DEG`; both methods treat a camera beyond it as no
+  solution (:func:`facing_check`);
+- **left and right of the skull** (:func:`check_skull_labels`): ``dot(right x anterior,
+  superior) > 0`` (the right-handed RAS frame); mirrored labels or a mirrored mesh make it
+  negative: an error naming the landmark file;
+- **left and right of a frontal photo** (:func:`check_photo_labels`): facing the camera, the
+  subject's left is on the image's right, so each ``_l`` landmark has the larger ``u``; when
+  every pair is reversed the photo or its labels are mirrored: an error naming the file.
+  Lateral photos show one side only and are not checked;
+- **declared view** (:func:`view_warning`): after the SFO, frontal = at most
+  :data:`~lilium.constants.VIEW_SPLIT_DEG` from the anterior direction, lateral = at least
+  that, on the declared side (``lateral_left``: the face points to the image's left, so the
+  camera sees the subject's left side); otherwise warning ``view_mismatch``;
+- **priors** (:func:`prior_warnings`): ``no_focal_prior``, ``no_scd_prior``, ``outside_prior``.
+
+:func:`landmark_error` is the comparable error of every result (pixels and millimetres at each
+landmark's depth). :func:`finish_result` attaches the warnings, the priors' provenance and the
+landmark error to a result; :func:`lilium.methods.run_sfo` calls it for every method.
+"""
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..constants import FACING_MAX_DEG, VIEW_SPLIT_DEG, focal_cap_px
+from ..fitness.camera_penalty import head_deviation_deg
+from ..inputs import CaseWarning
+from ..softtissue.landmarks import side, twin
+
+#: Anterior landmarks the anterior direction aims at when nasion is missing, in order.
+ANTERIOR_TARGETS = ("glabella", "subspinale", "prosthion", "metopion", "pogonion", "gnathion")
+
+#: Bilateral pairs whose mean midpoint is the anterior target without any midline landmark.
+ANTERIOR_PAIRS = ("dacryon", "ectoconchion", "alare")
+
+#: Upper and lower midline landmarks of the superior direction's fallback.
+UPPER_MIDLINE = ("nasion", "glabella", "metopion", "bregma")
+LOWER_MIDLINE = ("prosthion", "subspinale", "infradentale", "pogonion", "gnathion")
+
+#: Options that give each prior, for the messages.
+PRIOR_OPTIONS = {
+    "focal_px": "--focal-px LO HI (or priors.focal_px in photo.json, or a photo with EXIF)",
+    "scd_mm": "--scd-mm LO HI (or priors.scd_mm in photo.json)",
+}
+
+
+def _unit(v):
+    n = float(np.linalg.norm(v))
+    return None if not np.isfinite(n) or n < 1e-9 else np.asarray(v, float) / n
+
+
+@dataclass(frozen=True)
+class SkullDirections:
+    """Anatomical directions of a skull, skull frame.
+
+    Attributes
+    ----------
+    origin_mm : ndarray of shape (3,)
+    anterior : ndarray of shape (3,)
+        Unit vector from the origin to the anterior target.
+    right : ndarray of shape (3,) or None
+        Unit vector towards the subject's right (None without a bilateral pair).
+    superior : ndarray of shape (3,) or None
+        Unit vector (None without an upper and a lower midline landmark).
+    origin_source, anterior_source : str
+        E.g. ``"porion midpoint"``, ``"nasion"``, for the messages.
+    """
+
+    origin_mm: np.ndarray
+    anterior: np.ndarray
+    right: np.ndarray | None
+    superior: np.ndarray | None
+    origin_source: str
+    anterior_source: str
+
+
+def _right(lm):
+    diffs = [_unit(lm[twin(n)] - lm[n]) for n in lm if side(n) == "l" and twin(n) in lm]
+    diffs = [d for d in diffs if d is not None]
+    return _unit(np.mean(diffs, axis=0)) if diffs else None
+
+
+def _superior(lm):
+    if "nasion" in lm and "prosthion" in lm:
+        return _unit(lm["nasion"] - lm["prosthion"])
+    upper = [lm[n] for n in UPPER_MIDLINE if n in lm]
+    lower = [lm[n] for n in LOWER_MIDLINE if n in lm]
+    if not upper or not lower:
+        return None
+    return _unit(np.mean(upper, axis=0) - np.mean(lower, axis=0))
+
+
+def skull_directions(landmarks_mm, vertices_mm):
+    """The skull's origin, anterior, right and superior directions (module docstring).
+
+    Parameters
+    ----------
+    landmarks_mm : dict of str -> array_like of shape (3,)
+        Cranial landmarks, skull frame.
+    vertices_mm : ndarray of shape (V, 3)
+        The skull mesh (its centroid is the origin without porion).
+
+    Returns
+    -------
+    SkullDirections or None
+        None when no anterior target is present (the rules that need it are skipped).
+    """
+    lm = {k: np.asarray(v, dtype=float) for k, v in landmarks_mm.items()}
+    if "porion_l" in lm and "porion_r" in lm:
+        origin, origin_source = (lm["porion_l"] + lm["porion_r"]) / 2, "porion midpoint"
+    else:
+        origin, origin_source = np.mean(np.asarray(vertices_mm, float), axis=0), "mesh centroid"
+    targets = [n for n in ("nasion", *ANTERIOR_TARGETS) if n in lm]
+    if targets:
+        target, target_source = lm[targets[0]], targets[0]
+    else:
+        mids = [
+            (lm[f"{b}_l"] + lm[f"{b}_r"]) / 2
+            for b in ANTERIOR_PAIRS
+            if f"{b}_l" in lm and f"{b}_r" in lm
+        ]
+        if not mids:
+            return None
+        target, target_source = np.mean(mids, axis=0), "orbital and nasal pair midpoints"
+    anterior = _unit(target - origin)
+    if anterior is None:
+        return None
+    return SkullDirections(
+        origin, anterior, _right(lm), _superior(lm), origin_source, target_source
+    )
+
+
+def camera_centres_mm(R, t):
+    """Camera centres ``-R^T t`` (S, 3), skull frame, of ``R (S, 3, 3)`` and ``t (S, 3)``."""
+    R = np.asarray(R, dtype=float).reshape(-1, 3, 3)
+    t = np.asarray(t, dtype=float).reshape(-1, 3)
+    return -np.einsum("sji,sj->si", R, t)
+
+
+def facing_angle_deg(directions, R, t):
+    """Angle (degrees) between the anterior direction and the direction skull -> camera.
+
+    Parameters
+    ----------
+    directions : SkullDirections
+    R : array_like of shape (S, 3, 3)
+    t : array_like of shape (S, 3)
+        World-to-camera (``skull2cam``) rotations and translations (mm).
+
+    Returns
+    -------
+    angle_deg : ndarray of shape (S,)
+        About 0 for a frontal camera, 90 for a lateral one, 180 behind the head; NaN for a
+        camera that is not finite.
+    """
+    d = camera_centres_mm(R, t) - directions.origin_mm
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        d = d / np.max(np.abs(d), axis=1, keepdims=True)  # run-off cameras: no overflow
+        cos = (d @ directions.anterior) / np.linalg.norm(d, axis=1)
+    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+
+
+def facing_check(skull):
+    """The skull-faces-camera rule of one skull as a batched predicate, or None.
+
+    Returns
+    -------
+    callable or None
+        ``check(R (S, 3, 3), t (S, 3)) -> (S,) bool``, True where the camera sees the front of
+        the skull (a non-finite camera passes: it fails elsewhere); None when the skull has no
+        anterior direction (the rule is then skipped).
+    """
+    directions = skull_directions(skull.landmarks_mm, skull.vertices_mm)
+    if directions is None:
+        return None
+
+    def check(R, t):
+        angle = facing_angle_deg(directions, R, t)
+        return ~(angle > FACING_MAX_DEG)
+
+    return check
+
+
+def facing_failure(skull, photo):
+    """The message of an SFO whose landmarks fit only from behind the skull."""
+    skull_file = skull.landmarks_file or f"the cranial landmarks of skull {skull.id!r}"
+    photo_file = photo.landmarks_file or f"the facial landmarks of photo {photo.id!r}"
+    return (
+        f"the landmarks fit only with a camera behind the skull (more than {FACING_MAX_DEG:g} "
+        f"deg from its anterior direction): are left and right swapped in {skull_file} (or in "
+        f"{photo_file})? Swap the _l and _r names of the mirrored file"
+    )
+
+
+def label_handedness(landmarks_mm, vertices_mm):
+    """``dot(right x anterior, superior)`` of a skull's labels; positive when they are right.
+
+    Returns
+    -------
+    float or None
+        In [-1, 1]; None when a direction cannot be formed (no bilateral pair, no anterior or
+        superior landmarks).
+    """
+    d = skull_directions(landmarks_mm, vertices_mm)
+    if d is None or d.right is None or d.superior is None:
+        return None
+    return float(np.cross(d.right, d.anterior) @ d.superior)
+
+
+def check_skull_labels(skull):
+    """Raise when the skull's left and right labels (or its mesh) are mirrored.
+
+    Raises
+    ------
+    ValueError
+        Naming ``skull.landmarks_file`` and what to swap.
+    """
+    handedness = label_handedness(skull.landmarks_mm, skull.vertices_mm)
+    if handedness is None or handedness >= 0:
+        return
+    where = skull.landmarks_file or f"skull {skull.id!r}: cranial landmarks"
+    raise ValueError(
+        f"{where}: left and right are mirrored (the _r minus _l direction, anterior and superior "
+        f"form a left-handed frame, {handedness:+.2f}); swap every _l and _r name in this file "
+        "(zygion_l <-> zygion_r, ...), or, if the labels follow the anatomy, the mesh itself is "
+        "mirrored: re-import it with its true handedness"
+    )
+
+
+def photo_pair_order(landmarks_uv):
+    """Bilateral pairs of a photo's landmarks and how many are reversed for a frontal view.
+
+    Returns
+    -------
+    pairs : list of str
+        Base names of the pairs present (``"exocanthion"``, ...).
+    reversed_pairs : list of str
+        Those whose ``_l`` landmark lies at a smaller ``u`` than its ``_r`` twin.
+    """
+    pairs, reversed_pairs = [], []
+    for name, uv in landmarks_uv.items():
+        if side(name) == "l" and twin(name) in landmarks_uv:
+            base = name[:-2]
+            pairs.append(base)
+            if float(uv[0]) < float(landmarks_uv[twin(name)][0]):
+                reversed_pairs.append(base)
+    return pairs, reversed_pairs
+
+
+def check_photo_labels(photo):
+    """Raise when every left/right pair of a frontal photo is reversed (mirrored photo/labels).
+
+    Raises
+    ------
+    ValueError
+        Naming ``photo.landmarks_file`` and what to flip or swap.
+    """
+    if photo.view != "frontal":
+        return
+    pairs, reversed_pairs = photo_pair_order(photo.landmarks_uv)
+    if not pairs or len(reversed_pairs) < len(pairs):
+        return
+    where = photo.landmarks_file or f"photo {photo.id!r}: facial landmarks"
+    raise ValueError(
+        f"{where}: in this frontal photo every _l landmark lies left of its _r twin "
+        f"({', '.join(pairs)}), but facing the camera the subject's left is on the image's "
+        "right: the photo is mirrored (a selfie or a flipped scan: flip the image and its "
+        "landmarks horizontally) or _l and _r are swapped in the labels (swap them)"
+    )
+
+
+def check_inputs(skull, photo):
+    """The checks before any SFO: left and right of the skull and of the photo.
+
+    Raises
+    ------
+    ValueError
+        The first rule broken, naming the file and the fix.
+    """
+    check_skull_labels(skull)
+    check_photo_labels(photo)
+
+
+def view_warning(skull, photo, camera):
+    """Warning ``view_mismatch`` when the camera disagrees with the photo's declared view.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    camera : Camera
+
+    Returns
+    -------
+    CaseWarning or None
+    """
+    directions = skull_directions(skull.landmarks_mm, skull.vertices_mm)
+    if directions is None:
+        return None
+    angle = float(facing_angle_deg(directions, camera.R, camera.t)[0])
+    seen = "frontal"
+    if angle >= VIEW_SPLIT_DEG:
+        seen = "lateral"
+        if directions.right is not None:
+            centre = camera_centres_mm(camera.R, camera.t)[0] - directions.origin_mm
+            seen = "lateral_right" if centre @ directions.right > 0 else "lateral_left"
+    declared = photo.view
+    if seen == declared or (seen == "lateral" and declared != "frontal"):
+        return None
+    where = photo.landmarks_file or f"photo {photo.id!r}"
+    side_text = {
+        "frontal": "in front of the face",
+        "lateral": "beside the head",
+        "lateral_left": "on the subject's left (lateral_left)",
+        "lateral_right": "on the subject's right (lateral_right)",
+    }[seen]
+    return CaseWarning(
+        "view_mismatch",
+        f"{where} declares the view {declared!r} but the camera found is {angle:.0f} deg from "
+        f"the skull's anterior direction, {side_text}; check the view (photo.json's \"view\" "
+        "or --view) and the landmarks",
+    )
+
+
+def _source(photo, key, value):
+    if value is None:
+        return "none"
+    return photo.prior_sources.get(key, "photo.json")
+
+
+def priors_record(photo):
+    """The ``"priors"`` of ``result.json``: each prior's value and where it came from.
+
+    Returns
+    -------
+    dict
+        ``{"focal_px": {"range": [lo, hi] | None, "source": ...}, "scd_mm": {...},
+        "head_rotation": {"skull2cam": 3x3 | None, "tolerance_deg": float | None,
+        "source": ...}}``.
+    """
+    p = photo.priors
+    head = p.head_rotation_skull2cam if p.uses_head else None
+    return {
+        "focal_px": {
+            "range": None if p.focal_px is None else [float(x) for x in p.focal_px],
+            "source": _source(photo, "focal_px", p.focal_px),
+        },
+        "scd_mm": {
+            "range": None if p.scd_mm is None else [float(x) for x in p.scd_mm],
+            "source": _source(photo, "scd_mm", p.scd_mm),
+        },
+        "head_rotation": {
+            "skull2cam": None if head is None else np.asarray(head, float).tolist(),
+            "tolerance_deg": None if head is None else float(p.head_tolerance_deg),
+            "source": _source(photo, "head_rotation", head),
+        },
+    }
+
+
+def scd_point_mm(facial_landmarks_mm):
+    """The point the subject-to-camera distance is measured to (SPEC section 5)."""
+    if "nasion" in facial_landmarks_mm:
+        return np.asarray(facial_landmarks_mm["nasion"], float)
+    return np.mean([np.asarray(v, float) for v in facial_landmarks_mm.values()], axis=0)
+
+
+def prior_warnings(photo, camera=None, facial_landmarks_mm=None):
+    """Warnings about the priors: missing ones, and a camera outside a given one.
+
+    Parameters
+    ----------
+    photo : Photo
+    camera : Camera, optional
+        The SFO's camera (None: failed, only the missing-prior warnings).
+    facial_landmarks_mm : dict, optional
+        The estimated facial landmarks (the SCD is measured to their nasion or centroid).
+
+    Returns
+    -------
+    list of CaseWarning
+    """
+    p = photo.priors
+    out = []
+    if p.focal_px is None:
+        out.append(
+            CaseWarning(
+                "no_focal_prior",
+                "no focal-length prior: the camera is constrained by the landmarks alone "
+                "(focal length and distance trade against each other, and the focal length is "
+                f"capped at {focal_cap_px(None):.0f} px); give {PRIOR_OPTIONS['focal_px']}",
+            )
+        )
+    if p.scd_mm is None:
+        out.append(
+            CaseWarning(
+                "no_scd_prior",
+                "no subject-to-camera distance prior: the distance is constrained by the "
+                f"landmarks alone; give {PRIOR_OPTIONS['scd_mm']}",
+            )
+        )
+    if camera is None:
+        return out
+    checks = [("focal length", camera.focal_px, p.focal_px, "px", "focal_px")]
+    if facial_landmarks_mm:
+        scd = camera.distance_mm(scd_point_mm(facial_landmarks_mm))
+        checks.append(
+            ("subject-to-camera distance", float(np.ravel(scd)[0]), p.scd_mm, "mm", "scd_mm")
+        )
+    for label, value, bounds, unit, key in checks:
+        if bounds is not None and not bounds[0] <= value <= bounds[1]:
+            out.append(
+                CaseWarning(
+                    "outside_prior",
+                    f"the {label} found, {value:.0f} {unit}, lies outside its prior "
+                    f"{bounds[0]:.0f}-{bounds[1]:.0f} {unit} ({_source(photo, key, bounds)}); "
+                    "check the prior and the landmarks",
+                )
+            )
+    if p.uses_head:
+        dev = float(head_deviation_deg(camera.R[None], p.head_rotation_skull2cam)[0])
+        if dev > p.head_tolerance_deg:
+            out.append(
+                CaseWarning(
+                    "outside_prior",
+                    f"the head orientation found deviates {dev:.1f} deg from its prior "
+                    f"(tolerance {p.head_tolerance_deg:g} deg, "
+                    f"{_source(photo, 'head_rotation', True)}); check the prior and the landmarks",
+                )
+            )
+    return out
+
+
+def landmark_error(camera, facial_landmarks_mm, photo):
+    """Reprojection error of the estimated facial landmarks, in pixels and millimetres.
+
+    ``mean_mm`` converts each landmark's pixel error to millimetres at its own depth
+    (``px * Z / focal_px``, Z = the landmark's camera-frame depth), so methods and photos of
+    different resolutions compare.
+
+    Parameters
+    ----------
+    camera : Camera
+    facial_landmarks_mm : dict of str -> array_like of shape (3,)
+        Estimated 3D facial landmarks (skull frame), keyed by facial name.
+    photo : Photo
+
+    Returns
+    -------
+    dict or None
+        ``{"mean_px", "mean_mm", "per_landmark_px": {name: px}}``; None without a landmark in
+        the photo.
+    """
+    names = [n for n in facial_landmarks_mm if n in photo.landmarks_uv]
+    if camera is None or not names:
+        return None
+    X = np.array([facial_landmarks_mm[n] for n in names], dtype=float)
+    uv = np.array([photo.landmarks_uv[n] for n in names], dtype=float)
+    err_px = np.linalg.norm(camera.project(X) - uv, axis=1)
+    depth_mm = camera.to_camera_frame(X)[:, 2]
+    err_mm = err_px * depth_mm / camera.focal_px
+    finite = np.isfinite(err_px)
+    return {
+        "mean_px": float(np.mean(err_px)) if finite.all() else None,
+        "mean_mm": float(np.mean(err_mm)) if finite.all() else None,
+        "per_landmark_px": {
+            n: (float(e) if np.isfinite(e) else None) for n, e in zip(names, err_px, strict=True)
+        },
+    }
+
+
+def finish_result(result, skull, photo):
+    """A result with its warnings, priors' provenance and landmark error attached.
+
+    Warnings, in order: the photo's own (read with it, e.g. ``exif_focal_unusable``), the
+    method's (e.g. ``focal_cap``), the missing or violated priors, ``view_mismatch``.
+
+    Parameters
+    ----------
+    result : SfoResult
+    skull : Skull
+    photo : Photo
+
+    Returns
+    -------
+    SfoResult
+    """
+    warnings = [*photo.warnings, *result.warnings]
+    warnings += prior_warnings(photo, result.camera, result.facial_landmarks_mm)
+    error = None
+    if result:
+        view = view_warning(skull, photo, result.camera)
+        if view is not None:
+            warnings.append(view)
+        error = landmark_error(result.camera, result.facial_landmarks_mm, photo)
+    return replace(
+        result, warnings=tuple(warnings), priors=priors_record(photo), landmark_error=error
+    )
