@@ -147,3 +147,39 @@ def test_context_without_vertices_is_refused():
     context = prepare_skof(np.array([[0, 1, 2]]), np.ones((4, 4), bool))
     with pytest.raises(ValueError, match="with the skull's vertices"):
         skull_outside_pixels_cameras(context, np.eye(3)[None], [[0, 0, 10.0]], [10.0], [2, 2])
+
+
+def _lm_problems(S=120, N=18, rng=7):
+    from lilium.geometry.camera import project_points
+
+    rng = np.random.default_rng(rng)
+    X = rng.normal(scale=60.0, size=(S, N, 3))
+    R = np.array([rotvec_to_matrix(rng.normal(size=3)) for _ in range(S)])
+    t = np.column_stack([rng.normal(scale=20.0, size=(S, 2)), rng.uniform(500.0, 1500.0, S)])
+    f = rng.uniform(1000.0, 4000.0, S)
+    uv = project_points(X, R, t, f) + rng.normal(scale=2.0, size=(S, N, 2))
+    turn = np.array([rotvec_to_matrix(rng.normal(scale=0.05, size=3)) for _ in range(S)])
+    start = (turn @ R, t + rng.normal(scale=[5.0, 5.0, 50.0], size=(S, 3)), f * 1.05)
+    weights = (rng.random((S, N)) > 0.2).astype(float)
+    t[0, 2] = -5.0  # one problem starts behind the camera
+    return uv, X, start, weights
+
+
+@needs_numba
+def test_lm_kernel_matches_the_numpy_iterations():
+    """Lilium's warm-started refinement (6 iterations): the compiled loop takes the numpy
+    path's steps (1e-9 relative)."""
+    from lilium.methods.options import SfoOptions
+    from lilium.pose.refine import refine_batch
+
+    uv, X, (R0, t0, f0), w = _lm_problems()
+    options = SfoOptions().refine
+    compiled = refine_batch(uv, X, R0, t0, f0, w, options)
+    with jit.kernels("numpy"):
+        reference = refine_batch(uv, X, R0, t0, f0, w, options)
+    assert compiled.n_iterations == reference.n_iterations
+    for name in ("R", "t", "focal_px", "sq_err_px2", "cost"):
+        a, b = getattr(compiled, name), getattr(reference, name)
+        np.testing.assert_array_equal(np.isfinite(a), np.isfinite(b))
+        ok = np.isfinite(b)
+        np.testing.assert_allclose(a[ok], b[ok], rtol=1e-9, atol=1e-9 * np.abs(b[ok]).max())
