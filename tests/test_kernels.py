@@ -183,3 +183,29 @@ def test_lm_kernel_matches_the_numpy_iterations():
         np.testing.assert_array_equal(np.isfinite(a), np.isfinite(b))
         ok = np.isfinite(b)
         np.testing.assert_allclose(a[ok], b[ok], rtol=1e-9, atol=1e-9 * np.abs(b[ok]).max())
+
+
+@needs_numba
+@pytest.mark.parametrize("view", ["frontal", "lateral_left", "lateral_right"])
+def test_curve_detection_kernel_gives_the_numpy_curves(view):
+    from lilium.fitness.curves import detect_curves_batch
+
+    vertices, faces = shell_skull(n_lat=30, n_lon=40, rng=8)
+    low = vertices[faces].mean(axis=1)[:, 1] < -20.0  # an open cap: a chin-like region
+    used, region = np.unique(faces[low], return_inverse=True)
+    region = region.reshape(-1, 3)
+    topology = mesh_edge_topology(region)
+    R, t, focal = cameras(40, rng=9)
+    uv = project_vertices(vertices[used], R, t, focal, CENTRE)
+    uv[3] += 5000.0  # a window clipped at the image's surroundings
+    span = uv[:, :2, 1] if view != "frontal" else None
+    compiled = detect_curves_batch(
+        uv, view, topology=topology, span_v=span, image_shape=(HEIGHT, WIDTH)
+    )
+    with jit.kernels("numpy"):
+        reference = detect_curves_batch(
+            uv, view, topology=topology, span_v=span, image_shape=(HEIGHT, WIDTH)
+        )
+    assert len(reference.points) > 500
+    np.testing.assert_array_equal(compiled.offset, reference.offset)
+    np.testing.assert_array_equal(compiled.points, reference.points)

@@ -65,49 +65,75 @@ class FaceClusters:
     node_children: np.ndarray
 
 
+@njit
 def _kd_order(points, leaf_size):
     """Order of points ``(N, 3)`` in which every run of ``leaf_size`` is a compact k-d cell.
 
-    Median splits along the longest side of each cell's bounding box, with the left part a
-    multiple of ``leaf_size`` points, until cells hold at most ``leaf_size``; consecutive leaves
-    are then neighbours in the tree, so runs of leaves are compact too.
+    Splits along the longest side of each cell's bounding box, the left part a multiple of
+    ``leaf_size`` points (about half), until cells hold at most ``leaf_size``; consecutive
+    leaves are neighbours in the tree, so runs of leaves are compact too.
     """
-    order = np.arange(len(points))
-    stack = [(0, len(points))]
-    while stack:
-        lo, hi = stack.pop()
+    n_points = points.shape[0]
+    order = np.arange(n_points)
+    stack = np.empty((128, 2), np.int64)
+    stack[0, 0], stack[0, 1] = 0, n_points
+    depth = 1
+    while depth > 0:
+        depth -= 1
+        lo, hi = stack[depth, 0], stack[depth, 1]
         n = hi - lo
         if n <= leaf_size:
             continue
-        idx = order[lo:hi]
-        p = points[idx]
-        axis = int(np.argmax(p.max(axis=0) - p.min(axis=0)))
+        idx = order[lo:hi].copy()
+        best_axis, best_extent = 0, -1.0
+        for axis in range(3):
+            a_min, a_max = np.inf, -np.inf
+            for i in idx:
+                a_min = min(a_min, points[i, axis])
+                a_max = max(a_max, points[i, axis])
+            if a_max - a_min > best_extent:
+                best_axis, best_extent = axis, a_max - a_min
+        key = np.empty(n)
+        for k in range(n):
+            key[k] = points[idx[k], best_axis]
+        order[lo:hi] = idx[np.argsort(key, kind="mergesort")]
         half = max(leaf_size, (n // 2 + leaf_size - 1) // leaf_size * leaf_size)
         if half >= n:
-            half = n - n % leaf_size if n % leaf_size else n - leaf_size
-        part = np.argpartition(p[:, axis], half - 1, kind="introselect")
-        order[lo:hi] = idx[part]
-        stack.append((lo + half, hi))
-        stack.append((lo, lo + half))
+            half = n - leaf_size
+        stack[depth, 0], stack[depth, 1] = lo + half, hi
+        stack[depth + 1, 0], stack[depth + 1, 1] = lo, lo + half
+        depth += 2
     return order
 
 
+@njit
 def _spheres(vertices, faces, ranges):
-    """Bounding sphere ``(x, y, z, r)`` of the corners of each face range ``[lo, hi)`` (K, 2).
-
-    The ranges of one call must be consecutive and cover the faces (one tree level).
-    """
-    out = np.zeros((len(ranges), 4))
-    if len(faces) == 0:
-        return out
-    corners = vertices[faces].reshape(-1, 3)  # (3F, 3)
-    starts = 3 * ranges[:, 0]
-    lo = np.minimum.reduceat(corners, starts, axis=0)
-    hi = np.maximum.reduceat(corners, starts, axis=0)
-    centre = 0.5 * (lo + hi)
-    d2 = np.sum((corners - np.repeat(centre, 3 * (ranges[:, 1] - ranges[:, 0]), axis=0)) ** 2, 1)
-    out[:, :3] = centre
-    out[:, 3] = np.sqrt(np.maximum.reduceat(d2, starts)) * (1.0 + 1e-12) + 1e-9
+    """Bounding sphere ``(x, y, z, r)`` of the corners of each face range ``[lo, hi)`` (K, 2):
+    centre at the middle of their bounding box, radius the largest distance (padded)."""
+    out = np.zeros((ranges.shape[0], 4))
+    for k in range(ranges.shape[0]):
+        lo, hi = ranges[k, 0], ranges[k, 1]
+        if hi <= lo:
+            continue
+        box_lo = np.full(3, np.inf)
+        box_hi = np.full(3, -np.inf)
+        for f in range(lo, hi):
+            for j in range(3):
+                for a in range(3):
+                    x = vertices[faces[f, j], a]
+                    box_lo[a] = min(box_lo[a], x)
+                    box_hi[a] = max(box_hi[a], x)
+        centre = 0.5 * (box_lo + box_hi)
+        r2 = 0.0
+        for f in range(lo, hi):
+            for j in range(3):
+                d2 = 0.0
+                for a in range(3):
+                    d = vertices[faces[f, j], a] - centre[a]
+                    d2 += d * d
+                r2 = max(r2, d2)
+        out[k, :3] = centre
+        out[k, 3] = np.sqrt(r2) * (1.0 + 1e-12) + 1e-9
     return out
 
 
@@ -127,7 +153,9 @@ def face_clusters(vertices_mm, faces, leaf_faces=LEAF_FACES, fan_out=FAN_OUT):
     faces = np.asarray(faces, dtype=np.int64)
     n = len(faces)
     centroids = vertices_mm[faces].mean(axis=1) if n else np.zeros((0, 3))
-    order = _kd_order(centroids, leaf_faces) if n else np.zeros(0, np.int64)
+    order = (
+        _kd_order(np.ascontiguousarray(centroids), int(leaf_faces)) if n else np.zeros(0, np.int64)
+    )
     clustered = faces[order]
     # Levels, leaves first: the face range [lo, hi) of each node.
     lo = np.arange(0, max(n, 1), leaf_faces, dtype=np.int64)
@@ -147,7 +175,7 @@ def face_clusters(vertices_mm, faces, leaf_faces=LEAF_FACES, fan_out=FAN_OUT):
     node_faces = np.concatenate(levels)
     return FaceClusters(
         order=order,
-        node_sphere=np.concatenate([_spheres(vertices_mm, clustered, lv) for lv in levels]),
+        node_sphere=_spheres(vertices_mm, np.ascontiguousarray(clustered), node_faces),
         node_faces=node_faces,
         node_children=children,
     )
