@@ -12,7 +12,9 @@ same numbers (``tests/test_kernels.py``).
     python benchmarks/bench_speed.py                       # generated Exp. C photos
     python benchmarks/bench_speed.py --dataset DIR --dataset DIR2   # e.g. a 150k-face skull
 
-Each SFO is seeded (seed 1, perturbed axes set C1) and runs on one core.
+Each SFO is seeded (seed 1, perturbed axes set C1) and runs on one core. Times are the process's
+CPU time (``time.process_time``, single-threaded BLAS), not wall time: on a shared machine the
+wall clock also counts the time other processes hold the core.
 """
 
 import os
@@ -39,7 +41,7 @@ VARIANTS = METHODS["lilium"].variants
 
 
 class TermClock:
-    """Wall time spent in Lilium's camera refinement and its image terms (wrapped methods)."""
+    """CPU time spent in Lilium's camera refinement and its image terms (wrapped methods)."""
 
     PARTS = {
         "cameras": (lilium_method.LiliumProblem, "cameras"),
@@ -57,11 +59,11 @@ class TermClock:
             self._saved[part] = original
 
             def timed(*args, _original=original, _part=part, **kwargs):
-                t0 = time.perf_counter()
+                t0 = time.process_time()
                 try:
                     return _original(*args, **kwargs)
                 finally:
-                    self.seconds[_part] += time.perf_counter() - t0
+                    self.seconds[_part] += time.process_time() - t0
 
             setattr(owner, name, timed)
         return self
@@ -85,9 +87,9 @@ def photos_of(root):
 
 
 def time_sfo(method, skull, photo, options=SfoOptions(), seed=1):
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     result = run_sfo(method, skull, photo, options, seed)
-    return time.perf_counter() - t0, result
+    return time.process_time() - t0, result
 
 
 def main(argv=None):
@@ -146,7 +148,7 @@ def main(argv=None):
 
     g = args.reference_generations
     print(
-        f"\nTime per SFO, one core: compiled at {args.generations} generations x "
+        f"\nCPU time per SFO, one core: compiled at {args.generations} generations x "
         f"{args.population}; the ratio numpy / compiled measured at {g} generations "
         f"(POSEST-SFO: median of {args.posest_repeats} runs, whole SFO in-process)"
     )
