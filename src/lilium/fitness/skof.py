@@ -19,7 +19,8 @@ shared 2-core machine under load (where OpenCV's per-triangle ``fillConvexPoly``
 7-29 ms at 3k faces and 36-83 ms at 20k-50k): 0.65-0.69 ms at 3k, 1.3-2.5 ms at 20k,
 2.6-3.4 ms at 50k faces; with the skull inside the mask 0.2, 0.8 and 1.7 ms. That loop's own
 union differs by its fill rule (it also paints pixels the edges merely graze: about +0.26 % of
-``S`` here). For the DE budget, a skull decimated to ~20k faces is the sensible input.
+``S`` here). Lilium counts on the full skull with :func:`skull_outside_pixels_cameras`, which
+skips whole clusters of faces the same way before projecting them (compiled).
 """
 
 from dataclasses import dataclass
