@@ -13,8 +13,8 @@ Reported per term and view:
   (:meth:`PllContext.evaluate`, a batch of one) and the batched
   :meth:`PllContext.evaluate_batch`, and the largest difference between the oracle's totals and
   the batched ones (must be 0).
-- P_skof: :meth:`SkofTerm.outside_pixels` (projection + exact union count) at the decimated
-  level, and the pixel-count difference of the decimated skull (:data:`SKOF_FACES`) against the
+- P_skof: :meth:`SkofTerm.outside_pixels` (projection + exact union count) on the full
+  skull (exact, with its shortcut), and the pixel-count difference of the term against the
   full mesh on the same cameras (relative to the full count and to ``|S|``).
 """
 
@@ -136,7 +136,7 @@ def bench_case(name, skull, photo, truth):
             f"x{t_ref / max(t_new, 1e-9):4.1f}  max|diff| {diff:.3g}"
             f" | P_skof {len(skof.context.topology.faces)} faces {t_skof * ms:6.3f} ms, "
             f"{len(skull.faces)} faces {t_full * ms:6.3f} ms; |S\\F| median {np.median(exact):.0f}"
-            f" px, decimated-full median {np.median(dec - exact):+.0f} px "
+            f" px, term-full median {np.median(dec - exact):+.0f} px "
             f"(max {np.max(rel) * 100:.1f} %)"
         )
 

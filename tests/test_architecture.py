@@ -11,6 +11,7 @@ import lilium
 LAYERS = {
     "constants": 0,
     "validation": 0,
+    "jit": 0,
     "geometry": 1,
     "optimisation": 1,
     "softtissue": 2,

@@ -27,8 +27,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import jit
 from ..constants import VIEWS
 from ..imaging.raster import scan_crossings, winding_intervals
+from ._curve_kernels import VIEW_CODES, boundary_kernel
 
 #: Largest side (pixels) of the window a region is rasterised in; beyond, it is clipped.
 MAX_WINDOW_PX = 8192
@@ -429,6 +431,23 @@ def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
     empty, clipped = np.ones(S, bool), np.zeros(S, bool)
     if topology.n_faces and S:
         lo, hi, empty, clipped = _windows(uv, image_shape)
+    if jit.compiled():
+        u = np.ascontiguousarray(uv[..., 0])
+        v = np.ascontiguousarray(uv[..., 1])
+        member, points = boundary_kernel(
+            u,
+            v,
+            topology.corners,
+            topology.face_edges,
+            topology.face_dirs,
+            topology.edges_a,
+            topology.edges_b,
+            np.ascontiguousarray(lo),
+            np.ascontiguousarray(hi),
+            ~empty,
+            VIEW_CODES[view],
+        )
+        return _span_and_join(member, points, span_v, S)
     members, points = [], []
     together = np.flatnonzero(~empty & ~clipped)
     if view != "frontal" and len(together):
@@ -465,6 +484,11 @@ def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
     if clipped.any():
         order = np.argsort(member, kind="stable")
         member, points = member[order], points[order]
+    return _span_and_join(member, points, span_v, S)
+
+
+def _span_and_join(member, points, span_v, S):
+    """Boundary pixels ``(N, 2)`` of members ``(N,)``: span filter, then joined fragments."""
     if span_v is not None and len(points):
         span_v = np.asarray(span_v, dtype=float).reshape(S, 2)
         a, b = span_v[member, 0], span_v[member, 1]

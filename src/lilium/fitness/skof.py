@@ -19,7 +19,8 @@ shared 2-core machine under load (where OpenCV's per-triangle ``fillConvexPoly``
 7-29 ms at 3k faces and 36-83 ms at 20k-50k): 0.65-0.69 ms at 3k, 1.3-2.5 ms at 20k,
 2.6-3.4 ms at 50k faces; with the skull inside the mask 0.2, 0.8 and 1.7 ms. That loop's own
 union differs by its fill rule (it also paints pixels the edges merely graze: about +0.26 % of
-``S`` here). For the DE budget, a skull decimated to ~20k faces is the sensible input.
+``S`` here). Lilium counts on the full skull with :func:`skull_outside_pixels_cameras`, which
+skips whole clusters of faces the same way before projecting them (compiled).
 """
 
 from dataclasses import dataclass
@@ -27,8 +28,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from .. import jit
 from ..imaging.raster import (
     EdgeTopology,
+    check_faces,
     check_topology,
     face_orientations,
     mesh_edge_topology,
@@ -36,6 +39,7 @@ from ..imaging.raster import (
     skull_raster,  # noqa: F401 - the raster S itself, re-exported next to the count
     winding_intervals,
 )
+from ._skof_kernels import FaceClusters, face_clusters, outside_pixels_kernel, project_vertices
 
 #: Weight of the outside-pixel count in P_skof (SPEC section 5).
 SKOF_WEIGHT = 100.0
@@ -105,15 +109,97 @@ def face_mask_index(face_mask):
 
 @dataclass(frozen=True)
 class SkofContext:
-    """Everything P_skof needs that is fixed during one SFO."""
+    """Everything P_skof needs that is fixed during one SFO.
+
+    Attributes
+    ----------
+    topology : EdgeTopology
+        Of the skull's faces (in cluster order when ``clusters`` is set).
+    mask_index : FaceMaskIndex
+    vertices_mm : ndarray of shape (V, 3) or None
+        The skull's vertices, for :func:`skull_outside_pixels_cameras`.
+    clusters : FaceClusters or None
+        The faces' Morton clusters (:mod:`lilium.fitness._skof_kernels`).
+    """
 
     topology: EdgeTopology
     mask_index: FaceMaskIndex
+    vertices_mm: np.ndarray | None = None
+    clusters: FaceClusters | None = None
 
 
-def prepare_skof(faces, face_mask):
-    """Build the :class:`SkofContext` of a skull mesh and a face mask (once per SFO)."""
-    return SkofContext(mesh_edge_topology(faces), face_mask_index(face_mask))
+def prepare_skof(faces, face_mask, vertices_mm=None):
+    """Build the :class:`SkofContext` of a skull mesh and a face mask (once per SFO).
+
+    With ``vertices_mm`` the faces are also clustered (:func:`face_clusters`) for
+    :func:`skull_outside_pixels_cameras`.
+    """
+    faces = check_faces(faces, None if vertices_mm is None else len(vertices_mm))
+    if vertices_mm is None:
+        return SkofContext(mesh_edge_topology(faces), face_mask_index(face_mask))
+    vertices_mm = np.ascontiguousarray(vertices_mm, dtype=float)
+    clusters = face_clusters(vertices_mm, faces)
+    return SkofContext(
+        mesh_edge_topology(faces[clusters.order]),
+        face_mask_index(face_mask),
+        vertices_mm,
+        clusters,
+    )
+
+
+def skull_outside_pixels_cameras(context, R, t, focal_px, principal_point_px):
+    """``|S \\ F|`` of the full skull under S cameras (exact; P_skof's count).
+
+    Compiled: only the clusters of faces that can reach a non-face pixel are projected and
+    rasterised (:mod:`lilium.fitness._skof_kernels`). Numpy path: every vertex projected
+    (:func:`~lilium.fitness._skof_kernels.project_vertices`, the same rounding) and
+    :func:`skull_outside_pixels_batch`. Both give the same counts.
+
+    Parameters
+    ----------
+    context : SkofContext
+        From :func:`prepare_skof` with the skull's vertices.
+    R : array_like of shape (S, 3, 3)
+    t : array_like of shape (S, 3)
+        Skull-to-camera rotation and translation (mm).
+    focal_px : array_like of shape (S,)
+    principal_point_px : array_like of shape (2,)
+
+    Returns
+    -------
+    count : ndarray of shape (S,) of int64
+    """
+    if context.clusters is None:
+        raise ValueError("build the SkofContext with the skull's vertices (prepare_skof)")
+    R = np.ascontiguousarray(R, dtype=float).reshape(-1, 3, 3)
+    t = np.ascontiguousarray(t, dtype=float).reshape(-1, 3)
+    f = np.ascontiguousarray(focal_px, dtype=float).reshape(-1)
+    c = np.asarray(principal_point_px, dtype=float)
+    if not jit.compiled():
+        uv = project_vertices(context.vertices_mm, R, t, f, c)
+        return skull_outside_pixels_batch(
+            uv, topology=context.topology, mask_index=context.mask_index
+        )
+    topo, cl, index = context.topology, context.clusters, context.mask_index
+    count, _ = outside_pixels_kernel(
+        context.vertices_mm,
+        topo.faces,
+        topo.face_edges,
+        topo.face_dirs,
+        topo.edges_a,
+        topo.edges_b,
+        cl.node_sphere,
+        cl.node_faces,
+        cl.node_children,
+        R,
+        t,
+        f,
+        float(c[0]),
+        float(c[1]),
+        index.clearance2,
+        index.outside_prefix,
+    )
+    return count
 
 
 def _check_uv(uv, batched):

@@ -34,6 +34,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
+from .. import jit
+from ._raster_kernels import scan_kernel
+
 __all__ = [
     "Crossings",
     "EdgeTopology",
@@ -66,6 +69,10 @@ class EdgeTopology:
         ``faces.T``, C-contiguous (fast gathers).
     edges_a, edges_b : ndarray of shape (E,)
         ``edges[:, 0]`` and ``edges[:, 1]``, contiguous.
+    face_edges : ndarray of shape (F, 3) of int64
+        The edge under each side ``faces[f, k] -> faces[f, (k + 1) % 3]`` (the compiled scan).
+    face_dirs : ndarray of shape (F, 3) of float64
+        +1 where that side runs along its edge ``a -> b``, -1 where it runs ``b -> a``.
     """
 
     faces: np.ndarray
@@ -74,6 +81,8 @@ class EdgeTopology:
     corners: np.ndarray
     edges_a: np.ndarray
     edges_b: np.ndarray
+    face_edges: np.ndarray
+    face_dirs: np.ndarray
 
     @property
     def n_faces(self):
@@ -118,7 +127,10 @@ def mesh_edge_topology(faces):
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     direction = np.where(a < b, 1, -1).astype(np.int8)
     if len(lo):
-        edges, edge_of = np.unique(np.column_stack([lo, hi]), axis=0, return_inverse=True)
+        # One int64 key per edge sorts like the (lo, hi) rows, and far faster.
+        n_vertices = int(hi.max()) + 1
+        keys, edge_of = np.unique(lo * n_vertices + hi, return_inverse=True)
+        edges = np.column_stack([keys // n_vertices, keys % n_vertices])
     else:
         edges, edge_of = np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
     incidence = sparse.csr_matrix(
@@ -133,6 +145,8 @@ def mesh_edge_topology(faces):
         corners=np.ascontiguousarray(faces.T),
         edges_a=np.ascontiguousarray(edges[:, 0]),
         edges_b=np.ascontiguousarray(edges[:, 1]),
+        face_edges=np.ascontiguousarray(edge_of.reshape(n_faces, 3), dtype=np.int64),
+        face_dirs=direction.astype(np.float64).reshape(n_faces, 3),
     )
 
 
@@ -245,11 +259,34 @@ def scan_crossings(uv, topology, row_range, col_range, sign=None):
     -------
     Crossings
     """
-    n_vertices = uv.shape[1]
     u = np.ascontiguousarray(uv[..., 0])
     v = np.ascontiguousarray(uv[..., 1])
     if sign is None:
         sign = face_orientations(u, v, topology.corners)
+    bits = _bits(row_range[1] - row_range[0]) + _bits(col_range[1] - col_range[0] + 1)
+    if bits + _bits(uv.shape[0]) + 2 > 62:
+        raise ValueError("scan window too large; clip row_range/col_range to the image")
+    if jit.compiled():
+        member, row, column, winding = scan_kernel(
+            u,
+            v,
+            np.ascontiguousarray(sign, dtype=np.float64),
+            topology.face_edges,
+            topology.face_dirs,
+            topology.edges_a,
+            topology.edges_b,
+            int(row_range[0]),
+            int(row_range[1]),
+            int(col_range[0]),
+            int(col_range[1]),
+        )
+        return Crossings(member, row, column, winding)
+    return _scan_crossings_numpy(u, v, sign, topology, row_range, col_range)
+
+
+def _scan_crossings_numpy(u, v, sign, topology, row_range, col_range):
+    """:func:`scan_crossings` in numpy (the reference of the compiled kernel)."""
+    n_members, n_vertices = u.shape
     member, a, b, weight = contour_edges(sign, topology)
     ia, ib = member * n_vertices + a, member * n_vertices + b
     u, v = u.reshape(-1), v.reshape(-1)
@@ -280,7 +317,7 @@ def scan_crossings(uv, topology, row_range, col_range, sign=None):
     d_bits = _bits(2 * half + 1)
     c_bits = _bits(col_range[1] - col_range[0] + 1)
     r_bits = _bits(row_range[1] - row_range[0])
-    if d_bits + c_bits + r_bits + _bits(uv.shape[0]) > 62:
+    if d_bits + c_bits + r_bits + _bits(n_members) > 62:
         raise ValueError("scan window too large; clip row_range/col_range to the image")
     edge_key = (np.take(member, keep) << (r_bits + c_bits + d_bits)) | (delta + half)
     key = np.take(edge_key, local) | (((row << c_bits) | column) << d_bits)

@@ -4,11 +4,9 @@ Glue between an SFO case (skull, photo) and the pure fitness functions of :mod:`
 each term is prepared once per SFO (regions, facial curve, mask index, mesh topology) and then
 evaluated for a whole population of cameras ``(R (S, 3, 3), t (S, 3), focal_px (S,))``.
 
-P_skof uses the skull decimated to :data:`SKOF_FACES` faces (quadric decimation): rasterising
-the 50k-face skull for every individual would dominate the run time (1.8 ms against 0.43 ms per
-individual). Measured against the full mesh on 480 cameras near the truth (2 deg, 10 mm, 3 %
-focal) of 16 generated photos: the outside-pixel count differs by a median of -7 px, by at most
-40 px for 90 % of the cameras and 135 px at worst (8,000 faces: -5, 26 and 70 px).
+P_skof counts the outside pixels of the full-resolution skull, exactly: the compiled count
+(:func:`lilium.fitness.skof.skull_outside_pixels_cameras`) projects and rasterises only the
+clusters of faces that can reach a non-face pixel under each camera.
 """
 
 import numpy as np
@@ -16,11 +14,7 @@ import numpy as np
 from ..fitness.curves import face_curve_from_mask
 from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
-from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_batch
-from ..geometry.mesh import decimate
-
-#: Faces of the skull used for P_skof (decimated when larger).
-SKOF_FACES = 5000
+from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_cameras
 
 #: Cranial landmarks the P_pll region needs, per view kind.
 PLL_LANDMARKS = {
@@ -111,15 +105,12 @@ def _check_term_inputs(skull, photo, term):
         raise ValueError(_missing_message(skull, photo, what, missing, using))
 
 
-def decimated(vertices_mm, faces, target_faces):
-    """The mesh with at most about ``target_faces`` faces (quadric decimation)."""
-    if len(faces) <= target_faces:
-        return vertices_mm, faces
-    return decimate(vertices_mm, faces, target_faces)
-
-
 class SkofTerm:
     """P_skof = 100 x (projected skull pixels outside the face mask), for a population.
+
+    Exact for the skull as given: every face of the full-resolution mesh counts (no
+    decimation; earlier versions rasterised a 5,000-face copy, whose best cameras could leave
+    pixels of the real skull outside the mask).
 
     Parameters
     ----------
@@ -128,25 +119,17 @@ class SkofTerm:
         Must have a face mask.
     centre : ndarray of shape (2,)
         Principal point (pixels).
-    target_faces : int, optional
-        Default :data:`SKOF_FACES`.
     """
 
-    def __init__(self, skull, photo, centre, target_faces=None):
+    def __init__(self, skull, photo, centre):
         _check_term_inputs(skull, photo, "skof")
-        target_faces = SKOF_FACES if target_faces is None else target_faces
-        self.vertices_mm, faces = decimated(skull.vertices_mm, skull.faces, target_faces)
-        self.context = prepare_skof(faces, photo.face_mask)
+        self.context = prepare_skof(skull.faces, photo.face_mask, skull.vertices_mm)
         self.centre = centre
 
     def outside_pixels(self, cameras):
         """Skull pixels outside the face mask under ``cameras`` (:class:`Cameras`), ``(S,)`` int."""
-        uv = cameras.project(self.vertices_mm)
-        # No culling: exact either way, and at ~8k faces culling costs 5-30 % more than it saves
-        # (the culled interior leaves open borders, i.e. more contour edges to scan;
-        # benchmarks/bench_terms.py cases).
-        return skull_outside_pixels_batch(
-            uv, topology=self.context.topology, mask_index=self.context.mask_index, cull=False
+        return skull_outside_pixels_cameras(
+            self.context, cameras.R, cameras.t, cameras.focal_px, self.centre
         )
 
     def __call__(self, cameras):

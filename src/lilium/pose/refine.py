@@ -23,8 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import jit
 from ..constants import FOCAL_MAX_PX, MIN_DEPTH_MM
 from ..geometry.rotations import rotvec_to_matrix
+from ._refine_kernels import lm_kernel
 from .residuals import reprojection_sq_errors
 
 
@@ -201,6 +203,8 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
     m = np.einsum("sn,snj->sj", w, P) / np.where(w_sum > 0, w_sum, 1.0)
     Pm = P - m[:, None, :]
     c = np.einsum("sij,sj->si", R, m) + t
+    if jit.compiled():  # the same iterations, compiled (pose/_refine_kernels.py)
+        return _refine_compiled(uv_c, P, Pm, m, w_sqrt, R, c, log_f, options)
     r, cost, J = _residuals_and_jacobian(uv_c, Pm, w_sqrt, R, c, log_f)
     # The centroid of points in front of the camera is in front of it too.
     cost = np.where(c[:, 2] > MIN_DEPTH_MM, cost, np.inf)
@@ -261,3 +265,30 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
     t = c - np.einsum("sij,sj->si", R, m)
     sq = reprojection_sq_errors(uv_c, P, R, t, np.exp(log_f))
     return BatchRefineResult(R, t, np.exp(log_f), sq, cost, iteration)
+
+
+def _refine_compiled(uv_c, P, Pm, m, w_sqrt, R, c, log_f, options):
+    """The iterations of :func:`refine_batch` by :func:`~lilium.pose._refine_kernels.lm_kernel`."""
+    floor = options.min_rms_px**2 * 2.0 * np.count_nonzero(w_sqrt, axis=1)
+    R = np.ascontiguousarray(R)
+    c = np.ascontiguousarray(c)
+    log_f = np.ascontiguousarray(log_f)
+    cost, iterations = lm_kernel(
+        np.ascontiguousarray(uv_c),
+        np.ascontiguousarray(Pm),
+        np.ascontiguousarray(w_sqrt),
+        R,
+        c,
+        log_f,
+        floor.astype(float),
+        int(options.max_iterations),
+        float(options.initial_lambda),
+        float(options.cost_tol),
+        float(options.gradient_tol),
+        float(options.max_lambda),
+        float(np.log(options.focal_stop_px)),
+    )
+    t = c - np.einsum("sij,sj->si", R, m)
+    sq = reprojection_sq_errors(uv_c, P, R, t, np.exp(log_f))
+    n_iterations = int(iterations.max()) if len(iterations) else 0
+    return BatchRefineResult(R, t, np.exp(log_f), sq, cost, n_iterations)

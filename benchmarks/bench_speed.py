@@ -1,0 +1,175 @@
+"""Time per SFO, compiled kernels against the numpy reference path, with a per-term profile.
+
+In one process and one run (so the ratios compare like with like on a noisy, shared machine):
+for each photo, POSEST-SFO (median of ``--posest-repeats`` runs, in-process) and every Lilium
+variant at the default DE budget (750 generations x 30) on the compiled path; then the same
+SFOs on the numpy reference path (``lilium.jit.kernels("numpy")``) for ``--reference-generations``
+generations, next to the compiled path at that budget, which gives the speed-up ratio; and a
+per-term profile of the compiled run (where the time of an SFO goes: camera refinement,
+P_skof, P_pll, the rest). The numpy path is the one the compiled kernels replaced: it gives the
+same numbers (``tests/test_kernels.py``).
+
+    python benchmarks/bench_speed.py                       # generated Exp. C photos
+    python benchmarks/bench_speed.py --dataset DIR --dataset DIR2   # e.g. a 150k-face skull
+
+Each SFO is seeded (seed 1, perturbed axes set C1) and runs on one core. Times are the process's
+CPU time (``time.process_time``, single-threaded BLAS), not wall time: on a shared machine the
+wall clock also counts the time other processes hold the core.
+"""
+
+import os
+
+for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
+
+import argparse  # noqa: E402
+import statistics  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from collections import defaultdict  # noqa: E402
+from dataclasses import replace  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from lilium import jit  # noqa: E402
+from lilium.io.case import read_photo, read_skull  # noqa: E402
+from lilium.io.jsonio import read_json  # noqa: E402
+from lilium.methods import METHODS, SfoOptions, run_sfo  # noqa: E402
+from lilium.methods import lilium as lilium_method  # noqa: E402
+from lilium.optimisation import DEOptions  # noqa: E402
+
+VARIANTS = METHODS["lilium"].variants
+
+
+class TermClock:
+    """CPU time spent in Lilium's camera refinement and its image terms (wrapped methods)."""
+
+    PARTS = {
+        "cameras": (lilium_method.LiliumProblem, "cameras"),
+        "p_skof": (lilium_method.SkofTerm, "__call__"),
+        "p_pll": (lilium_method.PllTerm, "__call__"),
+    }
+
+    def __init__(self):
+        self.seconds = defaultdict(float)
+        self._saved = {}
+
+    def __enter__(self):
+        for part, (owner, name) in self.PARTS.items():
+            original = getattr(owner, name)
+            self._saved[part] = original
+
+            def timed(*args, _original=original, _part=part, **kwargs):
+                t0 = time.process_time()
+                try:
+                    return _original(*args, **kwargs)
+                finally:
+                    self.seconds[_part] += time.process_time() - t0
+
+            setattr(owner, name, timed)
+        return self
+
+    def __exit__(self, *exc):
+        for part, (owner, name) in self.PARTS.items():
+            setattr(owner, name, self._saved[part])
+
+
+def photos_of(root):
+    """``(label, skull, photo)`` of every Exp. C photo of a dataset, on its own skull."""
+    index = read_json(root / "dataset.json")
+    out = []
+    for entry in index["photos"]:
+        subject = root / "subjects" / entry["subject"]
+        skull = read_skull(subject, axes_path=subject / "axes_C1.json")
+        photo = read_photo(root / entry["paths"]["C"])
+        view = entry["view"].split("_")[0]
+        out.append((f"{entry['id']} {view} {len(skull.faces) // 1000}k", skull, photo))
+    return out
+
+
+def time_sfo(method, skull, photo, options=SfoOptions(), seed=1):
+    t0 = time.process_time()
+    result = run_sfo(method, skull, photo, options, seed)
+    return time.process_time() - t0, result
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--dataset", type=Path, action="append", help="dataset folder(s)")
+    p.add_argument("--variants", default=",".join(VARIANTS))
+    p.add_argument("--generations", type=int, default=DEOptions().max_generations)
+    p.add_argument("--population", type=int, default=DEOptions().population_size)
+    p.add_argument("--reference-generations", type=int, default=40)
+    p.add_argument("--posest-repeats", type=int, default=30)
+    args = p.parse_args(argv)
+    if not jit.NUMBA_AVAILABLE:
+        p.error("numba is not installed: nothing to compare (pip install 'numba==0.68.1')")
+    roots = args.dataset
+    if not roots:
+        from lilium.synthetic.dataset import generate_dataset
+
+        root = Path(tempfile.mkdtemp(prefix="lilium-speed-"))
+        generate_dataset(root, 1, 1, seed=0, experiments=("C",), workers=1)
+        roots = [root]
+    variants = [v for v in args.variants.split(",") if v]
+    full = SfoOptions().with_de(
+        population_size=args.population, max_generations=args.generations, max_seconds=1e9
+    )
+    short = full.with_de(max_generations=args.reference_generations)
+    rows, profiles = [], []
+    for root in roots:
+        for label, skull, photo in photos_of(root):
+            # Warm-up: loads the compiled kernels (numba's cache) outside the timings.
+            run_sfo("lilium", skull, photo, SfoOptions("skof+pll").with_de(max_generations=2), 0)
+            times = {}
+            for numpy_path in (False, True):
+                with jit.kernels("numpy" if numpy_path else "numba"):
+                    runs = [
+                        time_sfo("posest-sfo", skull, photo)[0] for _ in range(args.posest_repeats)
+                    ]
+                times["posest-sfo", numpy_path] = statistics.median(runs)
+            rows.append(
+                (label, "posest-sfo", times["posest-sfo", False], None, times["posest-sfo", True])
+            )
+            for variant in variants:
+                with TermClock() as clock:
+                    seconds, result = time_sfo(
+                        "lilium", skull, photo, replace(full, variant=variant)
+                    )
+                profiles.append((label, variant, seconds, dict(clock.seconds)))
+                compiled_short, _ = time_sfo(
+                    "lilium", skull, photo, replace(short, variant=variant)
+                )
+                with jit.kernels("numpy"):
+                    reference_short, _ = time_sfo(
+                        "lilium", skull, photo, replace(short, variant=variant)
+                    )
+                rows.append((label, f"lilium {variant}", seconds, compiled_short, reference_short))
+                print(f"  {label:<22} lilium {variant:<9} {seconds:7.2f} s", flush=True)
+
+    g = args.reference_generations
+    print(
+        f"\nCPU time per SFO, one core: compiled at {args.generations} generations x "
+        f"{args.population}; the ratio numpy / compiled measured at {g} generations "
+        f"(POSEST-SFO: median of {args.posest_repeats} runs, whole SFO in-process)"
+    )
+    print(f"{'photo':<22} {'method':<18} {'compiled s':>10} {'numpy s (est.)':>14} {'ratio':>6}")
+    for label, method, seconds, compiled_short, reference_short in rows:
+        if compiled_short is None:
+            ratio = reference_short / seconds
+            estimate = reference_short
+        else:
+            ratio = reference_short / compiled_short
+            estimate = seconds * ratio
+        print(f"{label:<22} {method:<18} {seconds:10.4f} {estimate:14.2f} {ratio:6.1f}")
+    print("\nPer-term profile of the compiled runs (s per SFO; 'rest' = DE, decoding, P_cam)")
+    print(f"{'photo':<22} {'variant':<9} {'total':>7} {'cameras':>8} {'p_skof':>7} ", end="")
+    print(f"{'p_pll':>7} {'rest':>7}")
+    for label, variant, seconds, parts in profiles:
+        cams, skof, pll = (parts.get(k, 0.0) for k in ("cameras", "p_skof", "p_pll"))
+        rest = seconds - cams - skof - pll
+        print(f"{label:<22} {variant:<9} {seconds:7.2f} {cams:8.2f} {skof:7.2f} ", end="")
+        print(f"{pll:7.2f} {rest:7.2f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,167 @@
+"""Compiled skull-curve detection of P_pll (:func:`lilium.fitness.curves.detect_curves_batch`);
+numba, see :mod:`lilium.jit`.
+
+Per member: the covered runs of the region's union raster in the member's own window (the
+contour-edge scan of :mod:`lilium.imaging._raster_kernels`, the same crossings), and from them,
+without building the raster, the skin-side boundary with isolated pixels (no 8-neighbour)
+dropped: the lowest pixel of every column (frontal: rows bottom-up, a union-find skipping the
+columns already done, so the cost follows the number of runs, not the covered area) or the first
+(``lateral_left``) or last (``lateral_right``) pixel of every row. Integer pixels, so the result
+equals the numpy path's exactly.
+"""
+
+import numpy as np
+
+from ..imaging._raster_kernels import accumulate_face, edge_crossings, sort_rows
+from ..jit import njit
+
+#: View codes of :func:`boundary_kernel`.
+VIEW_CODES = {"frontal": 0, "lateral_left": 1, "lateral_right": 2}
+
+
+@njit
+def _find(nxt, c):
+    """First column >= c still without a boundary pixel (path-halving union-find)."""
+    while nxt[c] != c:
+        nxt[c] = nxt[nxt[c]]
+        c = nxt[c]
+    return c
+
+
+@njit
+def _isolated(runs, row_start, k, h):
+    """Whether the one-pixel run ``k`` has no 8-neighbour among the runs of its row and the
+    rows above and below."""
+    r, c = runs[k, 0], runs[k, 1]
+    for rr in range(max(r - 1, 0), min(r + 2, h)):
+        for j in range(row_start[rr], row_start[rr + 1]):
+            if j != k and runs[j, 1] < c + 2 and runs[j, 2] > c - 1:
+                return False
+    return True
+
+
+@njit
+def boundary_kernel(u, v, corners, face_edges, face_dirs, edges_a, edges_b, lo, hi, todo, view):
+    """Skin-side boundary pixels of S projected regions.
+
+    Parameters
+    ----------
+    u, v : ndarray of shape (S, K)
+        Projected region vertices (NaN behind the camera).
+    corners : ndarray of shape (3, F)
+    face_edges, face_dirs, edges_a, edges_b : the region's edge topology
+        (:class:`lilium.imaging.raster.EdgeTopology`).
+    lo, hi : ndarray of shape (S, 2) of int64
+        ``(u, v)`` of each member's window: first pixel and one past the last.
+    todo : ndarray of shape (S,) of bool
+        Members to detect (the others get no points).
+    view : int
+        :data:`VIEW_CODES`.
+
+    Returns
+    -------
+    member : ndarray of shape (N,) of int64
+    points : ndarray of shape (N, 2)
+        ``uv`` of the boundary pixels, member after member, in curve order.
+    """
+    S = u.shape[0]
+    F = corners.shape[1]
+    E = edges_a.shape[0]
+    mult = np.zeros(E)
+    mark = np.full(E, -1, np.int64)
+    touched = np.empty(E, np.int64)
+    buf = np.empty((1024, 3), np.int64)
+    keys = np.empty(1024, np.int64)
+    rows = np.empty(1024, np.int64)
+    runs = np.empty((1024, 3), np.int64)
+    out_member = np.empty(1024, np.int64)
+    out = np.empty((1024, 2))
+    total = 0
+    for m in range(S):
+        if not todo[m]:
+            continue
+        um, vm = u[m], v[m]
+        n_touched = 0
+        for f in range(F):
+            i0, i1, i2 = corners[0, f], corners[1, f], corners[2, f]
+            du1, dv1 = um[i1] - um[i0], vm[i1] - vm[i0]
+            du2, dv2 = um[i2] - um[i0], vm[i2] - vm[i0]
+            area = du1 * dv2 - du2 * dv1
+            if area > 0.0:
+                s = 1.0
+            elif area < 0.0:
+                s = -1.0
+            else:
+                continue
+            n_touched = accumulate_face(
+                f, s, face_edges, face_dirs, mult, mark, m, touched, n_touched
+            )
+        u0, v0 = lo[m, 0], lo[m, 1]
+        w, h = hi[m, 0] - u0, hi[m, 1] - v0
+        buf, n = edge_crossings(
+            um, vm, touched, n_touched, mult, edges_a, edges_b,
+            float(v0), float(hi[m, 1]), float(u0), float(hi[m, 0]), buf,
+        )  # fmt: skip
+        keys, rows = sort_rows(buf, n, keys, rows)
+        # Covered runs (row, start, stop), sorted by row then start; no raster.
+        n_runs = 0
+        winding = 0
+        for i in range(n - 1):
+            winding += buf[i, 2]
+            start, stop = buf[i, 1], buf[i + 1, 1]
+            if winding != 0 and stop > start:
+                if n_runs == runs.shape[0]:
+                    grown_runs = np.empty((2 * n_runs, 3), np.int64)
+                    grown_runs[:n_runs] = runs[:n_runs]
+                    runs = grown_runs
+                runs[n_runs, 0] = buf[i, 0] - v0
+                runs[n_runs, 1] = start - u0
+                runs[n_runs, 2] = stop - u0
+                n_runs += 1
+        row_start = np.zeros(h + 2, np.int64)  # runs of window row r: row_start[r]..[r + 1]
+        for k in range(n_runs):
+            row_start[runs[k, 0] + 1] += 1
+        for r in range(h + 1):
+            row_start[r + 1] += row_start[r]
+        need = total + (w if view == 0 else h)
+        if need > out.shape[0]:
+            size = max(need, 2 * out.shape[0])
+            grown = np.empty((size, 2))
+            grown[:total] = out[:total]
+            out = grown
+            grown_m = np.empty(size, np.int64)
+            grown_m[:total] = out_member[:total]
+            out_member = grown_m
+        if view == 0:
+            # Rows bottom-up; nxt[c] leads to the first column >= c without a boundary pixel.
+            lowest = np.full(w, -1, np.int64)
+            nxt = np.arange(w + 1)
+            for r in range(h - 1, -1, -1):
+                for k in range(row_start[r], row_start[r + 1]):
+                    c = _find(nxt, runs[k, 1])
+                    while c < runs[k, 2]:
+                        if runs[k, 2] - runs[k, 1] == 1 and _isolated(runs, row_start, k, h):
+                            break
+                        lowest[c] = r
+                        nxt[c] = c + 1
+                        c = _find(nxt, c + 1)
+            for c in range(w):
+                if lowest[c] >= 0:
+                    out[total, 0] = c + u0
+                    out[total, 1] = lowest[c] + v0
+                    out_member[total] = m
+                    total += 1
+        else:
+            for r in range(h):
+                lo_k, hi_k = row_start[r], row_start[r + 1]
+                for j in range(hi_k - lo_k):
+                    k = lo_k + j if view == 1 else hi_k - 1 - j
+                    if runs[k, 2] - runs[k, 1] == 1 and _isolated(runs, row_start, k, h):
+                        continue
+                    c = runs[k, 1] if view == 1 else runs[k, 2] - 1
+                    out[total, 0] = c + u0
+                    out[total, 1] = r + v0
+                    out_member[total] = m
+                    total += 1
+                    break
+    return out_member[:total].copy(), out[:total].copy()

@@ -1,0 +1,267 @@
+"""Compiled Levenberg-Marquardt of :func:`lilium.pose.refine.refine_batch` (numba, see
+:mod:`lilium.jit`).
+
+The numpy code of :mod:`lilium.pose.refine` runs the problems of a batch in lockstep, one
+vectorised iteration for all active problems at a time; here each problem runs its own loop,
+with the same unknowns, residuals, Jacobian, damping updates and stopping tests, so every
+problem takes the same steps. Sums are accumulated in a fixed order, ``exp`` is libm's (numpy's
+SIMD ``exp`` differs in the last bit for a few per cent of arguments) and the 7 x 7 system is
+solved by Gaussian elimination with partial pivoting rather than LAPACK, so results agree with
+the numpy path to rounding, not bit for bit: to about 1e-12 relative for Lilium's warm-started
+refinements (``tests/test_kernels.py`` checks 1e-9); where a problem ends in a flat valley (a
+distant head, focal length and depth nearly interchangeable) the two paths stop at points that
+differ by up to about 1e-7 relative, within the refinement's own stopping tolerance. A
+singular system (LAPACK's error, where the numpy path turns to a pseudo-inverse) gives a
+rejected step and a larger damping.
+"""
+
+import numpy as np
+
+from ..constants import MIN_DEPTH_MM
+from ..jit import njit
+
+_SMALL_ANGLE = 1e-8  # as lilium.geometry.rotations
+
+
+@njit
+def _rotvec_to_matrix(w0, w1, w2, out):
+    """Rodrigues' formula, as :func:`lilium.geometry.rotations.rotvec_to_matrix`."""
+    theta_sq = w0 * w0 + w1 * w1 + w2 * w2
+    theta = np.sqrt(theta_sq)
+    if theta < _SMALL_ANGLE:
+        a = 1.0 - theta_sq / 6.0
+        b = 0.5 - theta_sq / 24.0
+    else:
+        a = np.sin(theta) / theta
+        b = (1.0 - np.cos(theta)) / (theta * theta)
+    w = (w0, w1, w2)
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = (b * w[i]) * w[j]
+    diag = 1.0 - b * theta_sq
+    x, y, z = a * w0, a * w1, a * w2
+    out[0, 0] += diag
+    out[1, 1] += diag
+    out[2, 2] += diag
+    out[0, 1] -= z
+    out[1, 0] += z
+    out[0, 2] += y
+    out[2, 0] -= y
+    out[1, 2] -= x
+    out[2, 1] += x
+
+
+@njit
+def _residuals(uv, P, ws, R, c, log_f, r, J):
+    """Weighted residuals ``r`` (2N,) and Jacobian ``J`` (2N, 7) of one problem; its cost.
+
+    The formulas of :func:`lilium.pose.refine._residuals_and_jacobian`.
+    """
+    N = P.shape[0]
+    f = np.exp(log_f)
+    cost = 0.0
+    behind = False
+    for n in range(N):
+        p0, p1, p2 = P[n, 0], P[n, 1], P[n, 2]
+        q0 = R[0, 0] * p0 + R[0, 1] * p1 + R[0, 2] * p2
+        q1 = R[1, 0] * p0 + R[1, 1] * p1 + R[1, 2] * p2
+        q2 = R[2, 0] * p0 + R[2, 1] * p1 + R[2, 2] * p2
+        X0, X1, z = q0 + c[0], q1 + c[1], q2 + c[2]
+        w = ws[n]
+        ahead = z > MIN_DEPTH_MM
+        if not ahead and w > 0:
+            behind = True
+        zs = z if ahead else 1.0
+        x, y = X0 / zs, X1 / zs
+        fx, fy = f * x, f * y
+        ru = (fx - uv[n, 0]) * w
+        rv = (fy - uv[n, 1]) * w
+        r[2 * n] = ru
+        r[2 * n + 1] = rv
+        cost += ru * ru
+        cost += rv * rv
+        fz = (f / zs) * w
+        wfx, wfy = fx * w, fy * w
+        cz = c[2] / zs
+        i, k = 2 * n, 2 * n + 1
+        J[i, 0] = -fz * x * q1
+        J[i, 1] = fz * (q2 + x * q0)
+        J[i, 2] = -fz * q1
+        J[k, 0] = -fz * (q2 + y * q1)
+        J[k, 1] = fz * y * q0
+        J[k, 2] = fz * q0
+        J[i, 3] = cz * w
+        J[i, 4] = 0.0
+        J[k, 3] = 0.0
+        J[k, 4] = cz * w
+        J[i, 5] = wfx - fz * c[0]
+        J[k, 5] = wfy - fz * c[1]
+        J[i, 6] = wfx * (1.0 - cz)
+        J[k, 6] = wfy * (1.0 - cz)
+    return np.inf if behind else cost
+
+
+@njit
+def _solve7(A, g, out):
+    """``out = -A^{-1} g`` by Gaussian elimination with partial pivoting; False if singular."""
+    M = A.copy()
+    b = g.copy()
+    n = 7
+    for col in range(n):
+        p = col
+        best = abs(M[col, col])
+        for i in range(col + 1, n):
+            if abs(M[i, col]) > best:
+                best = abs(M[i, col])
+                p = i
+        if best == 0.0 or not np.isfinite(best):
+            return False
+        if p != col:
+            for j in range(n):
+                M[col, j], M[p, j] = M[p, j], M[col, j]
+            b[col], b[p] = b[p], b[col]
+        for i in range(col + 1, n):
+            factor = M[i, col] / M[col, col]
+            for j in range(col, n):
+                M[i, j] -= factor * M[col, j]
+            b[i] -= factor * b[col]
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, n):
+            s -= M[i, j] * out[j]
+        out[i] = s / M[i, i]
+    for i in range(n):
+        out[i] = -out[i]
+    return True
+
+
+@njit
+def lm_kernel(
+    uv,
+    P,
+    ws,
+    R,
+    c,
+    log_f,
+    floor,
+    max_iterations,
+    initial_lambda,
+    cost_tol,
+    gradient_tol,
+    max_lambda,
+    log_f_stop,
+):
+    """Levenberg-Marquardt of S problems, each to its own stop; ``R``, ``c``, ``log_f`` in place.
+
+    Parameters
+    ----------
+    uv : ndarray of shape (S, N, 2)
+    P : ndarray of shape (S, N, 3)
+        Points minus their weighted centroid.
+    ws : ndarray of shape (S, N)
+        Square roots of the weights.
+    R : ndarray of shape (S, 3, 3)
+    c : ndarray of shape (S, 3)
+    log_f : ndarray of shape (S,)
+    floor : ndarray of shape (S,)
+        Cost below which a problem counts as fitted exactly.
+
+    Returns
+    -------
+    cost : ndarray of shape (S,)
+    iterations : ndarray of shape (S,) of int64
+    """
+    S, N = ws.shape
+    cost = np.empty(S)
+    iterations = np.zeros(S, np.int64)
+    r = np.empty(2 * N)
+    J = np.empty((2 * N, 7))
+    r_new = np.empty(2 * N)
+    J_new = np.empty((2 * N, 7))
+    JtJ = np.empty((7, 7))
+    A = np.empty((7, 7))
+    g = np.empty(7)
+    delta = np.empty(7)
+    dR = np.empty((3, 3))
+    R_new = np.empty((3, 3))
+    c_new = np.empty(3)
+    for s in range(S):
+        cost_s = _residuals(uv[s], P[s], ws[s], R[s], c[s], log_f[s], r, J)
+        if not c[s, 2] > MIN_DEPTH_MM:
+            cost_s = np.inf
+        lam, nu = initial_lambda, 2.0
+        active = np.isfinite(cost_s) and cost_s > floor[s]
+        it = 0
+        while active and it < max_iterations:
+            it += 1
+            for i in range(7):
+                for j in range(7):
+                    acc = 0.0
+                    for k in range(2 * N):
+                        acc += J[k, i] * J[k, j]
+                    JtJ[i, j] = acc
+                acc = 0.0
+                for k in range(2 * N):
+                    acc += J[k, i] * r[k]
+                g[i] = acc
+            worst = 0.0
+            for i in range(7):
+                worst = max(worst, abs(g[i]) / np.sqrt(max(JtJ[i, i], 1e-300)))
+            small_gradient = worst <= gradient_tol * np.sqrt(cost_s)
+            for i in range(7):
+                for j in range(7):
+                    A[i, j] = JtJ[i, j]
+                A[i, i] += lam * (JtJ[i, i] + 1e-12)
+            solved = _solve7(A, g, delta)
+            if not solved:
+                for i in range(7):
+                    delta[i] = np.nan
+            gd, dJd = 0.0, 0.0
+            for i in range(7):
+                gd += g[i] * delta[i]
+                for j in range(7):
+                    dJd += delta[i] * JtJ[i, j] * delta[j]
+            predicted = -2.0 * gd - dJd
+            _rotvec_to_matrix(delta[0], delta[1], delta[2], dR)
+            for i in range(3):
+                for j in range(3):
+                    R_new[i, j] = (
+                        dR[i, 0] * R[s, 0, j] + dR[i, 1] * R[s, 1, j] + dR[i, 2] * R[s, 2, j]
+                    )
+            log_cz = np.log(c[s, 2])
+            sigma = log_f[s] - log_cz + delta[5]
+            tau = log_cz + delta[6]
+            scale = np.exp(log_f[s] - log_cz)
+            back = np.exp(-sigma)
+            c_new[0] = (c[s, 0] * scale + delta[3]) * back
+            c_new[1] = (c[s, 1] * scale + delta[4]) * back
+            c_new[2] = np.exp(tau)
+            logf_new = sigma + tau
+            cost_new = _residuals(uv[s], P[s], ws[s], R_new, c_new, logf_new, r_new, J_new)
+            better = cost_new < cost_s
+            cost_old = cost_s
+            gain = cost_old - cost_new if better else 0.0
+            if better:
+                R[s] = R_new
+                c[s] = c_new
+                log_f[s] = logf_new
+                r[:] = r_new
+                J[:, :] = J_new
+                cost_s = cost_new
+            rho = gain / max(predicted, 1e-300)
+            shrink = max(1.0 / 3.0, 1.0 - (2.0 * min(rho, 1.0) - 1.0) ** 3)
+            lam = max(lam * shrink if better else lam * nu, 1e-12)
+            nu = 2.0 if better else nu * 2.0
+            done = (
+                (better and gain <= cost_tol * cost_old)
+                or (not better and predicted <= cost_tol * cost_old)
+                or cost_s <= floor[s]
+                or small_gradient
+                or lam > max_lambda
+                or log_f[s] > log_f_stop
+            )
+            if done:
+                active = False
+        cost[s] = cost_s
+        iterations[s] = it
+    return cost, iterations

@@ -1,0 +1,211 @@
+"""The compiled kernels against their numpy references (lilium.jit): same integers, same floats.
+
+The references are the numpy code the kernels replaced (still the package's fallback path,
+selected with ``lilium.jit.kernels("numpy")``) and the per-triangle oracle of
+``tests/raster_oracle.py``.
+"""
+
+import numpy as np
+import pytest
+
+from lilium import jit
+from lilium.fitness._skof_kernels import face_clusters, project_vertices
+from lilium.fitness.skof import (
+    prepare_skof,
+    skull_outside_pixels_batch,
+    skull_outside_pixels_cameras,
+)
+from lilium.geometry.rotations import rotvec_to_matrix
+from lilium.imaging.raster import mesh_edge_topology, scan_crossings
+from raster_oracle import skull_raster_per_triangle
+
+needs_numba = pytest.mark.skipif(not jit.NUMBA_AVAILABLE, reason="numba is not installed")
+
+HEIGHT, WIDTH = 480, 640
+CENTRE = np.array([320.0, 240.0])
+
+
+def shell_skull(n_lat=40, n_lon=60, rng=0):
+    """A bumpy two-walled shell (outer and inner table, mm) with a hole at the bottom.
+
+    Open borders, back faces inside the front ones, about 2 n_lat n_lon faces per wall.
+    """
+    rng = np.random.default_rng(rng)
+    theta = np.linspace(0.05, 0.8 * np.pi, n_lat)
+    phi = np.linspace(0, 2 * np.pi, n_lon, endpoint=False)
+    T, P = np.meshgrid(theta, phi, indexing="ij")
+    bumps = 0.08 * np.sin(3 * T) * np.cos(5 * P) + 0.01 * rng.standard_normal(T.shape)
+    direction = np.stack([np.sin(T) * np.cos(P), np.cos(T), np.sin(T) * np.sin(P)], -1)
+    radii = np.array([70.0, 85.0, 90.0])
+    walls, faces = [], []
+    idx = np.arange(n_lat * n_lon).reshape(n_lat, n_lon)
+    nxt = np.roll(idx, -1, axis=1)
+    quads = [
+        np.stack([idx[:-1], nxt[:-1], nxt[1:]], -1).reshape(-1, 3),
+        np.stack([idx[:-1], nxt[1:], idx[1:]], -1).reshape(-1, 3),
+    ]
+    for k, scale in enumerate((1.0, 0.9)):
+        walls.append((direction * ((1 + bumps) * scale)[..., None] * radii).reshape(-1, 3))
+        wall_faces = np.vstack(quads) + k * n_lat * n_lon
+        faces.append(wall_faces if k == 0 else wall_faces[:, ::-1])
+    return np.vstack(walls), np.vstack(faces)
+
+
+def face_mask(holes=True):
+    """An elliptical head mask, with a notch and a hole (non-convex, not simply connected)."""
+    rows, cols = np.mgrid[:HEIGHT, :WIDTH]
+    mask = ((cols - 320) / 190.0) ** 2 + ((rows - 250) / 215.0) ** 2 <= 1.0
+    if not holes:
+        return mask
+    mask[300:330, 120:260] = False
+    mask[150:170, 300:330] = False
+    return mask
+
+
+def cameras(n, rng=0):
+    """Rotated, scaled and shifted cameras looking at the shell: some clip the image, some put
+    vertices behind the camera."""
+    rng = np.random.default_rng(rng)
+    R = np.array([rotvec_to_matrix(rng.normal(scale=0.6, size=3)) for _ in range(n)])
+    depth = rng.uniform(400.0, 2500.0, n)
+    depth[: n // 8] = rng.uniform(60.0, 110.0, n // 8)  # the camera inside the shell's reach
+    t = np.column_stack([rng.normal(scale=40.0, size=(n, 2)), depth])
+    focal = depth * rng.uniform(1.2, 3.2, n)
+    return R, t, focal
+
+
+@needs_numba
+@pytest.mark.parametrize("window", [((0, HEIGHT), (0, WIDTH)), ((-37, 700), (-50, 900))])
+def test_scan_kernel_gives_the_numpy_crossings(window):
+    vertices, faces = shell_skull()
+    topology = mesh_edge_topology(faces)
+    uv = project_vertices(vertices, *cameras(12, rng=1), CENTRE)
+    compiled = scan_crossings(uv, topology, *window)
+    with jit.kernels("numpy"):
+        reference = scan_crossings(uv, topology, *window)
+    assert len(reference.row) > 1000
+    for field in ("member", "row", "column", "winding"):
+        np.testing.assert_array_equal(getattr(compiled, field), getattr(reference, field))
+
+
+def test_full_skull_count_equals_the_raster_of_every_face():
+    """The culled count (either path) equals the full mesh's, never fewer, on rotated and
+    scaled skulls."""
+    vertices, faces = shell_skull(rng=2)
+    mask = face_mask()
+    context = prepare_skof(faces, mask, vertices)
+    R, t, focal = cameras(64, rng=3)
+    uv = project_vertices(vertices, R, t, focal, CENTRE)
+    with jit.kernels("numpy"):
+        full = skull_outside_pixels_batch(uv, faces, mask, cull=False)
+        numpy_path = skull_outside_pixels_cameras(context, R, t, focal, CENTRE)
+    np.testing.assert_array_equal(numpy_path, full)
+    assert (full < 2000).sum() >= 3 and (full > 50_000).sum() >= 10  # near and far cases
+    if jit.NUMBA_AVAILABLE:
+        np.testing.assert_array_equal(
+            skull_outside_pixels_cameras(context, R, t, focal, CENTRE), full
+        )
+    # The independent per-triangle union agrees where it is defined (no vertex behind).
+    for m in np.flatnonzero(np.all(np.isfinite(uv), axis=(1, 2)))[:6]:
+        oracle = skull_raster_per_triangle(uv[m], faces, (HEIGHT, WIDTH))
+        assert int((oracle & ~mask).sum()) == full[m]
+
+
+@needs_numba
+def test_skull_slightly_inside_the_mask_counts_its_few_outside_pixels():
+    """Cameras near one that fits: the shortcut skips most clusters and still counts exactly."""
+    vertices, faces = shell_skull(rng=4)
+    mask = face_mask(holes=False)
+    context = prepare_skof(faces, mask, vertices)
+    rng = np.random.default_rng(5)
+    n = 40
+    R = np.array([rotvec_to_matrix(rng.normal(scale=0.03, size=3)) for _ in range(n)])
+    t = np.column_stack([rng.normal(scale=4.0, size=(n, 2)), rng.uniform(1500, 1700, n)])
+    focal = t[:, 2] * rng.uniform(1.5, 2.3, n)
+    uv = project_vertices(vertices, R, t, focal, CENTRE)
+    full = skull_outside_pixels_batch(uv, faces, mask, cull=False)
+    np.testing.assert_array_equal(skull_outside_pixels_cameras(context, R, t, focal, CENTRE), full)
+    assert (full == 0).any() and (full > 0).any()
+
+
+def test_clusters_cover_every_face_once():
+    vertices, faces = shell_skull(n_lat=11, n_lon=13)
+    clusters = face_clusters(vertices, faces, leaf_faces=8, fan_out=4)
+    np.testing.assert_array_equal(np.sort(clusters.order), np.arange(len(faces)))
+    leaves = clusters.node_children[:, 1] == clusters.node_children[:, 0]
+    ranges = clusters.node_faces[leaves]
+    np.testing.assert_array_equal(ranges[1:, 0], ranges[:-1, 1])
+    assert ranges[0, 0] == 0 and ranges[-1, 1] == len(faces)
+    # Every node's sphere holds the corners of its faces.
+    clustered = vertices[faces[clusters.order]]
+    for (lo, hi), sphere in zip(clusters.node_faces, clusters.node_sphere, strict=True):
+        d = np.linalg.norm(clustered[lo:hi].reshape(-1, 3) - sphere[:3], axis=1)
+        assert d.max() <= sphere[3]
+
+
+def test_context_without_vertices_is_refused():
+    context = prepare_skof(np.array([[0, 1, 2]]), np.ones((4, 4), bool))
+    with pytest.raises(ValueError, match="with the skull's vertices"):
+        skull_outside_pixels_cameras(context, np.eye(3)[None], [[0, 0, 10.0]], [10.0], [2, 2])
+
+
+def _lm_problems(S=120, N=18, rng=7):
+    from lilium.geometry.camera import project_points
+
+    rng = np.random.default_rng(rng)
+    X = rng.normal(scale=60.0, size=(S, N, 3))
+    R = np.array([rotvec_to_matrix(rng.normal(size=3)) for _ in range(S)])
+    t = np.column_stack([rng.normal(scale=20.0, size=(S, 2)), rng.uniform(500.0, 1500.0, S)])
+    f = rng.uniform(1000.0, 4000.0, S)
+    uv = project_points(X, R, t, f) + rng.normal(scale=2.0, size=(S, N, 2))
+    turn = np.array([rotvec_to_matrix(rng.normal(scale=0.05, size=3)) for _ in range(S)])
+    start = (turn @ R, t + rng.normal(scale=[5.0, 5.0, 50.0], size=(S, 3)), f * 1.05)
+    weights = (rng.random((S, N)) > 0.2).astype(float)
+    t[0, 2] = -5.0  # one problem starts behind the camera
+    return uv, X, start, weights
+
+
+@needs_numba
+def test_lm_kernel_matches_the_numpy_iterations():
+    """Lilium's warm-started refinement (6 iterations): the compiled loop takes the numpy
+    path's steps (1e-9 relative)."""
+    from lilium.methods.options import SfoOptions
+    from lilium.pose.refine import refine_batch
+
+    uv, X, (R0, t0, f0), w = _lm_problems()
+    options = SfoOptions().refine
+    compiled = refine_batch(uv, X, R0, t0, f0, w, options)
+    with jit.kernels("numpy"):
+        reference = refine_batch(uv, X, R0, t0, f0, w, options)
+    assert compiled.n_iterations == reference.n_iterations
+    for name in ("R", "t", "focal_px", "sq_err_px2", "cost"):
+        a, b = getattr(compiled, name), getattr(reference, name)
+        np.testing.assert_array_equal(np.isfinite(a), np.isfinite(b))
+        ok = np.isfinite(b)
+        np.testing.assert_allclose(a[ok], b[ok], rtol=1e-9, atol=1e-9 * np.abs(b[ok]).max())
+
+
+@needs_numba
+@pytest.mark.parametrize("view", ["frontal", "lateral_left", "lateral_right"])
+def test_curve_detection_kernel_gives_the_numpy_curves(view):
+    from lilium.fitness.curves import detect_curves_batch
+
+    vertices, faces = shell_skull(n_lat=30, n_lon=40, rng=8)
+    low = vertices[faces].mean(axis=1)[:, 1] < -20.0  # an open cap: a chin-like region
+    used, region = np.unique(faces[low], return_inverse=True)
+    region = region.reshape(-1, 3)
+    topology = mesh_edge_topology(region)
+    R, t, focal = cameras(40, rng=9)
+    uv = project_vertices(vertices[used], R, t, focal, CENTRE)
+    uv[3] += 5000.0  # a window clipped at the image's surroundings
+    span = uv[:, :2, 1] if view != "frontal" else None
+    compiled = detect_curves_batch(
+        uv, view, topology=topology, span_v=span, image_shape=(HEIGHT, WIDTH)
+    )
+    with jit.kernels("numpy"):
+        reference = detect_curves_batch(
+            uv, view, topology=topology, span_v=span, image_shape=(HEIGHT, WIDTH)
+        )
+    assert len(reference.points) > 500
+    np.testing.assert_array_equal(compiled.offset, reference.offset)
+    np.testing.assert_array_equal(compiled.points, reference.points)
