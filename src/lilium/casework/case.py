@@ -11,6 +11,13 @@ from ..methods.registry import check_method, method_tag, run_sfo
 from .inputs import check_runnable, load_photos, load_skull
 
 
+def term_label(term):
+    """``p_pll`` -> ``P_pll``; ``p_cam_focal`` -> ``P_cam (focal)``."""
+    if term.startswith("p_cam_"):
+        return f"P_cam ({term[len('p_cam_') :]})"
+    return "P_" + term[2:] if term.startswith("p_") else term
+
+
 def run_case(
     skull_path,
     photos,
@@ -51,6 +58,12 @@ def run_case(
     Returns
     -------
     list of ReportEntry
+
+    Notes
+    -----
+    Before the first SFO, ``log`` gets one line per term Lilium will switch off for a photo
+    (:func:`~lilium.casework.inputs.check_runnable`): ``<photo>: lilium <variant>: P_pll
+    switched off: <why>``; each SFO's line ends with the terms it ran without.
     """
     from ..report.html import ReportEntry, write_report
 
@@ -63,8 +76,14 @@ def run_case(
         from dataclasses import replace
 
         options = replace(options, depth_table=read_depth_table(depth_table))
+    planned = {}
     for photo, inputs, _ in records:  # every problem before any long run
-        check_runnable(skull, photo, methods, options.variant, skull_inputs, inputs)
+        planned[photo.id] = check_runnable(
+            skull, photo, methods, options.variant, skull_inputs, inputs
+        )
+    for photo_id, off in planned.items():
+        for term, why in off.items():
+            log(f"{photo_id}: lilium {options.variant}: {term_label(term)} switched off: {why}")
     out = Path(out)
     entries = []
     for photo, inputs, notes in records:
@@ -84,7 +103,8 @@ def run_case(
                 if result
                 else f"FAILED ({result.error})"
             )
-            log(f"{photo.id}: {name}: {status}, {result.seconds:.2f} s -> {folder}")
+            off = f", off: {', '.join(result.terms_off)}" if result.terms_off else ""
+            log(f"{photo.id}: {name}: {status}{off}, {result.seconds:.2f} s -> {folder}")
             entries.append(
                 ReportEntry(skull, photo, result, {**skull_inputs, **inputs}, notes, outputs)
             )

@@ -28,7 +28,7 @@ from ..pose.refine import refine_batch
 from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
-from .lilium_terms import PllTerm, SkofTerm
+from .lilium_terms import image_terms, prior_terms_off
 from .options import SfoOptions
 from .result import SfoResult
 
@@ -84,11 +84,12 @@ class LiliumProblem:
         self.scd_index = [names.index("nasion")] if "nasion" in names else list(range(len(names)))
         self.rng = np.random.default_rng(rng)
         self.periodic = np.tile([False, False, True], len(self.corr.cranial_names))
-        self.skof = self.pll = None
-        if self.use_skof:
-            self.skof = SkofTerm(self.skull, self.photo, self.centre)
-        if self.use_pll:
-            self.pll = PllTerm(self.skull, self.photo, self.centre)
+        # Asked-for terms whose inputs are missing are switched off (SPEC section 5), and so is
+        # each P_cam part without its prior: ``terms_off`` says which and why.
+        self.skof, self.pll, self.terms_off = image_terms(
+            skull, photo, self.centre, self.use_skof, self.use_pll
+        )
+        self.terms_off.update(prior_terms_off(photo.priors))
         self.n_fallbacks = 0  # statistics only
 
     # -- evaluation -------------------------------------------------------------------------
@@ -235,9 +236,10 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     -------
     SfoResult
         The best member DE ranked: its camera, fitness and terms as DE evaluated them
-        (``fitness`` equals the last value of ``history``). ``extra`` holds ``history`` (best
-        fitness per generation), ``generations``, ``evaluations``, ``stop``, ``genes`` and
-        ``fallbacks``.
+        (``fitness`` equals the last value of ``history``); ``terms_off`` names the terms the
+        variant asks for that could not apply, and the P_cam parts without a prior. ``extra``
+        holds ``history`` (best fitness per generation), ``generations``, ``evaluations``,
+        ``stop``, ``genes`` and ``fallbacks``.
     """
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
@@ -268,6 +270,7 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         facial_landmarks_mm=dict(zip(problem.corr.facial_names, facial, strict=True)),
         seconds=time.perf_counter() - start,
         error="" if ok else "no camera found for the best soft-tissue estimate",
+        terms_off=dict(problem.terms_off),
         extra={
             "history": de.history.tolist(),
             "generations": de.nit,

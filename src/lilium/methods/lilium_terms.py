@@ -13,10 +13,11 @@ focal) of 16 generated photos: the outside-pixel count differs by a median of -7
 
 import numpy as np
 
-from ..fitness.curves import face_curve_from_mask
+from ..fitness.curves import face_curve_from_mask, missing_curve_bounds
 from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_batch
+from ..geometry.camera import principal_point_of
 from ..geometry.mesh import decimate
 
 #: Faces of the skull used for P_skof (decimated when larger).
@@ -69,6 +70,68 @@ class SkofTerm:
         return skof_penalty(self.outside_pixels(cameras)).astype(float)
 
 
+class TermOff(ValueError):
+    """A fitness term cannot apply to this skull and photo: its inputs are missing.
+
+    Not an error of the SFO (SPEC section 5, "When a term cannot apply"): :func:`image_terms`
+    switches the term off and keeps the message as the reason (``SfoResult.terms_off``).
+    """
+
+
+#: Cranial landmarks that cut the skull's P_pll region: the chin-jaw (frontal views) and the
+#: forehead (lateral views).
+PLL_SKULL_LANDMARKS = {
+    "frontal": ("infradentale", "mental_foramen_l", "mental_foramen_r"),
+    "lateral": ("glabella", "metopion"),
+}
+
+
+def _region_name(view):
+    return "chin-jaw" if view == "frontal" else "forehead"
+
+
+def pll_skull_landmarks(view):
+    """The cranial landmarks P_pll needs on the skull in ``view`` (:data:`PLL_SKULL_LANDMARKS`)."""
+    return PLL_SKULL_LANDMARKS["frontal" if view == "frontal" else "lateral"]
+
+
+def skof_off_reason(photo):
+    """Why P_skof cannot apply to ``photo`` ("" when it can): it needs the face mask."""
+    if photo.face_mask is None:
+        return f"photo {photo.id!r} has no face mask (face_mask.png or --mask)"
+    return ""
+
+
+def pll_off_reason(skull, photo):
+    """Why P_pll cannot apply ("" when the landmarks and curve inputs it needs are there).
+
+    The cheap checks only (no mesh work): the cranial landmarks that cut the skull's region;
+    a facial curve (``face_curve.json``, or the face mask with the landmarks that bound the
+    curve on it). :class:`PllTerm` finds the rest (an empty region or curve).
+    """
+    view, region = photo.view, _region_name(photo.view)
+    missing = [n for n in pll_skull_landmarks(view) if n not in skull.landmarks_mm]
+    if missing:
+        absent = " (no mandible?)" if view == "frontal" and "infradentale" in missing else ""
+        return (
+            f"skull {skull.id!r} has no {', '.join(missing)}{absent} in its cranial landmarks, "
+            f"which cut the {region} region"
+        )
+    if photo.face_curve_uv is not None:
+        return ""
+    if photo.face_mask is None:
+        return (
+            f"photo {photo.id!r} has neither face_curve.json nor a face mask for the {region} curve"
+        )
+    unmarked = missing_curve_bounds(view, photo.landmarks_uv)
+    if unmarked:
+        return (
+            f"photo {photo.id!r} has no {', '.join(unmarked)} to bound the {region} curve on the "
+            "face mask (mark it, or give face_curve.json)"
+        )
+    return ""
+
+
 class PllTerm:
     """P_pll between the skull's and the face's chin-jaw (frontal) or forehead (lateral) curves.
 
@@ -77,44 +140,35 @@ class PllTerm:
 
     Raises
     ------
-    ValueError
-        A landmark the region or the facial curve needs is missing, or neither a face curve
-        nor a mask is given.
+    TermOff
+        P_pll cannot apply (:func:`pll_off_reason`; the skull's region or the facial curve is
+        empty; the skull's landmarks cannot orient the head); the message says why.
     """
 
     def __init__(self, skull, photo, centre):
-        view = photo.view
-        lm = skull.landmarks_mm
-        need = (
-            ("infradentale", "mental_foramen_l", "mental_foramen_r")
-            if view == "frontal"
-            else ("glabella", "metopion")
-        )
-        missing = [n for n in need if n not in lm]
-        if missing:
-            raise ValueError(
-                f"skull {skull.id!r}: the pll variants need the cranial landmarks "
-                f"{', '.join(missing)} (in cranial_landmarks.json) to cut the "
-                f"{'chin-jaw' if view == 'frontal' else 'forehead'} region"
+        reason = pll_off_reason(skull, photo)
+        if reason:
+            raise TermOff(reason)
+        view, lm, region_name = photo.view, skull.landmarks_mm, _region_name(photo.view)
+        try:
+            frame = anatomical_frame(lm)
+        except ValueError as exc:
+            raise TermOff(f"skull {skull.id!r}: {exc}") from None
+        cut = chin_jaw_region if view == "frontal" else forehead_region
+        region = cut(skull.vertices_mm, skull.faces, lm, frame)
+        if len(region.faces) == 0:
+            raise TermOff(
+                f"skull {skull.id!r}: the {region_name} region between its landmarks holds no "
+                "triangle of the mesh (check the landmarks against skull.ply)"
             )
-        frame = anatomical_frame(lm)
-        if view == "frontal":
-            region = chin_jaw_region(skull.vertices_mm, skull.faces, lm, frame)
-        else:
-            region = forehead_region(skull.vertices_mm, skull.faces, lm, frame)
         if photo.face_curve_uv is not None:
             face_curve = photo.face_curve_uv
-        elif photo.face_mask is not None:
-            face_curve = face_curve_from_mask(photo.face_mask, view, photo.landmarks_uv)
         else:
-            raise ValueError(
-                f"photo {photo.id!r} has neither face_curve.json nor face_mask.png; the pll "
-                "variants need one of them"
-            )
+            face_curve = face_curve_from_mask(photo.face_mask, view, photo.landmarks_uv)
         if len(face_curve) < 2:
-            raise ValueError(
-                f"photo {photo.id!r}: the facial {'chin-jaw' if view == 'frontal' else 'forehead'}"
-                " curve is empty; check face_mask.png and the landmarks, or give face_curve.json"
+            raise TermOff(
+                f"photo {photo.id!r}: the facial {region_name} curve is empty (check "
+                "face_mask.png and the landmarks, or give face_curve.json)"
             )
         self.region_vertices_mm = skull.vertices_mm[region.vertex_index]
         self.context = PllContext.build(
@@ -134,3 +188,96 @@ class PllTerm:
         uv = camera.project(self.region_vertices_mm)
         span_v = None if self.span_mm is None else camera.project(self.span_mm)[:, 1]
         return self.context.skull_curve(uv, span_v), self.context.face_curve
+
+
+#: Labels of the P_cam parts a missing prior switches off (keys of ``terms_off``).
+PRIOR_TERMS = {
+    "p_cam_focal": "focal length",
+    "p_cam_scd": "subject-to-camera distance",
+    "p_cam_head": "head orientation",
+}
+
+
+def prior_terms_off(priors):
+    """The P_cam parts without their prior: ``{key of PRIOR_TERMS: reason}``.
+
+    Parameters
+    ----------
+    priors : lilium.fitness.camera_penalty.Priors
+    """
+    off = {}
+    if priors.focal_px is None:
+        off["p_cam_focal"] = "no focal prior (focal_px in photo.json, --focal-px or EXIF)"
+    if priors.scd_mm is None:
+        off["p_cam_scd"] = "no subject-to-camera distance prior (scd_mm in photo.json or --scd-mm)"
+    if not priors.uses_head:
+        off["p_cam_head"] = (
+            "no head orientation prior (head_rotation_skull2cam and head_tolerance_deg in "
+            "photo.json)"
+        )
+    return off
+
+
+def image_terms(skull, photo, centre, use_skof, use_pll):
+    """The image penalties an SFO asks for, each built or switched off.
+
+    An asked-for term whose inputs are missing (:class:`TermOff`) is switched off, not an
+    error (SPEC section 5): the SFO runs with the other terms.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    centre : ndarray of shape (2,)
+        Principal point (pixels).
+    use_skof, use_pll : bool
+        Whether the variant asks for P_skof / P_pll.
+
+    Returns
+    -------
+    skof : SkofTerm or None
+    pll : PllTerm or None
+    terms_off : dict of str -> str
+        ``{"p_skof": why, "p_pll": why}`` for the asked-for terms that cannot apply.
+    """
+    skof = pll = None
+    off = {}
+    if use_skof:
+        off["p_skof"] = skof_off_reason(photo)
+        if not off["p_skof"]:
+            skof = SkofTerm(skull, photo, centre)
+    if use_pll:
+        try:
+            pll = PllTerm(skull, photo, centre)
+        except TermOff as exc:
+            off["p_pll"] = str(exc)
+    return skof, pll, {k: v for k, v in off.items() if v}
+
+
+def planned_terms_off(skull, photo, variant_terms):
+    """What an SFO of ``photo`` will switch off, before it runs (the case's check).
+
+    Builds P_pll (cheap: a region cut and a facial curve) but not P_skof (only its mask check).
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    variant_terms : (bool, bool)
+        ``(use_skof, use_pll)`` of the variant.
+
+    Returns
+    -------
+    dict of str -> str
+        Term -> reason, the image terms first, then the P_cam parts (:func:`prior_terms_off`).
+    """
+    use_skof, use_pll = variant_terms
+    off = {}
+    if use_skof and skof_off_reason(photo):
+        off["p_skof"] = skof_off_reason(photo)
+    if use_pll:
+        try:
+            PllTerm(skull, photo, principal_point_of(photo.image_size_wh))
+        except TermOff as exc:
+            off["p_pll"] = str(exc)
+    return {**off, **prior_terms_off(photo.priors)}

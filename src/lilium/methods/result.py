@@ -31,6 +31,11 @@ class SfoResult:
         Why it failed ("" on success).
     extra : dict
         Method-specific additions (e.g. the fitness history).
+    terms_off : dict of str -> str
+        Terms switched off for this SFO because their inputs are missing, and why (SPEC
+        section 5, "When a term cannot apply"): ``p_skof``, ``p_pll`` (asked for by the
+        variant), ``p_cam_focal``, ``p_cam_scd``, ``p_cam_head`` (a P_cam part without its
+        prior). Empty when every term ran; ``result.json`` then has no ``terms_off`` key.
     """
 
     method: str
@@ -45,6 +50,7 @@ class SfoResult:
     seconds: float
     error: str = ""
     extra: dict = field(default_factory=dict)
+    terms_off: dict = field(default_factory=dict)
 
     def __bool__(self):
         return self.camera is not None
@@ -61,6 +67,11 @@ class SfoResult:
             "camera": camera,
             "fitness": _finite_or_none(self.fitness),
             "terms": {k: _finite_or_none(v) for k, v in self.terms.items()},
+            **(
+                {"terms_off": {str(k): str(v) for k, v in self.terms_off.items()}}
+                if self.terms_off
+                else {}
+            ),
             "facial_landmarks_3d": {
                 k: [float(x) for x in v] for k, v in self.facial_landmarks_mm.items()
             },

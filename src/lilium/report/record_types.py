@@ -138,6 +138,8 @@ class SfoRecord:
     outputs : tuple of (str, str)
         Label and link (relative to the report).
     pictures : Pictures
+    terms_off : tuple of (str, str)
+        Terms switched off because their inputs are missing, and why (``SfoResult.terms_off``).
     """
 
     index: int
@@ -164,6 +166,7 @@ class SfoRecord:
     inputs: tuple
     outputs: tuple
     pictures: Pictures
+    terms_off: tuple = ()
 
 
 @dataclass(frozen=True)

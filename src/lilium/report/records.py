@@ -201,6 +201,7 @@ def sfo_record(entry, index=1, hash_cache=None):
         inputs=input_files(entry.inputs, hash_cache),
         outputs=tuple((str(k), str(v)) for k, v in entry.outputs.items()),
         pictures=pictures,
+        terms_off=tuple((str(k), str(v)) for k, v in result.terms_off.items()),
     )
 
 
