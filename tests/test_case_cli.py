@@ -278,34 +278,40 @@ def test_face_curve_option_and_sidecar(files, tmp_path, capsys):
     _one_line_error(capsys, argv + ["--out", tmp_path], "--face-curve given 2 times for 1 photo")
 
 
-def test_missing_input_messages_suggest_only_variants_that_run(files, tmp_path, capsys):
+def test_missing_inputs_switch_their_term_off_and_say_so_first(files, tmp_path, capsys):
+    """SPEC 5 "when a term cannot apply": no mask, no curve, no mandible landmarks are not
+    errors; each term they feed is switched off, said before the first SFO and in result.json."""
     _add_mandible_landmarks(files)
     chin = _chin_curve(files)
     (files / "front_mask.png").unlink()
     base = ["case", "--skull", files / "skull.ply", "--photo", files / "front.png"]
     base += ["--method", "lilium", "--generations", "2", "--population", "8"]
-    out = tmp_path / "out"
-    # No mask, no curve: only base runs (pll would fail for want of a curve).
-    line = _one_line_error(
-        capsys, base + ["--variant", "skof", "--out", out], "front", "needs a face mask"
-    )
-    assert "--variant base" in line and "--variant pll" not in line
-    line = _one_line_error(
-        capsys, base + ["--variant", "pll", "--out", out], "a face curve or a face mask"
-    )
-    assert "--variant base" in line and "skof" not in line.split("missing,")[1]
-    assert not (out / "front").exists(), "checked before any SFO runs"
-    # With a curve, pll runs: the skof message now suggests it too.
+    # No mask and no curve: both image terms are off, the SFO runs with the rest.
+    code, stdout, err = _run(base + ["--variant", "skof+pll", "--out", tmp_path / "a"], capsys)
+    assert code == 0, err
+    lines = stdout.splitlines()
+    off = [i for i, line in enumerate(lines) if "switched off" in line]
+    ran = [i for i, line in enumerate(lines) if "lilium skof+pll: focal" in line]
+    assert off and ran and max(off) < ran[0]
+    assert sum("P_skof switched off" in lines[i] for i in off) == 1
+    assert sum("P_pll switched off" in lines[i] for i in off) == 1
+    result = json.loads((tmp_path / "a" / "front" / "lilium-skof+pll" / "result.json").read_text())
+    assert set(result["terms_off"]) >= {"p_skof", "p_pll"}
+    assert result["terms"]["p_skof"] is None and result["terms"]["p_pll"] is None
+    # With a curve, P_pll runs and only P_skof is off.
     (files / "front_face_curve.json").write_text(json.dumps({"chin_jaw": chin}))
-    line = _one_line_error(capsys, base + ["--variant", "skof+pll", "--out", out], "face mask")
-    assert "--variant base or --variant pll" in line
-    # Without the mandible landmarks, pll cannot run even with a curve.
+    code, stdout, err = _run(base + ["--variant", "skof+pll", "--out", tmp_path / "b"], capsys)
+    assert code == 0, err
+    result = json.loads((tmp_path / "b" / "front" / "lilium-skof+pll" / "result.json").read_text())
+    assert "p_skof" in result["terms_off"] and "p_pll" not in result["terms_off"]
+    # Without the mandible landmarks P_pll is off again, and the reason names them.
     lines = (files / "skull.fcsv").read_text().splitlines()
     keep = [ln for ln in lines if ",infradentale," not in ln]
     assert len(keep) == len(lines) - 1
     (files / "skull.fcsv").write_text("\n".join(keep) + "\n")
-    line = _one_line_error(capsys, base + ["--variant", "pll", "--out", out], "infradentale")
-    assert "--variant base" in line and "--variant pll" not in line.split("missing,")[1]
+    code, stdout, err = _run(base + ["--variant", "pll", "--out", tmp_path / "c"], capsys)
+    assert code == 0, err
+    assert "P_pll switched off" in stdout and "infradentale" in stdout
 
 
 def test_help_defines_the_face_mask_and_the_sidecars(capsys):

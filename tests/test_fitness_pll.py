@@ -144,7 +144,7 @@ def test_face_curve_from_mask():
     assert np.array_equal(lat, np.column_stack([np.full(11, 5.0), np.arange(20, 31)]))
     lat = face_curve_from_mask(mask, "lateral_right", {"glabella": (0, 30), "metopion": (0, 20)})
     assert np.all(lat[:, 0] == 36)
-    with pytest.raises(ValueError, match="needs the landmarks"):
+    with pytest.raises(ValueError, match="cheilion_r is not marked; mark it"):
         face_curve_from_mask(mask, "frontal", {"cheilion_l": (1, 1)})
     with pytest.raises(ValueError, match="view must be one of"):
         face_curve_from_mask(mask, "oblique", {})

@@ -13,6 +13,13 @@ from .folders import labelled_skull
 from .inputs import check_runnable, load_photos, load_skull
 
 
+def term_label(term):
+    """``p_pll`` -> ``P_pll``; ``p_cam_focal`` -> ``P_cam (focal)``."""
+    if term.startswith("p_cam_"):
+        return f"P_cam ({term[len('p_cam_') :]})"
+    return "P_" + term[2:] if term.startswith("p_") else term
+
+
 def run_case(
     skull_path,
     photos,
@@ -56,6 +63,12 @@ def run_case(
     Returns
     -------
     list of ReportEntry
+
+    Notes
+    -----
+    Before the first SFO, ``log`` gets one line per term Lilium will switch off for a photo
+    (:func:`~lilium.casework.inputs.check_runnable`): ``<photo>: lilium <variant>: P_pll
+    switched off: <why>``; each SFO's line ends with the terms it ran without.
     """
     from ..report.html import ReportEntry, write_report
 
@@ -69,9 +82,15 @@ def run_case(
         from dataclasses import replace
 
         options = replace(options, depth_table=read_depth_table(depth_table))
+    planned = {}
     for photo, inputs, _ in records:  # every problem before any long run
-        check_runnable(skull, photo, methods, options.variant, skull_inputs, inputs)
+        planned[photo.id] = check_runnable(
+            skull, photo, methods, options.variant, skull_inputs, inputs
+        )
         check_inputs(skull, photo)  # left/right of skull and photo (names the file)
+    for photo_id, off in planned.items():
+        for term, why in off.items():
+            log(f"{photo_id}: lilium {options.variant}: {term_label(term)} switched off: {why}")
     out = Path(out)
     entries = []
     for photo, inputs, notes in records:
@@ -90,7 +109,8 @@ def run_case(
                 if result
                 else f"FAILED ({result.error})"
             )
-            log(f"{photo.id}: {name}: {status}, {result.seconds:.2f} s -> {folder}")
+            off = f", off: {', '.join(result.terms_off)}" if result.terms_off else ""
+            log(f"{photo.id}: {name}: {status}{off}, {result.seconds:.2f} s -> {folder}")
             for warning in result.warnings:
                 log(f"  warning {warning.code}: {warning.message}")
             entries.append(

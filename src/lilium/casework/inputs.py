@@ -306,12 +306,14 @@ def _json_keys(path):
 
 
 def check_runnable(skull, photo, methods, variant, skull_inputs, photo_inputs):
-    """Raise the ``ValueError`` an SFO of ``photo`` would raise, before any SFO runs.
+    """Check that an SFO of ``photo`` can run, before any SFO runs; say what it will switch off.
 
-    Checks that the landmarks pair (:func:`lilium.inputs.correspondences`) and, for Lilium, what
-    ``variant`` needs: a face mask for P_skof; for P_pll the cranial landmarks that cut the
-    region and a facial curve (``face_curve.json`` or one found in the mask). The message starts
-    with the file to fix.
+    The landmarks must pair (:func:`lilium.inputs.correspondences`: at least four pairs, the
+    one case no term set can run); otherwise the ``ValueError`` starts with the file to fix.
+    For Lilium, a term the variant asks for whose inputs are missing (P_skof without a face
+    mask; P_pll without the cranial landmarks that cut its region, e.g. a skull without its
+    mandible, or without a facial curve) is switched off, not an error (SPEC section 5), and
+    so is each P_cam part without its prior.
 
     Parameters
     ----------
@@ -322,11 +324,16 @@ def check_runnable(skull, photo, methods, variant, skull_inputs, photo_inputs):
         Lilium's variant.
     skull_inputs, photo_inputs : dict of str -> Path
         The labelled files of :func:`load_skull` and :func:`load_photos`.
+
+    Returns
+    -------
+    dict of str -> str
+        What Lilium's SFO of this photo will switch off, and why (empty when Lilium does not
+        run); the same as its ``result.json``'s ``terms_off``.
     """
-    from ..geometry.camera import principal_point_of
     from ..inputs import correspondences
     from ..methods.lilium import VARIANTS
-    from ..methods.lilium_terms import PllTerm, check_variant_inputs, missing_inputs
+    from ..methods.lilium_terms import planned_terms_off
 
     photo_file = photo_inputs.get("facial landmarks") or photo_inputs.get("photo.json")
     try:
@@ -334,20 +341,5 @@ def check_runnable(skull, photo, methods, variant, skull_inputs, photo_inputs):
     except ValueError as exc:
         raise ValueError(f"{photo_file}: {exc}") from None
     if "lilium" not in methods:
-        return
-    use_skof, use_pll = VARIANTS[variant]
-    missing = missing_inputs(skull, photo, variant)
-    if missing:
-        # Name the file to fix: the skull's landmarks when only cranial landmarks are missing.
-        cranial = all(m.startswith("the cranial landmarks") for m in missing)
-        where = skull_inputs.get("cranial landmarks") if cranial else photo_inputs.get("photo")
-        try:
-            check_variant_inputs(skull, photo, variant)
-        except ValueError as exc:
-            raise ValueError(f"{where}: {exc}") from None
-    if use_pll:
-        try:
-            PllTerm(skull, photo, principal_point_of(photo.image_size_wh))
-        except ValueError as exc:
-            where = skull_inputs.get("cranial landmarks") if str(exc).startswith("skull") else None
-            raise ValueError(f"{where or photo_inputs.get('photo')}: {exc}") from None
+        return {}
+    return planned_terms_off(skull, photo, VARIANTS[variant])

@@ -97,4 +97,6 @@ def run(args):
         f"{name}: focal {result.camera.focal_px:.0f} px, score {result.fitness:.3f}, "
         f"{result.seconds:.2f} s -> {args.out}"
     )
+    for term, why in result.terms_off.items():  # inputs missing: ran without it (SPEC 5)
+        print(f"  {term} switched off: {why}")
     return 0

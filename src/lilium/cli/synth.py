@@ -1,7 +1,23 @@
 """``lilium synth``: generate a synthetic evaluation dataset (subjects, photos A/B/C)."""
 
+import argparse
 import time
 from pathlib import Path
+
+
+def fraction(closed):
+    """``--no-mandible-share`` ([0, 1]) / ``--drop-landmark-rate`` ([0, 1)) argument type."""
+
+    def parse(text):
+        from ..synthetic.incomplete import check_fraction
+
+        try:
+            return check_fraction(text, "the value", closed=closed)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = "fraction"
+    return parse
 
 
 def register(subparsers):
@@ -24,6 +40,26 @@ def register(subparsers):
         "--experiments", default="A,B,C", help="comma-separated noise profiles (default A,B,C)"
     )
     p.add_argument("--workers", type=int, default=2, help="processes over subjects (default 2)")
+    p.add_argument(
+        "--no-mandible-share",
+        type=fraction(closed=True),
+        default=0.0,
+        metavar="SHARE",
+        help=(
+            "share of the subjects whose skull has no mandible, 0 to 1 (default 0: every skull "
+            "complete, as in the paper); the face keeps its chin and lips"
+        ),
+    )
+    p.add_argument(
+        "--drop-landmark-rate",
+        type=fraction(closed=False),
+        default=0.0,
+        metavar="RATE",
+        help=(
+            "probability that a visible photo landmark is left unmarked, 0 to <1 (default 0: "
+            "every visible landmark marked, as in the paper)"
+        ),
+    )
     p.add_argument("--contact-sheet", type=Path, help="also write a contact sheet PNG here")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
@@ -53,6 +89,8 @@ def run(args):
             experiments=experiments,
             progress=progress,
             workers=args.workers,
+            no_mandible_share=args.no_mandible_share,
+            drop_landmark_rate=args.drop_landmark_rate,
         )
     finally:
         if bar is not None:
@@ -61,6 +99,13 @@ def run(args):
         f"wrote {len(index['subjects'])} subjects and {len(index['photos'])} photos "
         f"x {len(experiments)} experiments to {args.out} in {time.perf_counter() - start:.1f} s"
     )
+    incomplete = index.get("incomplete")
+    if incomplete:
+        unmarked = sum(len(p.get("unmarked_landmarks", ())) for p in index["photos"])
+        print(
+            f"incomplete: {len(incomplete['subjects_without_mandible'])} skull(s) without the "
+            f"mandible, {unmarked} landmark(s) left unmarked"
+        )
     if args.contact_sheet:
         from ..synthetic.contact_sheet import contact_sheet
 

@@ -22,6 +22,8 @@ file's folder (to the current folder for a preset). Example::
     subjects = 5
     photos = 2                       # frontal photos per subject (as many lateral)
     seed = 0
+    no_mandible_share = 0.0          # share of skulls without the mandible (default 0)
+    drop_landmark_rate = 0.0         # chance a visible photo landmark is unmarked (default 0)
 
     [de]
     population = 10
@@ -45,6 +47,7 @@ from pathlib import Path
 
 from ..methods.registry import METHODS
 from ..optimisation.de import DEOptions
+from ..synthetic.incomplete import check_fraction
 
 #: The experiments of SPEC section 7.
 EXPERIMENTS = ("A", "B", "C")
@@ -90,6 +93,14 @@ class DatasetConfig:
     photos : int
         Frontal photos per subject; as many lateral ones.
     seed : int
+    no_mandible_share : float
+        Share of the generated skulls without the mandible, in [0, 1].
+    drop_landmark_rate : float
+        Probability that a visible photo landmark is left unmarked, in [0, 1).
+
+    Both default to 0, in every preset: the paper's subjects and photos are complete
+    (:mod:`lilium.synthetic.incomplete`). They apply when the dataset is generated; an existing
+    dataset is used as it is.
     """
 
     path: Path = Path("dataset")
@@ -97,6 +108,8 @@ class DatasetConfig:
     subjects: int = 5
     photos: int = 2
     seed: int = 0
+    no_mandible_share: float = 0.0
+    drop_landmark_rate: float = 0.0
 
 
 #: Keys of a config's ``[de]`` table and the :class:`DEOptions` fields they set.
@@ -152,6 +165,9 @@ class ExperimentConfig:
         """Hash of the settings that change a result (a database holds one setting only)."""
         de = {key: getattr(self.de, name) for key, name in DE_KEYS.items()}
         key = {"de": de, "seed": self.seed, "dataset_seed": self.dataset.seed}
+        for name in ("no_mandible_share", "drop_landmark_rate"):  # only when set: old
+            if getattr(self.dataset, name):  # databases keep their fingerprint
+                key[f"dataset_{name}"] = getattr(self.dataset, name)
         return hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:16]
 
 
@@ -161,6 +177,8 @@ class ExperimentConfig:
 #: docs/experiments.md).
 #: ``paper``: the paper's protocol (17 subjects x 60 photos, 5 repetitions, 5 x 5 runs in C,
 #: DE 750 generations or 500 s).
+#: Both generate complete skulls and fully marked photos (``no_mandible_share`` and
+#: ``drop_landmark_rate`` 0, as in the paper); a config file can set them under ``[dataset]``.
 PRESETS = {
     "quick": ExperimentConfig(
         name="quick",
@@ -196,7 +214,15 @@ _TOP_KEYS = {
     "dataset",
     "de",
 }
-_DATASET_KEYS = {"path", "generate", "subjects", "photos", "seed"}
+_DATASET_KEYS = {
+    "path",
+    "generate",
+    "subjects",
+    "photos",
+    "seed",
+    "no_mandible_share",
+    "drop_landmark_rate",
+}
 _DE_KEYS = {"population", "generations", "max_seconds"}
 
 
@@ -304,6 +330,15 @@ def config_from_dict(data, base_dir=Path("."), where="config"):
     for key in ("subjects", "photos", "seed"):
         if key in ds:
             ds_changes[key] = check_int(f"{where}: dataset.{key}", ds[key], f"dataset.{key}")
+    for key, closed in (("no_mandible_share", True), ("drop_landmark_rate", False)):
+        if key in ds:
+            value = ds[key]
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                span = "[0, 1]" if closed else "[0, 1)"
+                raise ValueError(
+                    f"{where}: dataset.{key} must be a number in {span}, got {value!r}"
+                )
+            ds_changes[key] = check_fraction(value, f"{where}: dataset.{key}", closed)
     changes["dataset"] = replace(cfg.dataset, **ds_changes)
 
     de = data.get("de", {})

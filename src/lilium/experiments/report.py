@@ -22,6 +22,11 @@ Definitions (decisions the paper leaves open are marked *):
   a camera), with the mean % of skull pixels outside the mask among its implausible SFOs and
   how many of them were positive / negative pairs.
 - **Time**: the method's own seconds per SFO (reading and scoring excluded), mean and median.
+- **Terms switched off** (SPEC section 5): per experiment, method and view, how many SFOs ran
+  with a term switched off because its inputs were missing (``terms_off`` of the stored
+  result: P_pll for a skull without its mandible, P_skof without a mask, a P_cam part without
+  its prior), in all and per term. *Ranks over skulls with different terms off are biased (an
+  off term is a zero), so a non-empty table qualifies every rank of its rows.
 """
 
 import csv
@@ -34,6 +39,7 @@ import numpy as np
 
 from .config import ALL_METHODS, EXPERIMENTS, method_label
 from .store import ResultStore, database_error
+from .terms_off import terms_off_markdown, terms_off_rows, terms_off_table
 
 #: Views of the tables: frontal photos and lateral ones (left and right together).
 VIEW_GROUPS = ("frontal", "lateral")
@@ -404,7 +410,7 @@ def plot_bpe(rows, path):
     return Path(path)
 
 
-def markdown_report(db, summary, tests, implausible, n_rows):
+def markdown_report(db, summary, tests, implausible, n_rows, terms_off=()):
     parts = [f"# Lilium experiment report\n\nDatabase: `{db}` ({n_rows} SFOs).\n"]
     parts.append("## Mean rank of the true skull and BPE (mm)\n")
     parts.append(
@@ -520,6 +526,7 @@ def markdown_report(db, summary, tests, implausible, n_rows):
             lines,
         )
     )
+    parts.append(terms_off_markdown(terms_off))
     parts.append("\n\n## Plots\n\n![rank distribution](rank_distribution.png)\n\n![BPE](bpe.png)\n")
     return "\n".join(parts)
 
@@ -548,15 +555,17 @@ def write_report(db, out_dir):
     summary = summary_table(rows, ranks)
     tests = wilcoxon_table(rows, ranks)
     implausible = implausible_table(rows)
+    terms_off = terms_off_table(terms_off_rows(db))
     paths = {
         "summary": write_csv(out_dir / "summary.csv", summary),
         "wilcoxon": write_csv(out_dir / "wilcoxon.csv", tests),
         "implausible": write_csv(out_dir / "implausible.csv", implausible),
+        "terms_off": write_csv(out_dir / "terms_off.csv", terms_off),
         "ranks": write_csv(out_dir / "ranks.csv", ranks),
         "rank_plot": plot_rank_distribution(ranks, out_dir / "rank_distribution.png"),
         "bpe_plot": plot_bpe(rows, out_dir / "bpe.png"),
     }
     md = out_dir / "report.md"
-    md.write_text(markdown_report(db, summary, tests, implausible, len(rows)) + "\n")
+    md.write_text(markdown_report(db, summary, tests, implausible, len(rows), terms_off) + "\n")
     paths["markdown"] = md
     return paths

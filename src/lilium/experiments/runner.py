@@ -127,6 +127,8 @@ def load_dataset(cfg, workers=1, log=print):
             seed=cfg.dataset.seed,
             experiments=("A", "B", "C"),
             workers=max(1, min(workers, cfg.dataset.subjects)),
+            no_mandible_share=cfg.dataset.no_mandible_share,
+            drop_landmark_rate=cfg.dataset.drop_landmark_rate,
         )
     index = read_json(index_path)
     check_index(index, index_path)

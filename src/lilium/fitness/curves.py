@@ -159,6 +159,26 @@ def refine_curve(points, view, ordered=True):
     return orient_curve(join_fragments(p), view)
 
 
+def face_curve_bounds(view):
+    """The two facial landmarks that bound a view's facial curve taken from the mask.
+
+    ``("cheilion_l", "cheilion_r")`` for the chin-jaw (frontal), ``("glabella", "metopion")``
+    for the forehead (lateral).
+    """
+    return (
+        ("cheilion_l", "cheilion_r") if check_view(view) == "frontal" else ("glabella", "metopion")
+    )
+
+
+def missing_curve_bounds(view, landmarks_uv):
+    """Which of :func:`face_curve_bounds` are absent (or not finite) in ``landmarks_uv``."""
+    return [
+        n
+        for n in face_curve_bounds(view)
+        if n not in landmarks_uv or not np.all(np.isfinite(np.asarray(landmarks_uv[n], float)))
+    ]
+
+
 def face_curve_from_mask(face_mask, view, landmarks_uv):
     """The facial contour of a photo from its face mask (SPEC section 5).
 
@@ -181,16 +201,27 @@ def face_curve_from_mask(face_mask, view, landmarks_uv):
     -------
     curve : ndarray of shape (N, 2)
         Ordered, 8-connected pixel curve.
+
+    Raises
+    ------
+    ValueError
+        A bounding landmark is missing (:func:`missing_curve_bounds`). An SFO does not get
+        here: it switches P_pll off instead (:class:`lilium.methods.lilium_terms.PllTerm`).
     """
     check_view(view)
     mask = np.asarray(face_mask) != 0
     if mask.ndim != 2:
         raise ValueError(f"face_mask must be 2D (rows, columns), got shape {mask.shape}")
     height, width = mask.shape
-    names = ("cheilion_l", "cheilion_r") if view == "frontal" else ("glabella", "metopion")
-    missing = [n for n in names if n not in landmarks_uv]
+    names = face_curve_bounds(view)
+    missing = missing_curve_bounds(view, landmarks_uv)
     if missing:
-        raise ValueError(f"the {view} facial curve from the mask needs the landmarks {missing}")
+        region = "chin-jaw" if view == "frontal" else "forehead"
+        raise ValueError(
+            f"the {region} curve of a {view} photo is taken from the face mask between "
+            f"{names[0]} and {names[1]}, and {' and '.join(missing)} is not marked; mark it in "
+            "the photo's landmarks or give face_curve.json"
+        )
     a, b = (np.asarray(landmarks_uv[n], dtype=float) for n in names)
     if view == "frontal":
         cols = np.arange(

@@ -36,7 +36,7 @@ from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
 from .checks import facing_check, facing_failure
-from .lilium_terms import PllTerm, SkofTerm
+from .lilium_terms import image_terms, prior_terms_off
 from .options import SfoOptions, with_focal_cap
 from .posest_sfo import (
     RUN_OFF_FACTOR,
@@ -101,11 +101,12 @@ class LiliumProblem:
         self.scd_index = [names.index("nasion")] if "nasion" in names else list(range(len(names)))
         self.rng = np.random.default_rng(rng)
         self.periodic = np.tile([False, False, True], len(self.corr.cranial_names))
-        self.skof = self.pll = None
-        if self.use_skof:
-            self.skof = SkofTerm(self.skull, self.photo, self.centre)
-        if self.use_pll:
-            self.pll = PllTerm(self.skull, self.photo, self.centre)
+        # Asked-for terms whose inputs are missing are switched off (SPEC section 5), and so is
+        # each P_cam part without its prior: ``terms_off`` says which and why.
+        self.skof, self.pll, self.terms_off = image_terms(
+            skull, photo, self.centre, self.use_skof, self.use_pll
+        )
+        self.terms_off.update(prior_terms_off(photo.priors))
         self.n_fallbacks = 0  # statistics only
         # Lowest MSE (px^2) of a camera refused for the focal cap, and its focal length.
         self.capped_mse, self.capped_focal_px = np.inf, None
@@ -278,9 +279,10 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     -------
     SfoResult
         The best member DE ranked: its camera, fitness and terms as DE evaluated them
-        (``fitness`` equals the last value of ``history``). ``extra`` holds ``history`` (best
-        fitness per generation), ``generations``, ``evaluations``, ``stop``, ``genes`` and
-        ``fallbacks``.
+        (``fitness`` equals the last value of ``history``); ``terms_off`` names the terms the
+        variant asks for that could not apply, and the P_cam parts without a prior. ``extra``
+        holds ``history`` (best fitness per generation), ``generations``, ``evaluations``,
+        ``stop``, ``genes`` and ``fallbacks``.
     """
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
@@ -320,6 +322,7 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         seconds=time.perf_counter() - start,
         error=error,
         warnings=warnings,
+        terms_off=dict(problem.terms_off),
         extra={
             "history": de.history.tolist(),
             "generations": de.nit,

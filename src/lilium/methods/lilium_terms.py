@@ -11,98 +11,11 @@ clusters of faces that can reach a non-face pixel under each camera.
 
 import numpy as np
 
-from ..fitness.curves import face_curve_from_mask
+from ..fitness.curves import face_curve_from_mask, missing_curve_bounds
 from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_cameras
-
-#: Cranial landmarks the P_pll region needs, per view kind.
-PLL_LANDMARKS = {
-    "frontal": ("infradentale", "mental_foramen_l", "mental_foramen_r"),
-    "lateral": ("glabella", "metopion"),
-}
-
-
-def _pll_landmarks_missing(skull, view):
-    need = PLL_LANDMARKS["frontal" if view == "frontal" else "lateral"]
-    return [n for n in need if n not in skull.landmarks_mm]
-
-
-def missing_inputs(skull, photo, variant):
-    """What a Lilium variant needs and this skull and photo lack.
-
-    Parameters
-    ----------
-    skull : Skull
-    photo : Photo
-    variant : str
-        A key of :data:`lilium.methods.lilium.VARIANTS`.
-
-    Returns
-    -------
-    list of str
-        Plain-words descriptions (empty when the variant can run).
-    """
-    from .lilium import VARIANTS  # the one table (that module imports this one)
-
-    use_skof, use_pll = VARIANTS[variant]
-    missing = []
-    if use_skof and photo.face_mask is None:
-        missing.append("a face mask (face_mask.png in a photo folder, --mask or <stem>_mask.png)")
-    if use_pll:
-        if photo.face_curve_uv is None and photo.face_mask is None:
-            missing.append(
-                "a face curve or a face mask (face_curve.json / --face-curve / "
-                "<stem>_face_curve.json, or a mask to derive it from)"
-            )
-        lm = _pll_landmarks_missing(skull, photo.view)
-        if lm:
-            missing.append(f"the cranial landmarks {', '.join(lm)}")
-    return missing
-
-
-def runnable_variants(skull, photo):
-    """The Lilium variants this skull and photo have every input for, in table order."""
-    from .lilium import VARIANTS
-
-    return tuple(v for v in VARIANTS if not missing_inputs(skull, photo, v))
-
-
-def _missing_message(skull, photo, what, missing, exclude):
-    others = [v for v in runnable_variants(skull, photo) if v not in exclude]
-    suggest = (
-        f"or run --variant {' or --variant '.join(others)}, which these inputs allow"
-        if others
-        else "no Lilium variant runs without them (POSEST-SFO does: --method posest-sfo)"
-    )
-    return (
-        f"skull {skull.id!r}, photo {photo.id!r}: {what} {'; and '.join(missing)}; add what "
-        f"is missing, {suggest}"
-    )
-
-
-def check_variant_inputs(skull, photo, variant):
-    """Raise a ``ValueError`` when ``variant`` lacks an input, suggesting variants that run.
-
-    The suggestion is checked against what is there (mask, curve, mandible or forehead
-    landmarks), so it never proposes a variant that would fail in turn.
-    """
-    missing = missing_inputs(skull, photo, variant)
-    if missing:
-        what = f"Lilium variant {variant!r} needs"
-        raise ValueError(_missing_message(skull, photo, what, missing, (variant,)))
-
-
-def _check_term_inputs(skull, photo, term):
-    """As :func:`check_variant_inputs` for every variant using ``term`` (``skof``/``pll``)."""
-    from .lilium import VARIANTS
-
-    missing = missing_inputs(skull, photo, term)
-    if missing:
-        index = ("skof", "pll").index(term)
-        using = [v for v, terms in VARIANTS.items() if terms[index]]
-        what = f"the {term} variants ({', '.join(using)}) need"
-        raise ValueError(_missing_message(skull, photo, what, missing, using))
+from ..geometry.camera import principal_point_of
 
 
 class SkofTerm:
@@ -122,7 +35,9 @@ class SkofTerm:
     """
 
     def __init__(self, skull, photo, centre):
-        _check_term_inputs(skull, photo, "skof")
+        reason = skof_off_reason(photo)
+        if reason:
+            raise TermOff(reason)
         self.context = prepare_skof(skull.faces, photo.face_mask, skull.vertices_mm)
         self.centre = centre
 
@@ -136,6 +51,68 @@ class SkofTerm:
         return skof_penalty(self.outside_pixels(cameras)).astype(float)
 
 
+class TermOff(ValueError):
+    """A fitness term cannot apply to this skull and photo: its inputs are missing.
+
+    Not an error of the SFO (SPEC section 5, "When a term cannot apply"): :func:`image_terms`
+    switches the term off and keeps the message as the reason (``SfoResult.terms_off``).
+    """
+
+
+#: Cranial landmarks that cut the skull's P_pll region: the chin-jaw (frontal views) and the
+#: forehead (lateral views).
+PLL_SKULL_LANDMARKS = {
+    "frontal": ("infradentale", "mental_foramen_l", "mental_foramen_r"),
+    "lateral": ("glabella", "metopion"),
+}
+
+
+def _region_name(view):
+    return "chin-jaw" if view == "frontal" else "forehead"
+
+
+def pll_skull_landmarks(view):
+    """The cranial landmarks P_pll needs on the skull in ``view`` (:data:`PLL_SKULL_LANDMARKS`)."""
+    return PLL_SKULL_LANDMARKS["frontal" if view == "frontal" else "lateral"]
+
+
+def skof_off_reason(photo):
+    """Why P_skof cannot apply to ``photo`` ("" when it can): it needs the face mask."""
+    if photo.face_mask is None:
+        return f"photo {photo.id!r} has no face mask (face_mask.png or --mask)"
+    return ""
+
+
+def pll_off_reason(skull, photo):
+    """Why P_pll cannot apply ("" when the landmarks and curve inputs it needs are there).
+
+    The cheap checks only (no mesh work): the cranial landmarks that cut the skull's region;
+    a facial curve (``face_curve.json``, or the face mask with the landmarks that bound the
+    curve on it). :class:`PllTerm` finds the rest (an empty region or curve).
+    """
+    view, region = photo.view, _region_name(photo.view)
+    missing = [n for n in pll_skull_landmarks(view) if n not in skull.landmarks_mm]
+    if missing:
+        absent = " (no mandible?)" if view == "frontal" and "infradentale" in missing else ""
+        return (
+            f"skull {skull.id!r} has no {', '.join(missing)}{absent} in its cranial landmarks, "
+            f"which cut the {region} region"
+        )
+    if photo.face_curve_uv is not None:
+        return ""
+    if photo.face_mask is None:
+        return (
+            f"photo {photo.id!r} has neither face_curve.json nor a face mask for the {region} curve"
+        )
+    unmarked = missing_curve_bounds(view, photo.landmarks_uv)
+    if unmarked:
+        return (
+            f"photo {photo.id!r} has no {', '.join(unmarked)} to bound the {region} curve on the "
+            "face mask (mark it, or give face_curve.json)"
+        )
+    return ""
+
+
 class PllTerm:
     """P_pll between the skull's and the face's chin-jaw (frontal) or forehead (lateral) curves.
 
@@ -144,28 +121,35 @@ class PllTerm:
 
     Raises
     ------
-    ValueError
-        A landmark the region or the facial curve needs is missing, or neither a face curve
-        nor a mask is given.
+    TermOff
+        P_pll cannot apply (:func:`pll_off_reason`; the skull's region or the facial curve is
+        empty; the skull's landmarks cannot orient the head); the message says why.
     """
 
     def __init__(self, skull, photo, centre):
-        view = photo.view
-        lm = skull.landmarks_mm
-        _check_term_inputs(skull, photo, "pll")
-        frame = anatomical_frame(lm)
-        if view == "frontal":
-            region = chin_jaw_region(skull.vertices_mm, skull.faces, lm, frame)
-        else:
-            region = forehead_region(skull.vertices_mm, skull.faces, lm, frame)
+        reason = pll_off_reason(skull, photo)
+        if reason:
+            raise TermOff(reason)
+        view, lm, region_name = photo.view, skull.landmarks_mm, _region_name(photo.view)
+        try:
+            frame = anatomical_frame(lm)
+        except ValueError as exc:
+            raise TermOff(f"skull {skull.id!r}: {exc}") from None
+        cut = chin_jaw_region if view == "frontal" else forehead_region
+        region = cut(skull.vertices_mm, skull.faces, lm, frame)
+        if len(region.faces) == 0:
+            raise TermOff(
+                f"skull {skull.id!r}: the {region_name} region between its landmarks holds no "
+                "triangle of the mesh (check the landmarks against skull.ply)"
+            )
         if photo.face_curve_uv is not None:
             face_curve = photo.face_curve_uv
-        else:  # check_variant_inputs: a mask is there
+        else:
             face_curve = face_curve_from_mask(photo.face_mask, view, photo.landmarks_uv)
         if len(face_curve) < 2:
-            raise ValueError(
-                f"photo {photo.id!r}: the facial {'chin-jaw' if view == 'frontal' else 'forehead'}"
-                " curve is empty; check face_mask.png and the landmarks, or give face_curve.json"
+            raise TermOff(
+                f"photo {photo.id!r}: the facial {region_name} curve is empty (check "
+                "face_mask.png and the landmarks, or give face_curve.json)"
             )
         self.region_vertices_mm = skull.vertices_mm[region.vertex_index]
         self.context = PllContext.build(
@@ -185,3 +169,96 @@ class PllTerm:
         uv = camera.project(self.region_vertices_mm)
         span_v = None if self.span_mm is None else camera.project(self.span_mm)[:, 1]
         return self.context.skull_curve(uv, span_v), self.context.face_curve
+
+
+#: Labels of the P_cam parts a missing prior switches off (keys of ``terms_off``).
+PRIOR_TERMS = {
+    "p_cam_focal": "focal length",
+    "p_cam_scd": "subject-to-camera distance",
+    "p_cam_head": "head orientation",
+}
+
+
+def prior_terms_off(priors):
+    """The P_cam parts without their prior: ``{key of PRIOR_TERMS: reason}``.
+
+    Parameters
+    ----------
+    priors : lilium.fitness.camera_penalty.Priors
+    """
+    off = {}
+    if priors.focal_px is None:
+        off["p_cam_focal"] = "no focal prior (focal_px in photo.json, --focal-px or EXIF)"
+    if priors.scd_mm is None:
+        off["p_cam_scd"] = "no subject-to-camera distance prior (scd_mm in photo.json or --scd-mm)"
+    if not priors.uses_head:
+        off["p_cam_head"] = (
+            "no head orientation prior (head_rotation_skull2cam and head_tolerance_deg in "
+            "photo.json)"
+        )
+    return off
+
+
+def image_terms(skull, photo, centre, use_skof, use_pll):
+    """The image penalties an SFO asks for, each built or switched off.
+
+    An asked-for term whose inputs are missing (:class:`TermOff`) is switched off, not an
+    error (SPEC section 5): the SFO runs with the other terms.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    centre : ndarray of shape (2,)
+        Principal point (pixels).
+    use_skof, use_pll : bool
+        Whether the variant asks for P_skof / P_pll.
+
+    Returns
+    -------
+    skof : SkofTerm or None
+    pll : PllTerm or None
+    terms_off : dict of str -> str
+        ``{"p_skof": why, "p_pll": why}`` for the asked-for terms that cannot apply.
+    """
+    skof = pll = None
+    off = {}
+    if use_skof:
+        off["p_skof"] = skof_off_reason(photo)
+        if not off["p_skof"]:
+            skof = SkofTerm(skull, photo, centre)
+    if use_pll:
+        try:
+            pll = PllTerm(skull, photo, centre)
+        except TermOff as exc:
+            off["p_pll"] = str(exc)
+    return skof, pll, {k: v for k, v in off.items() if v}
+
+
+def planned_terms_off(skull, photo, variant_terms):
+    """What an SFO of ``photo`` will switch off, before it runs (the case's check).
+
+    Builds P_pll (cheap: a region cut and a facial curve) but not P_skof (only its mask check).
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    variant_terms : (bool, bool)
+        ``(use_skof, use_pll)`` of the variant.
+
+    Returns
+    -------
+    dict of str -> str
+        Term -> reason, the image terms first, then the P_cam parts (:func:`prior_terms_off`).
+    """
+    use_skof, use_pll = variant_terms
+    off = {}
+    if use_skof and skof_off_reason(photo):
+        off["p_skof"] = skof_off_reason(photo)
+    if use_pll:
+        try:
+            PllTerm(skull, photo, principal_point_of(photo.image_size_wh))
+        except TermOff as exc:
+            off["p_pll"] = str(exc)
+    return {**off, **prior_terms_off(photo.priors)}

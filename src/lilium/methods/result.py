@@ -39,6 +39,11 @@ class SfoResult:
     landmark_error : dict or None
         ``mean_px``, ``mean_mm``, ``per_landmark_px``
         (:func:`lilium.methods.checks.landmark_error`); None when the SFO failed.
+    terms_off : dict of str -> str
+        Terms switched off for this SFO because their inputs are missing, and why (SPEC
+        section 5, "When a term cannot apply"): ``p_skof``, ``p_pll`` (asked for by the
+        variant), ``p_cam_focal``, ``p_cam_scd``, ``p_cam_head`` (a P_cam part without its
+        prior). Empty when every term ran; ``result.json`` then has no ``terms_off`` key.
 
     :func:`lilium.methods.run_sfo` fills ``warnings``, ``priors`` and ``landmark_error`` for
     every method (:func:`lilium.methods.checks.finish_result`).
@@ -59,6 +64,7 @@ class SfoResult:
     warnings: tuple = ()
     priors: dict | None = None
     landmark_error: dict | None = None
+    terms_off: dict = field(default_factory=dict)
 
     def __bool__(self):
         return self.camera is not None
@@ -75,6 +81,11 @@ class SfoResult:
             "camera": camera,
             "fitness": _finite_or_none(self.fitness),
             "terms": {k: _finite_or_none(v) for k, v in self.terms.items()},
+            **(
+                {"terms_off": {str(k): str(v) for k, v in self.terms_off.items()}}
+                if self.terms_off
+                else {}
+            ),
             "facial_landmarks_3d": {
                 k: [float(x) for x in v] for k, v in self.facial_landmarks_mm.items()
             },

@@ -274,9 +274,20 @@ def _camera_table(sfo):
 
 
 def _terms_table(sfo):
+    off = dict(sfo.terms_off)  # asked for but without their inputs: say why (SPEC section 5)
     rows = [
-        [TERM_LABELS.get(k, _e(k)), _num(v, "{:.4g}", "off") if sfo.ok else "&ndash;"]
+        [
+            TERM_LABELS.get(k, _e(k)),
+            f"switched off: {_e(off[k])}"
+            if k in off
+            else (_num(v, "{:.4g}", "off") if sfo.ok else "&ndash;"),
+        ]
         for k, v in sfo.terms
+    ]
+    rows += [
+        [f"{TERM_LABELS['p_cam']}, {_e(k[len('p_cam_') :])} part", f"switched off: {_e(why)}"]
+        for k, why in sfo.terms_off
+        if k.startswith("p_cam_")
     ]
     score = f"method's own score ({_e(sfo.summary.score_label)})"
     rows.append([f"<b>{score}</b>", f"<b>{_num(sfo.fitness, '{:.4g}')}</b>"])

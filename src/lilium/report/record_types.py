@@ -172,6 +172,8 @@ class SfoRecord:
     cranial_numbers : tuple of (str, int)
         Cranial landmark and the number of its facial counterpart in ``landmarks`` (1-based),
         for the landmarks this SFO used.
+    terms_off : tuple of (str, str)
+        Terms switched off because their inputs are missing, and why (``SfoResult.terms_off``).
     """
 
     index: int
@@ -202,6 +204,7 @@ class SfoRecord:
     cranial_numbers: tuple = ()
     warnings: tuple = ()
     priors: tuple = ()
+    terms_off: tuple = ()
 
 
 @dataclass(frozen=True)

@@ -282,6 +282,7 @@ def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
         ),
         warnings=warnings,
         priors=prior_rows(result),
+        terms_off=tuple((str(k), str(v)) for k, v in result.terms_off.items()),
     )
 
 

@@ -17,6 +17,12 @@ does not depend on the number of worker processes or their scheduling. The photo
 A, B and C share their camera and render; B and C share their noisy landmarks too (C differs from
 B only in the soft-tissue axes given to the methods, listed in ``photo.json`` as
 ``"soft_tissue_axes_sets"``, file names relative to the *tested* skull's subject folder).
+
+Incomplete cases (:mod:`lilium.synthetic.incomplete`; default none): ``no_mandible_share`` of
+the subjects have a skull without the mandible (subject entry ``"mandible": false``), and
+``drop_landmark_rate`` leaves visible landmarks of the photos unmarked (photo entry
+``"unmarked_landmarks"``); ``dataset.json`` then records both under ``"incomplete"``. With the
+defaults nothing changes, file for file.
 """
 
 import os
@@ -29,6 +35,8 @@ import cv2
 import numpy as np
 
 from ..io.jsonio import write_json
+from ..softtissue.landmarks import CORRESPONDENCES
+from . import incomplete as _incomplete
 from . import noise as _noise
 from . import photos as _photos
 
@@ -73,12 +81,20 @@ def _link_or_copy(src, dst):
         shutil.copyfile(src, dst)
 
 
-def write_photo_folders(photos_root, pid, subject_id, photo, experiments, noisy_uv, axes_files):
-    """Write one photo's folders, one per experiment; returns ``{exp: relative path}``."""
+def write_photo_folders(
+    photos_root, pid, subject_id, photo, experiments, noisy_uv, axes_files, unmarked=()
+):
+    """Write one photo's folders, one per experiment; returns ``{exp: relative path}``.
+
+    ``unmarked``: visible landmarks left out of ``photo.json`` (and the face curve with them
+    when one bounds it, :func:`lilium.synthetic.incomplete.curve_kept`).
+    """
     photos_root = Path(photos_root)
     first = None
     paths = {}
     curve = {k: np.asarray(v).tolist() for k, v in photo.face_curve.items()}
+    if not _incomplete.curve_kept(photo.camera.view, unmarked):
+        curve = {}
     for exp in experiments:
         folder = photos_root / exp / pid
         folder.mkdir(parents=True, exist_ok=True)
@@ -98,6 +114,7 @@ def write_photo_folders(photos_root, pid, subject_id, photo, experiments, noisy_
             noise=exp,
             landmarks_uv=None if exp == "A" else noisy_uv,
             extra=extra,
+            unmarked=unmarked,
         )
         write_json(folder / "photo.json", record)
         if curve:
@@ -115,7 +132,8 @@ def _default_subject_api():
 
 def _generate_subject(task):
     """Worker: make, write and photograph one subject. Returns its index entries."""
-    (out_dir, subject_id, seed_seq, n_photos, experiments, ranges, factory, writer) = task
+    (out_dir, subject_id, seed_seq, n_photos, experiments, ranges, factory, writer) = task[:8]
+    mandible, drop_rate = task[8:] if len(task) > 8 else (True, 0.0)
     cv2.setNumThreads(1)
     start = time.perf_counter()
     if factory is None or writer is None:
@@ -124,7 +142,12 @@ def _generate_subject(task):
         writer = writer or default_writer
     out_dir = Path(out_dir)
     subject_seq, axes_seq, photos_seq = seed_seq.spawn(3)
-    subject = factory(subject_id, np.random.default_rng(subject_seq))
+    subject_rng = np.random.default_rng(subject_seq)
+    if mandible:
+        subject = factory(subject_id, subject_rng)
+    else:  # the same person, the skull without its mandible
+        subject = factory(subject_id, subject_rng, mandible=False)
+    on_skull = getattr(subject, "cranial_landmarks", None)
     subject_dir = out_dir / "subjects" / subject_id
     writer(subject_dir, subject)
 
@@ -134,6 +157,8 @@ def _generate_subject(task):
         sets = _noise.perturbed_axes_sets(axes, np.random.default_rng(axes_seq))
         for k, axes_set in enumerate(sets, start=1):
             name = f"axes_C{k}.json"
+            if on_skull is not None:  # drawn for every axis, written for the skull's landmarks
+                axes_set = {c: v for c, v in axes_set.items() if c in on_skull}
             write_json(subject_dir / name, {"axes": axes_set})
             axes_files.append(name)
 
@@ -142,6 +167,7 @@ def _generate_subject(task):
     photo_seqs = photos_seq.spawn(len(views))
     counters = {"frontal": 0, "lateral": 0}
     entries = []
+    pairable = {f for c, f in CORRESPONDENCES if on_skull is None or c in on_skull}
     for view, seq in zip(views, photo_seqs, strict=True):
         camera_seq, noise_seq = seq.spawn(2)
         key = "frontal" if view == "frontal" else "lateral"
@@ -149,25 +175,33 @@ def _generate_subject(task):
         counters[key] += 1
         photo = _photos.make_photo(head, view, np.random.default_rng(camera_seq), ranges)
         noisy = _noise.perturb_landmarks(photo.landmarks_uv, np.random.default_rng(noise_seq))
+        unmarked = ()
+        if drop_rate > 0:  # a third stream of the photo: the first two are as without it
+            unmarked = _incomplete.unmarked_landmarks(
+                photo.visible, pairable, drop_rate, np.random.default_rng(seq.spawn(1)[0])
+            )
         paths = write_photo_folders(
-            out_dir / "photos", pid, subject_id, photo, experiments, noisy, axes_files
+            out_dir / "photos", pid, subject_id, photo, experiments, noisy, axes_files, unmarked
         )
-        entries.append(
-            {
-                "id": pid,
-                "subject": subject_id,
-                "view": view,
-                "image_size": list(photo.camera.image_size_wh),
-                "n_visible_landmarks": len(photo.visible),
-                "paths": paths,
-            }
-        )
+        entry = {
+            "id": pid,
+            "subject": subject_id,
+            "view": view,
+            "image_size": list(photo.camera.image_size_wh),
+            "n_visible_landmarks": len(photo.visible),
+            "paths": paths,
+        }
+        if unmarked:
+            entry["unmarked_landmarks"] = list(unmarked)
+        entries.append(entry)
     subject_entry = {
         "id": subject_id,
         "path": f"subjects/{subject_id}",
         "axes_C": axes_files,
         "seconds": time.perf_counter() - start,
     }
+    if not mandible:
+        subject_entry["mandible"] = False
     return subject_entry, entries
 
 
@@ -182,6 +216,8 @@ def generate_dataset(
     ranges=_photos.CameraRanges(),
     subject_factory=None,
     subject_writer=None,
+    no_mandible_share=0.0,
+    drop_landmark_rate=0.0,
 ):
     """Generate subjects and their photos for the experiments A/B/C; write ``dataset.json``.
 
@@ -201,7 +237,13 @@ def generate_dataset(
     subject_factory, subject_writer : callable, optional
         ``factory(subject_id, rng) -> subject`` and ``writer(folder, subject)``; default
         ``lilium.synthetic.subjects.make_subject`` / ``write_subject``. With ``workers > 1``
-        they must be picklable (module-level functions).
+        they must be picklable (module-level functions). With ``no_mandible_share > 0`` the
+        factory must take ``mandible=False``.
+    no_mandible_share : float
+        Share of the subjects whose skull has no mandible, in [0, 1] (default 0; see
+        :mod:`lilium.synthetic.incomplete`).
+    drop_landmark_rate : float
+        Probability that a visible landmark of a photo is left unmarked, in [0, 1) (default 0).
 
     Returns
     -------
@@ -209,6 +251,7 @@ def generate_dataset(
         The index written to ``out_dir/dataset.json``.
     """
     experiments = tuple(_noise.check_profile(e) for e in experiments)
+    drop_rate = _incomplete.check_fraction(drop_landmark_rate, "drop_landmark_rate", closed=False)
     if not experiments:
         raise ValueError("experiments is empty; give at least one of A, B, C")
     if n_subjects < 1 or n_photos < 1:
@@ -218,8 +261,10 @@ def generate_dataset(
     start = time.perf_counter()
     ids = subject_ids(n_subjects)
     seqs = np.random.SeedSequence(seed).spawn(n_subjects)
+    no_mandible = _incomplete.mandible_less(ids, no_mandible_share, seed)
     tasks = [
         (str(out_dir), sid, seq, n_photos, experiments, ranges, subject_factory, subject_writer)
+        + (sid not in no_mandible, drop_rate)
         for sid, seq in zip(ids, seqs, strict=True)
     ]
     results = {}
@@ -265,5 +310,11 @@ def generate_dataset(
         "photos": photos,
         "seconds": time.perf_counter() - start,
     }
+    if no_mandible or drop_rate:  # only then: complete datasets stay as they were
+        index["incomplete"] = {
+            "no_mandible_share": float(no_mandible_share),
+            "subjects_without_mandible": sorted(no_mandible),
+            "drop_landmark_rate": drop_rate,
+        }
     write_json(out_dir / "dataset.json", index)
     return index

@@ -283,7 +283,8 @@ def head_faces_of(
 
 def prepare_head(subject):
     """A :class:`HeadModel` from a subject (``skin_vertices_mm``, ``skin_faces``,
-    ``facial_landmarks``)."""
+    ``facial_landmarks``; the mask's neck cut clears ``head_skull_vertices_mm``, the complete
+    skull of a subject whose skull lacks the mandible, or else ``skull_vertices_mm``)."""
     import trimesh
     from scipy.spatial import ConvexHull
 
@@ -296,7 +297,8 @@ def prepare_head(subject):
     facial = {k: np.asarray(v, dtype=float) for k, v in subject.facial_landmarks.items()}
     if not facial:
         raise ValueError("the subject has no facial landmarks; a photo needs them")
-    skull = getattr(subject, "skull_vertices_mm", None)
+    skull = getattr(subject, "head_skull_vertices_mm", None)  # the complete skull, if not given
+    skull = getattr(subject, "skull_vertices_mm", None) if skull is None else skull
     jaw = head_faces_of(vertices, faces, facial)
     head = jaw
     if skull is not None:
@@ -394,8 +396,7 @@ def face_curve_from_mask(mask, view, landmarks_uv):
         bounding landmark is missing.
     """
     check_view(view)
-    needed = ("cheilion_l", "cheilion_r") if view == "frontal" else ("glabella", "metopion")
-    if not all(n in landmarks_uv and np.all(np.isfinite(landmarks_uv[n])) for n in needed):
+    if _curves.missing_curve_bounds(view, landmarks_uv):
         return {}
     key = "chin_jaw" if view == "frontal" else "forehead"
     return {key: _curves.face_curve_from_mask(mask, view, landmarks_uv)}
@@ -469,7 +470,7 @@ def priors_of(camera):
     }
 
 
-def photo_record(photo, subject_id, noise="A", landmarks_uv=None, extra=None):
+def photo_record(photo, subject_id, noise="A", landmarks_uv=None, extra=None, unmarked=()):
     """The ``photo.json`` content of SPEC section 8.
 
     Parameters
@@ -482,6 +483,9 @@ def photo_record(photo, subject_id, noise="A", landmarks_uv=None, extra=None):
         positions. Only the visible landmarks are written either way.
     extra : dict, optional
         More top-level fields.
+    unmarked : sequence of str
+        Visible landmarks left out of ``landmarks`` (listed in the ground truth as
+        ``"unmarked_landmarks"``; :mod:`lilium.synthetic.incomplete`).
 
     Returns
     -------
@@ -489,9 +493,10 @@ def photo_record(photo, subject_id, noise="A", landmarks_uv=None, extra=None):
     """
     given = photo.landmarks_uv if landmarks_uv is None else landmarks_uv
     cam = photo.camera
+    marked = [n for n in photo.visible if n not in set(unmarked)]
     record = {
         "view": cam.view,
-        "landmarks": {n: np.asarray(given[n], dtype=float) for n in photo.visible},
+        "landmarks": {n: np.asarray(given[n], dtype=float) for n in marked},
         "priors": priors_of(cam),
         "ground_truth": {
             "subject": subject_id,
@@ -510,6 +515,8 @@ def photo_record(photo, subject_id, noise="A", landmarks_uv=None, extra=None):
             },
         },
     }
+    if unmarked:
+        record["ground_truth"]["unmarked_landmarks"] = list(unmarked)
     if extra:
         record.update(extra)
     return record

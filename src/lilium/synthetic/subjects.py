@@ -25,8 +25,17 @@ every target.
 
 ``soft_tissue_axes`` holds these true directions (the axes given to the methods; Exp. C perturbs
 them); ``bone_normals`` holds the default axes a method would compute from the skull mesh.
+
+Incomplete skulls (``make_subject(..., mandible=False)``): a skull found without its mandible.
+The person is the same (same shape, bone field, soft tissue, face and photos as with
+``mandible=True`` from the same seed: the face keeps its chin and lips); only the skull mesh is
+the cranium's alone (the bone field built again without the mandible and the lower teeth, the
+same vault bumps) and the mandible's landmarks (:data:`MANDIBLE_LANDMARKS`) are absent from
+``cranial_landmarks``. Ground truth stays whole: every facial landmark, the true soft tissue of
+every correspondence; the mandible's true landmarks are kept in ``removed_landmarks``.
 """
 
+import copy
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -42,6 +51,7 @@ from .anatomy.skin import build_skin
 from .anatomy.soft_tissue import draw_soft_tissue
 
 __all__ = [
+    "MANDIBLE_LANDMARKS",
     "SubjectShape",
     "SyntheticSubject",
     "distance_to_mesh",
@@ -64,7 +74,8 @@ class SyntheticSubject:
     skin_vertices_mm : ndarray of shape (V', 3)
     skin_faces : ndarray of shape (F', 3), int
     cranial_landmarks : dict of str -> ndarray of shape (3,)
-        Every name of :data:`~lilium.softtissue.landmarks.CRANIAL_NAMES`.
+        Every name of :data:`~lilium.softtissue.landmarks.CRANIAL_NAMES` (but the
+        :data:`MANDIBLE_LANDMARKS` when the skull has no mandible).
     facial_landmarks : dict of str -> ndarray of shape (3,)
         Every name of :data:`~lilium.softtissue.landmarks.FACIAL_NAMES`, on the skin.
     soft_tissue_axes : dict of str -> ndarray of shape (3,)
@@ -72,8 +83,16 @@ class SyntheticSubject:
     soft_tissue_depths_mm : dict of str -> float
         True depth ``|F - C|`` of each of them.
     bone_normals : dict of str -> ndarray of shape (3,)
-        Outward skull-surface normal (area-weighted over a few mm) at each cranial landmark.
+        Outward skull-surface normal (area-weighted over a few mm) at each cranial landmark,
+        on the complete skull.
     shape : SubjectShape
+    mandible : bool
+        Whether the skull mesh has its mandible.
+    removed_landmarks : dict of str -> ndarray of shape (3,)
+        True positions of the cranial landmarks the skull lacks (the mandible's).
+    head_skull_vertices_mm : ndarray of shape (V'', 3) or None
+        The complete skull the head was built on, when ``skull_vertices_mm`` is not it (no
+        mandible): the photos' neck cut clears it (:func:`~.photos.prepare_head`).
     """
 
     subject_id: str
@@ -87,6 +106,9 @@ class SyntheticSubject:
     soft_tissue_depths_mm: dict = field(default_factory=dict)
     bone_normals: dict = field(default_factory=dict)
     shape: SubjectShape | None = None
+    mandible: bool = True
+    removed_landmarks: dict = field(default_factory=dict)
+    head_skull_vertices_mm: np.ndarray | None = None
 
 
 #: Faces of the decimated skull and skin meshes.
@@ -97,6 +119,17 @@ SKIN_FACES = 40_000
 #: with new soft tissue, at most :data:`SOFT_TISSUE_TRIES` times.
 ON_SKIN_MM = 0.8
 SOFT_TISSUE_TRIES = 4
+
+#: Cranial landmarks on the mandible: absent from a skull without it.
+MANDIBLE_LANDMARKS = (
+    "infradentale",
+    "mental_foramen_l",
+    "mental_foramen_r",
+    "pogonion",
+    "gnathion",
+    "gonion_l",
+    "gonion_r",
+)
 
 
 def _mesh(field, target_faces):
@@ -185,7 +218,7 @@ def _face(bone, design, shape, cranial, normals, rng):
     return skin_v, skin_f, facial, depths, directions
 
 
-def make_subject(subject_id, rng=None):
+def make_subject(subject_id, rng=None, mandible=True):
     """Generate one synthetic subject.
 
     Parameters
@@ -193,6 +226,9 @@ def make_subject(subject_id, rng=None):
     subject_id : str
     rng : anything :func:`numpy.random.default_rng` accepts
         The same seed gives the identical subject.
+    mandible : bool
+        False: the skull without its mandible (see the module notes); the same seed gives the
+        same person, face and photos either way.
 
     Returns
     -------
@@ -205,8 +241,16 @@ def make_subject(subject_id, rng=None):
     """
     rng = np.random.default_rng(rng)
     shape = draw_shape(rng)
+    vault_rng = None if mandible else copy.deepcopy(rng)  # the same vault without the mandible
     bone, design, skull_v, skull_f, cranial, normals = _skull(shape, rng)
     skin_v, skin_f, facial, depths, directions = _face(bone, design, shape, cranial, normals, rng)
+    removed, head_skull = {}, None
+    if not mandible:
+        cranium, _ = build_bone(shape, vault_rng, mandible=False)
+        head_skull = skull_v
+        skull_v, skull_f = _mesh(cranium, SKULL_FACES)
+        removed = {n: cranial.pop(n) for n in MANDIBLE_LANDMARKS}
+        normals = {n: v for n, v in normals.items() if n in cranial}
     return SyntheticSubject(
         subject_id=str(subject_id),
         skull_vertices_mm=skull_v,
@@ -219,6 +263,9 @@ def make_subject(subject_id, rng=None):
         soft_tissue_depths_mm={c: depths[c] for c, _ in CORRESPONDENCES},
         bone_normals=normals,
         shape=shape,
+        mandible=bool(mandible),
+        removed_landmarks=removed,
+        head_skull_vertices_mm=head_skull,
     )
 
 
@@ -239,9 +286,11 @@ def make_subjects(n, seed=0, prefix="s"):
 def write_subject(folder, subject):
     """Write a subject folder (SPEC section 8).
 
-    ``skull.ply``, ``cranial_landmarks.json``, ``soft_tissue_axes.json`` (the true directions),
-    and the ground truth ``face.ply``, ``facial_landmarks.json`` (facial = cranial + true soft
-    tissue) and ``subject.json`` (shape parameters, true depths, bone normals).
+    ``skull.ply``, ``cranial_landmarks.json``, ``soft_tissue_axes.json`` (the true directions
+    of the cranial landmarks the skull has), and the ground truth ``face.ply``,
+    ``facial_landmarks.json`` (facial = cranial + true soft tissue) and ``subject.json`` (shape
+    parameters, true depths, bone normals; for a skull without its mandible also
+    ``"incomplete": {"mandible": false, "removed_landmarks": {name: [x, y, z]}}``).
     """
     from dataclasses import asdict
     from pathlib import Path
@@ -255,15 +304,25 @@ def write_subject(folder, subject):
     write_mesh(folder / "face.ply", subject.skin_vertices_mm, subject.skin_faces)
     write_json(folder / "cranial_landmarks.json", {"landmarks": subject.cranial_landmarks})
     write_json(folder / "facial_landmarks.json", {"landmarks": subject.facial_landmarks})
-    write_json(folder / "soft_tissue_axes.json", {"axes": subject.soft_tissue_axes})
-    write_json(
-        folder / "subject.json",
-        {
-            "subject": subject.subject_id,
-            "frame": "mm; x = subject's left, y = up, z = anterior",
-            "soft_tissue_depths_mm": subject.soft_tissue_depths_mm,
-            "bone_normals": subject.bone_normals,
-            "shape": asdict(subject.shape) if subject.shape is not None else None,
-        },
-    )
+    write_json(folder / "soft_tissue_axes.json", {"axes": axes_on_skull(subject)})
+    record = {
+        "subject": subject.subject_id,
+        "frame": "mm; x = subject's left, y = up, z = anterior",
+        "soft_tissue_depths_mm": subject.soft_tissue_depths_mm,
+        "bone_normals": subject.bone_normals,
+        "shape": asdict(subject.shape) if subject.shape is not None else None,
+    }
+    if not getattr(subject, "mandible", True):  # only then: complete subjects stay as they were
+        record["incomplete"] = {
+            "mandible": False,
+            "removed_landmarks": subject.removed_landmarks,
+        }
+    write_json(folder / "subject.json", record)
     return folder
+
+
+def axes_on_skull(subject, axes=None):
+    """The soft-tissue axes (``axes``, default the subject's true ones) of the cranial
+    landmarks its skull has: what a subject folder gives the methods."""
+    axes = subject.soft_tissue_axes if axes is None else axes
+    return {c: v for c, v in axes.items() if c in subject.cranial_landmarks}

@@ -11,7 +11,7 @@ Skull frame: mm, x = the subject's left, y = up, z = anterior.
 import numpy as np
 
 from ..softtissue.landmarks import CORRESPONDENCES, EXTRA_CRANIAL, EXTRA_FACIAL
-from .subjects import SyntheticSubject
+from .subjects import MANDIBLE_LANDMARKS, SyntheticSubject, axes_on_skull
 
 #: Facial landmark directions from the head centre: (azimuth towards the subject's left from
 #: anterior, elevation), degrees. Bilateral ones are given for the left side and mirrored.
@@ -65,7 +65,7 @@ def _radius(directions, scale, nose_mm, chin_mm):
     return r
 
 
-def make_toy_subject(subject_id="toy", rng=None, subdivisions=4):
+def make_toy_subject(subject_id="toy", rng=None, subdivisions=4, mandible=True):
     """A stand-in head; ``rng`` varies its proportions by a few per cent.
 
     Parameters
@@ -74,6 +74,9 @@ def make_toy_subject(subject_id="toy", rng=None, subdivisions=4):
     rng : anything ``np.random.default_rng`` accepts
     subdivisions : int
         Icosphere subdivisions of the skin and skull meshes (4 -> 5,120 faces each).
+    mandible : bool
+        False: the skull loses its "mandible" (the triangles below the infradentale in front
+        of the ear canals) and the :data:`~.subjects.MANDIBLE_LANDMARKS`; the head is the same.
 
     Returns
     -------
@@ -117,15 +120,23 @@ def make_toy_subject(subject_id="toy", rng=None, subdivisions=4):
     for cranial_name, facial_name in CORRESPONDENCES:
         v = facial[facial_name] - cranial[cranial_name]
         axes[cranial_name] = v / np.linalg.norm(v)
+    skull_faces, removed, head_skull = faces.copy(), {}, None
+    if not mandible:
+        jaw = np.all((skull[faces, 1] < cranial["infradentale"][1]) & (skull[faces, 2] > 0), axis=1)
+        skull_faces, head_skull = faces[~jaw], skull
+        removed = {n: cranial.pop(n) for n in MANDIBLE_LANDMARKS}
     return SyntheticSubject(
         subject_id=str(subject_id),
         skull_vertices_mm=skull,
-        skull_faces=faces.copy(),
+        skull_faces=skull_faces,
         skin_vertices_mm=skin,
         skin_faces=skin_faces,
         cranial_landmarks=cranial,
         facial_landmarks=facial,
         soft_tissue_axes=axes,
+        mandible=bool(mandible),
+        removed_landmarks=removed,
+        head_skull_vertices_mm=head_skull,
     )
 
 
@@ -160,4 +171,4 @@ def write_toy_subject(folder, subject):
     )
     write_json(folder / "cranial_landmarks.json", {"landmarks": subject.cranial_landmarks})
     write_json(folder / "facial_landmarks.json", {"landmarks": subject.facial_landmarks})
-    write_json(folder / "soft_tissue_axes.json", {"axes": subject.soft_tissue_axes})
+    write_json(folder / "soft_tissue_axes.json", {"axes": axes_on_skull(subject)})

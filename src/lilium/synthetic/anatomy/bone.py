@@ -103,23 +103,27 @@ def design_points(s):
     return d
 
 
-def build_bone(s, rng):
+def build_bone(s, rng, mandible=True):
     """The bone field of a subject (negative inside) and its design positions.
 
     Parameters
     ----------
     s : SubjectShape
     rng : numpy.random.Generator
-        Draws the low-frequency bumps of the vault.
+        Draws the low-frequency bumps of the vault (its only draws: the same generator state
+        gives the same vault with or without the mandible).
+    mandible : bool
+        False: the cranium alone, without the mandible and the lower teeth (a skull found
+        without its jaw); the other parts are built as with it, in the same order.
 
     Returns
     -------
     bone : GridField
         Skull frame, mm.
     design : dict
-        :func:`design_points`, plus ``body_arch`` (ndarray of shape (M, 2), the mandibular
-        body's arch ``(x, z)``), ``body_y`` (ndarray of shape (M,)) and ``ramus_top``
-        (ndarray of shape (3,)).
+        :func:`design_points`, plus (with the mandible) ``body_arch`` (ndarray of shape
+        (M, 2), the mandibular body's arch ``(x, z)``), ``body_y`` (ndarray of shape (M,)) and
+        ``ramus_top`` (ndarray of shape (3,)).
     """
     d = design_points(s)
     bone = GridField(GRID_LO_MM, GRID_HI_MM, VOXEL_MM)
@@ -130,10 +134,8 @@ def build_bone(s, rng):
     add_brow(bone, s, d)
     add_orbits(bone, d)
     add_nose(bone, s, d)
-    add_dentition(bone, s, d)
-    body, body_y, ramus_top = add_mandible(bone, s, d)
+    add_dentition(bone, s, d, lower=mandible)
+    if mandible:
+        d["body_arch"], d["body_y"], d["ramus_top"] = add_mandible(bone, s, d)
     add_ear_canals(bone, d)
-    d["body_arch"] = body
-    d["body_y"] = body_y
-    d["ramus_top"] = ramus_top
     return bone, d

@@ -203,7 +203,7 @@ def add_teeth(bone, xz, y_centre, height):
         add_ellipsoid(bone, c, r, t["margin_mm"], "union", t["blend_mm"], rot)
 
 
-def add_dentition(bone, s, d):
+def add_dentition(bone, s, d, lower=True):
     """Upper alveolar process and the upper and lower teeth (in place).
 
     Parameters
@@ -212,6 +212,8 @@ def add_dentition(bone, s, d):
     s : SubjectShape
     d : dict
         Design positions (:func:`~lilium.synthetic.anatomy.bone.design_points`).
+    lower : bool
+        Add the lower teeth too (they go with the mandible: False for a skull without it).
     """
     fw, pr, ua = s.fw, s.prognathism_mm, UPPER_ALVEOLAR
     n = ua["points"]
@@ -226,7 +228,8 @@ def add_dentition(bone, s, d):
         ua["rounding_mm"],
         ua["blend_mm"],
     )
-    for row, (high, low) in ((UPPER_TEETH, (yy, oc)), (LOWER_TEETH, (oc, inf))):
+    rows = ((UPPER_TEETH, (yy, oc)), (LOWER_TEETH, (oc, inf)))
+    for row, (high, low) in rows if lower else rows[:1]:
         per_pr = row["front_z_per_prognathism"]
         front = row["front_z_mm"] + per_pr * pr  # per_pr = 1: exactly + pr
         add_teeth(
