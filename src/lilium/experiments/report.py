@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from .config import ALL_METHODS, EXPERIMENTS, method_label
+from .identification import identification_markdown, identification_table, write_identification
 from .store import ResultStore, database_error
 
 #: Views of the tables: frontal photos and lateral ones (left and right together).
@@ -556,7 +557,13 @@ def write_report(db, out_dir):
         "rank_plot": plot_rank_distribution(ranks, out_dir / "rank_distribution.png"),
         "bpe_plot": plot_bpe(rows, out_dir / "bpe.png"),
     }
+    identification = identification_table(rows)
+    paths.update(write_identification(rows, identification, out_dir))
     md = out_dir / "report.md"
-    md.write_text(markdown_report(db, summary, tests, implausible, len(rows)) + "\n")
+    md.write_text(
+        markdown_report(db, summary, tests, implausible, len(rows))
+        + identification_markdown(identification)
+        + "\n"
+    )
     paths["markdown"] = md
     return paths
