@@ -112,3 +112,15 @@ def test_report_writes_identification_csv_and_cmc_plot(tmp_path):
     assert paths["cmc_plot"].read_bytes()[:4] == b"\x89PNG"
     assert paths["cmc"].is_file()
     assert "## Identification" in paths["markdown"].read_text()
+
+
+def test_medium_preset():
+    from lilium.experiments.config import PRESETS, load_config
+
+    medium = load_config("medium")
+    assert medium == PRESETS["medium"]
+    assert medium.experiments == ("C",) and medium.dataset.subjects >= 10
+    assert 2 * medium.dataset.photos == 4
+    assert medium.methods == (("posest-sfo", ""), ("lilium", "skof+pll"))
+    assert (medium.axes_sets, medium.runs_per_axes_set) == (1, 1)
+    assert (medium.de.population_size, medium.de.max_generations) == (30, 750)
