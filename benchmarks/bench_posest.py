@@ -255,6 +255,9 @@ SFO_VARIANTS = {
     "rel0.1+cand16": {"rel": 0.1, "n_candidates": 16},
     "rel0.1+cand16+lo1": {"rel": 0.1, "n_candidates": 16, "local_rounds": 1},
     "rel0.1f6+cand16": {"rel": 0.1, "floor": 6.0, "n_candidates": 16},
+    # The recommendation (docs/experiments.md): threshold max(6 px, 0.1 x spread), 16 refined
+    # hypotheses, one refinement each.
+    "rel0.1f6+cand16+lo1": {"rel": 0.1, "floor": 6.0, "n_candidates": 16, "local_rounds": 1},
 }
 
 
