@@ -10,7 +10,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-#: Bizygomatic breadth (mm) of the average face; :attr:`SubjectShape.fw` is relative to it.
+#: Bizygomatic breadth (mm) the design positions of :mod:`.bone` are drawn for;
+#: :attr:`SubjectShape.fw` is relative to it (the population's mean is the prior's, 127.3 mm).
 MEAN_FACE_WIDTH_MM = 130.0
 
 
