@@ -33,6 +33,19 @@ points (px), and the median time per call (ms). ``rms/best`` compares POSEST's R
 lower of the two references' on the problems all three solved (median and max ratio, and how many
 problems exceed 1 %). A last table times ``refine_batch`` on a population of warm-started
 problems (20 points each, 1 px noise, start perturbed by 2 deg, 3 % depth, 5 % focal length).
+
+SFO problems (``--sfo``): the positive pairs of Exp. C made by the project's generator, exactly
+as POSEST-SFO hands them to POSEST (:mod:`sfo_problems`: the photo's visible landmarks with
++-5 px noise, 3D points = cranial landmark + population mean depth along the subject's axes set
+C1, each true soft-tissue direction turned by up to 30 degrees; frontal and lateral photos; 6-22
+points). Scored by BPE (mm, SPEC section 7) against the truth and the failure rate (no camera or
+f > 10,000 px), for ``pycolmap`` (``estimate_and_refine_absolute_pose``: LO-RANSAC over P4Pf,
+12 px threshold, focal refined, its default refinement: Cauchy loss of scale 1 px) and POSEST
+with the settings of :data:`SFO_VARIANTS` (prototypes of decisions, through the public
+``PosestOptions`` / ``RansacOptions``; ``posest`` is the settings before the defaults changed, the
+package's defaults now are the ``rel0.1f6+cand16+lo1`` row)::
+
+    .venv/bin/python benchmarks/bench_posest.py --sfo --subjects 12 --photos 4 --seed 0
 """
 
 import argparse
@@ -46,6 +59,8 @@ from scipy.spatial.transform import Rotation
 from lilium.constants import FOCAL_MAX_PX, RANSAC_THRESHOLD_PX
 from lilium.geometry import Camera, geodesic_angle_deg, principal_point_of
 from lilium.pose import posest, refine_batch
+from lilium.pose.posest import PosestOptions
+from lilium.pose.ransac import RansacOptions
 
 try:
     import pycolmap
@@ -225,12 +240,139 @@ def bench_refine_batch(rng, population=100, n_points=20, repeats=20):
     return float(np.median(times)) * 1e3, result.n_iterations, rms
 
 
+#: POSEST settings tried on the SFO problems: ``rel`` = inlier threshold
+#: ``max(floor, rel x spread)`` with ``spread`` the RMS distance (px) of the given landmarks from
+#: their centroid (``floor`` 12 px unless given), ``n_candidates`` = MSAC hypotheses refined
+#: (the choice among hypotheses: the refined one with the lowest MSAC cost wins),
+#: ``local_rounds`` = refinements per hypothesis with re-classified inliers (local optimisation;
+#: 1 = refine once on MSAC's inliers), ``refine_on`` = LM on the inliers or all points.
+SFO_VARIANTS = {
+    "posest": {},
+    "rel0.1": {"rel": 0.1},
+    "rel0.2": {"rel": 0.2},
+    "cand16": {"n_candidates": 16},
+    "lo1": {"local_rounds": 1},
+    "all": {"refine_on": "all"},
+    "rel0.1+cand16": {"rel": 0.1, "n_candidates": 16},
+    "rel0.1+cand16+lo1": {"rel": 0.1, "n_candidates": 16, "local_rounds": 1},
+    "rel0.1f6+cand16": {"rel": 0.1, "floor": 6.0, "n_candidates": 16},
+    # The recommendation (docs/experiments.md): threshold max(6 px, 0.1 x spread), 16 refined
+    # hypotheses, one refinement each.
+    "rel0.1f6+cand16+lo1": {"rel": 0.1, "floor": 6.0, "n_candidates": 16, "local_rounds": 1},
+}
+
+
+def sfo_threshold_px(problem, rel=None, floor=RANSAC_THRESHOLD_PX):
+    """Inlier threshold (px) of a variant: fixed, or relative to the landmarks' spread."""
+    return RANSAC_THRESHOLD_PX if rel is None else max(floor, rel * problem.spread_px)
+
+
+def run_posest_variant(
+    problem, rel=None, floor=RANSAC_THRESHOLD_PX, n_candidates=4, local_rounds=4, **posest_kw
+):
+    """POSEST with one :data:`SFO_VARIANTS` setting (the unset ones as before the defaults
+    changed: fixed 12 px, 4 hypotheses, 4 rounds); the camera or None."""
+    ransac = RansacOptions(sfo_threshold_px(problem, rel, floor), n_candidates=n_candidates)
+    options = PosestOptions(
+        ransac=ransac, local_rounds=local_rounds, threshold_spread_fraction=None, **posest_kw
+    )
+    result = posest(problem.uv_px, problem.points_mm, problem.principal_point_px, options)
+    return result.camera if result else None
+
+
+def run_pycolmap_sfo(problem, seed):
+    """pycolmap's absolute pose with focal refinement (default refinement); camera or None."""
+    w, h = problem.image_size_wh
+    c = problem.principal_point_px
+    camera = pycolmap.Camera(
+        model="SIMPLE_PINHOLE", width=w, height=h, params=[1.2 * max(w, h), *c]
+    )
+    estimation = pycolmap.AbsolutePoseEstimationOptions()
+    estimation.estimate_focal_length = True
+    estimation.ransac.max_error = RANSAC_THRESHOLD_PX
+    estimation.ransac.random_seed = seed
+    refinement = pycolmap.AbsolutePoseRefinementOptions()
+    refinement.refine_focal_length = True
+    out = pycolmap.estimate_and_refine_absolute_pose(
+        problem.uv_px, problem.points_mm, camera, estimation, refinement
+    )
+    if out is None:
+        return None
+    f = float(camera.params[0])
+    if not 0.0 < f <= FOCAL_MAX_PX:
+        return None
+    M = out["cam_from_world"].matrix()
+    return Camera.from_rt(M[:, :3], M[:, 3], f, c)
+
+
+def sfo_benchmark(n_subjects, n_photos, seed):
+    """Print the SFO-problem table (BPE and failures per method and view)."""
+    from sfo_problems import sfo_problems
+
+    start = time.perf_counter()
+    problems = sfo_problems(n_subjects, n_photos, seed)
+    views = np.array([p.view for p in problems])
+    n_points = np.array([len(p.uv_px) for p in problems])
+    print(
+        f"SFO problems: {n_subjects} subjects x ({n_photos} frontal + {n_photos} lateral), seed "
+        f"{seed}, Exp. C (+-5 px, axes set C1), generated in {time.perf_counter() - start:.0f} s;"
+        f" points frontal {n_points[views == 'frontal'].min()}-"
+        f"{n_points[views == 'frontal'].max()}, lateral {n_points[views == 'lateral'].min()}-"
+        f"{n_points[views == 'lateral'].max()}"
+    )
+    methods = {}
+    if pycolmap is not None:
+        methods["pycolmap"] = run_pycolmap_sfo
+    else:
+        print("pycolmap not installed (pip install lilium[bench]); no reference")
+    for name, kw in SFO_VARIANTS.items():
+        methods[name] = lambda p, i, kw=kw: run_posest_variant(p, **kw)
+    bpe, ms = {}, {}
+    for name, fn in methods.items():
+        t0 = time.perf_counter()
+        bpe[name] = np.array([p.bpe_mm(fn(p, seed * 100_000 + i)) for i, p in enumerate(problems)])
+        ms[name] = 1e3 * (time.perf_counter() - t0) / len(problems)
+    header = (
+        f"{'method':>18} {'view':>8} {'n':>3} {'fail':>4} {'BPE mean':>9} {'BPE med':>8} "
+        f"{'both solved: mean':>18} {'ref':>6} {'ratio':>6} {'ms':>6}"
+    )
+    print(header)
+    print("-" * len(header))
+    ref = bpe.get("pycolmap")
+    for name in methods:
+        for view in ("frontal", "lateral"):
+            b = bpe[name][views == view]
+            line = (
+                f"{name:>18} {view:>8} {len(b):3d} {int(np.isnan(b).sum()):4d} "
+                f"{np.nanmean(b):9.2f} {np.nanmedian(b):8.2f}"
+            )
+            if ref is not None:
+                r = ref[views == view]
+                both = np.isfinite(b) & np.isfinite(r)
+                line += (
+                    f" {b[both].mean():18.2f} {r[both].mean():6.2f} "
+                    f"{np.nanmean(b) / np.nanmean(r):6.2f}"
+                )
+            print(line + f" {ms[name]:6.1f}")
+    print(
+        "fail = no camera or f > 10,000 px; BPE over the solved problems; 'both solved' = the"
+        " problems this method and pycolmap both solved (ref = pycolmap's mean there); ratio ="
+        " BPE mean / pycolmap's BPE mean"
+    )
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--problems", type=int, default=200, help="problems per noise level")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--noise", type=float, nargs="+", default=[0.0, 1.0, 2.0])
+    parser.add_argument("--sfo", action="store_true", help="SFO problems from the generator")
+    parser.add_argument("--subjects", type=int, default=12, help="--sfo: generated subjects")
+    parser.add_argument("--photos", type=int, default=4, help="--sfo: photos per view per subject")
     args = parser.parse_args(argv)
+    if args.sfo:
+        sfo_benchmark(args.subjects, args.photos, args.seed)
+        return
 
     methods = {"posest": lambda p, i: run_posest(p), "opencv": lambda p, i: run_opencv(p)}
     if pycolmap is not None:

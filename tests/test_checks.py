@@ -223,7 +223,7 @@ def test_focal_cap_with_and_without_a_prior(standin):
     assert "exceeds the 10000 px limit" in capped.error
     assert "give the focal prior (a photo with EXIF, or --focal-px LO HI)" in capped.error
     # Lilium: the same, through P_cam's cap.
-    options = SfoOptions(variant="base").with_de(max_generations=4, population_size=8)
+    options = SfoOptions(variant="base").with_de(max_generations=20, population_size=10)
     lifted = lilium_sfo(skull, with_prior, options, seed=0)
     assert lifted and lifted.camera.focal_px > 25_000.0  # above the 10,000 px default cap
     assert lifted.terms["p_cam"] < 1e8

@@ -175,6 +175,11 @@ class ExperimentConfig:
 #: (2 in A and B; 2 axis sets x 2 runs in C) and a small DE budget (population 10, 10
 #: generations, 2 s per SFO at most): 3,600 SFOs, under 30 minutes on 2 cores (measured in
 #: docs/experiments.md).
+#: ``medium``: the identification claim at the paper's DE budget on a smaller population: 10
+#: subjects x (2 frontal + 2 lateral) photos against every skull, Exp. C only (one axis set, one
+#: run), POSEST-SFO and Lilium+P_skof+P_pll with DE 30 x 750 generations (500 s at most):
+#: 40 photos x 10 skulls = 400 SFOs per method, 800 in all (size and measured time in
+#: docs/experiments.md).
 #: ``paper``: the paper's protocol (17 subjects x 60 photos, 5 repetitions, 5 x 5 runs in C,
 #: DE 750 generations or 500 s).
 #: Both generate complete skulls and fully marked photos (``no_mandible_share`` and
@@ -188,6 +193,17 @@ PRESETS = {
         runs_per_axes_set=2,
         de=DEOptions(population_size=10, max_generations=10, max_seconds=2.0),
         db=Path("lilium-quick/results.sqlite"),
+    ),
+    "medium": ExperimentConfig(
+        name="medium",
+        dataset=DatasetConfig(Path("lilium-medium/dataset"), True, 10, 2, 0),
+        experiments=("C",),
+        methods=(("posest-sfo", ""), ("lilium", "skof+pll")),
+        repetitions=1,
+        axes_sets=1,
+        runs_per_axes_set=1,
+        de=DEOptions(population_size=30, max_generations=750, max_seconds=500.0),
+        db=Path("lilium-medium/results.sqlite"),
     ),
     "paper": ExperimentConfig(
         name="paper",

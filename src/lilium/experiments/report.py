@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from .config import ALL_METHODS, EXPERIMENTS, method_label
+from .identification import identification_markdown, identification_table, write_identification
 from .store import ResultStore, database_error
 from .terms_off import terms_off_markdown, terms_off_rows, terms_off_table
 
@@ -565,7 +566,13 @@ def write_report(db, out_dir):
         "rank_plot": plot_rank_distribution(ranks, out_dir / "rank_distribution.png"),
         "bpe_plot": plot_bpe(rows, out_dir / "bpe.png"),
     }
+    identification = identification_table(rows)
+    paths.update(write_identification(rows, identification, out_dir))
     md = out_dir / "report.md"
-    md.write_text(markdown_report(db, summary, tests, implausible, len(rows), terms_off) + "\n")
+    md.write_text(
+        markdown_report(db, summary, tests, implausible, len(rows), terms_off)
+        + identification_markdown(identification)
+        + "\n"
+    )
     paths["markdown"] = md
     return paths

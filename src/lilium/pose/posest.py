@@ -9,7 +9,7 @@ caller's ``camera_check`` rejects) is a falsy :class:`PoseResult` carrying a mes
 code, not an exception.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -36,13 +36,38 @@ class PosestOptions:
     local_rounds : int
         Refinements at most per hypothesis; after each, its inliers are re-classified with the
         refined camera and, if they changed, it is refined again on the new set.
+    threshold_spread_fraction : float or None
+        When set, the inlier threshold is ``max(threshold_floor_px, fraction x spread)``, the
+        spread being the RMS distance (pixels) of the image points from their centroid, instead
+        of ``ransac.threshold_px``: a fixed 12 px is loose for a small face and tight for a
+        large one.
+    threshold_floor_px : float
+
+    Defaults chosen by measurement on SFO problems (``benchmarks/bench_posest.py --sfo``:
+    generated Exp. C positive pairs, 12 subjects x 8 photos, seeds 0 and 1, against pycolmap's
+    LO-RANSAC P4Pf with focal refinement): a threshold of max(6 px, 0.1 x spread), 16 refined
+    hypotheses and one refinement each gave 0.62-0.85 x pycolmap's mean BPE with no more
+    failures, where the fixed 12 px, 4 hypotheses and 4 rounds gave 0.76-1.12 x.
     """
 
-    ransac: RansacOptions = field(default_factory=lambda: RansacOptions(RANSAC_THRESHOLD_PX))
+    ransac: RansacOptions = field(
+        default_factory=lambda: RansacOptions(RANSAC_THRESHOLD_PX, n_candidates=16)
+    )
     refine: RefineOptions = field(default_factory=RefineOptions)
     refine_on: str = "inliers"
     focal_max_px: float = FOCAL_MAX_PX
-    local_rounds: int = 4
+    local_rounds: int = 1
+    threshold_spread_fraction: float | None = 0.1
+    threshold_floor_px: float = 6.0
+
+    def ransac_for(self, uv_px):
+        """:attr:`ransac` with the inlier threshold for these image points ``(N, 2)``."""
+        if self.threshold_spread_fraction is None:
+            return self.ransac
+        d = uv_px - uv_px.mean(axis=0)
+        spread = float(np.sqrt(np.mean(np.sum(d**2, axis=1))))
+        tau = max(self.threshold_floor_px, self.threshold_spread_fraction * spread)
+        return replace(self.ransac, threshold_px=tau)
 
 
 @dataclass(frozen=True)
@@ -151,11 +176,12 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0,
     if options.refine_on not in ("inliers", "all"):
         raise ValueError(f"refine_on must be 'inliers' or 'all', got {options.refine_on!r}")
     uv_c = uv - c
-    hyp = msac(uv_c, X, options.ransac, rng)
+    ransac = options.ransac_for(uv)
+    hyp = msac(uv_c, X, ransac, rng)
     if not hyp:
         return failure(hyp.message)
     R, t, f, _ = hyp.candidates
-    tau_sq = options.ransac.threshold_px**2
+    tau_sq = ransac.threshold_px**2
     sq = reprojection_sq_errors(uv_c, X, R, t, f)
     on_inliers = options.refine_on == "inliers"
     used = _used_points(sq, tau_sq) if on_inliers else np.ones(sq.shape, bool)
@@ -194,9 +220,7 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0,
     camera = Camera.from_rt(R[k], t[k], f[k], c)
     capped = np.isfinite(f) & (f > options.focal_max_px) & (score < score[k])
     capped_focal = float(f[np.argmin(np.where(capped, score, np.inf))]) if capped.any() else None
-    return PoseResult(
-        camera, errors, errors < options.ransac.threshold_px, capped_focal_px=capped_focal
-    )
+    return PoseResult(camera, errors, errors < ransac.threshold_px, capped_focal_px=capped_focal)
 
 
 def _used_points(sq_err_px2, tau_sq):

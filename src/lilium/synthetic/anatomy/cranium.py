@@ -63,7 +63,8 @@ ZYGOMATIC_ARCH = {
     "box_margin_mm": 10,
     "blend_mm": 3,
 }
-#: Temporal root of the arch and mastoid process.
+#: Temporal root of the arch (centre x scaled by ``fw``, so it stays inside zygion: unscaled,
+#: it made the zygion of every face narrower than 128.6 mm) and mastoid process.
 TEMPORAL_ROOT = Blob((55.0, -3.0, -4.0), (11.0, 13.0, 15.0), 8, 6)
 MASTOID = Blob((50.0, -22.0, -14.0), (8.0, 13.0, 10.0), 8, 5)
 #: Brow ridge: a capsule from above the lateral orbit (x = orbit x + ``lateral_mm`` * fw) to
@@ -228,8 +229,8 @@ def add_zygomatics(bone, s, d):
                 "union",
                 arch["blend_mm"],
             )
-        for part in (TEMPORAL_ROOT, MASTOID):
-            c = (sx * part.centre_mm[0], *part.centre_mm[1:])
+        for part, x_scale in ((TEMPORAL_ROOT, fw), (MASTOID, 1.0)):
+            c = (sx * part.centre_mm[0] * x_scale, *part.centre_mm[1:])
             add_ellipsoid(bone, c, part.radii_mm, part.margin_mm, "union", part.blend_mm)
 
 

@@ -10,7 +10,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-#: Bizygomatic breadth (mm) of the average face; :attr:`SubjectShape.fw` is relative to it.
+#: Bizygomatic breadth (mm) the design positions of :mod:`.bone` are drawn for;
+#: :attr:`SubjectShape.fw` is relative to it (the population's mean is the prior's, 127.3 mm).
 MEAN_FACE_WIDTH_MM = 130.0
 
 
@@ -27,19 +28,25 @@ class TruncatedNormal:
 #: Population of each shape parameter, in the order they are drawn (the field order of
 #: :class:`SubjectShape`). ``_mm``: millimetres, ``_deg``: degrees, others: unitless factors.
 SHAPE_PRIORS = {
-    "cranial_length": TruncatedNormal(187.0, 6.0, 177.0, 198.0),
-    "cranial_breadth": TruncatedNormal(140.0, 4.5, 131.0, 149.0),
+    # Tuned so that the craniometric spread matches the pooled-sex adult values of
+    # :data:`~.craniometry.PUBLISHED` (docs/population.md). Bounds about +-2 SD: wider ones
+    # let the skin lose a landmark (nasal_width 1.36, face_height 1.2 fail). The means differ
+    # from the measured values by the offset of each measurement's landmarks from the design
+    # position (e.g. glabella-opisthocranion = cranial_length - 4 mm, gonion-gonion =
+    # jaw_width + 8 mm).
+    "cranial_length": TruncatedNormal(184.0, 7.6, 169.0, 199.0),
+    "cranial_breadth": TruncatedNormal(139.7, 6.0, 128.0, 151.0),
     "vault_height": TruncatedNormal(1.0, 0.04, 0.92, 1.08),
-    "face_width": TruncatedNormal(MEAN_FACE_WIDTH_MM, 4.5, 121.0, 139.0),
-    "face_height": TruncatedNormal(1.0, 0.05, 0.9, 1.1),
-    "jaw_width": TruncatedNormal(98.0, 5.0, 88.0, 108.0),
-    "jaw_height": TruncatedNormal(1.0, 0.06, 0.88, 1.12),
+    "face_width": TruncatedNormal(127.3, 7.1, 113.5, 141.0),
+    "face_height": TruncatedNormal(0.99, 0.085, 0.82, 1.16),
+    "jaw_width": TruncatedNormal(86.5, 6.9, 73.0, 100.0),
+    "jaw_height": TruncatedNormal(1.0, 0.1, 0.8, 1.2),
     "gonial_deg": TruncatedNormal(0.0, 5.0, -9.0, 9.0),
     "chin_mm": TruncatedNormal(0.0, 2.0, -3.5, 3.5),
     "brow": TruncatedNormal(0.8, 0.3, 0.25, 1.4),
     "prognathism_mm": TruncatedNormal(0.0, 2.0, -3.5, 3.5),
     "orbit": TruncatedNormal(1.0, 0.05, 0.9, 1.1),
-    "nasal_width": TruncatedNormal(1.0, 0.08, 0.85, 1.15),
+    "nasal_width": TruncatedNormal(1.04, 0.07, 0.88, 1.15),
     "nose_projection_mm": TruncatedNormal(18.0, 2.2, 14.0, 23.0),
     "ear": TruncatedNormal(1.0, 0.07, 0.88, 1.12),
 }

@@ -1,0 +1,301 @@
+"""Identification metrics of an experiment (SPEC section 7): rank-1 rate, CMC, ROC AUC.
+
+For one photo in one run of a method the true skull's score is compared with the scores of the
+photo against every other skull of the experiment (lower is better; a failed SFO scores worse
+than every camera, and two failed SFOs tie). With ``b`` negatives strictly better than the true
+skull, ``k`` tied with it and ``n`` negatives in all:
+
+- **rank** = ``1 + b + k / 2`` (ties share the mean rank, as in the tables);
+- **CMC(r)**, the cumulative match curve, = the probability that the true skull is among the
+  ``r`` best when ties are broken at random: ``clip((r - b) / (k + 1), 0, 1)``. So a photo whose
+  true skull ties for first with one other counts 0.5 at rank 1 and 1 at rank 2;
+- **rank-1 rate** = CMC(1);
+- **ROC AUC** of the positive score against the negatives of the same photo, a tie counting
+  0.5: ``(n - b - k / 2) / n``, i.e. ``1 - (rank - 1) / n``; 1 = the true skull beats every
+  other, 0.5 = chance.
+
+Each is the mean over the photo-runs of a (method, experiment, view group): every photo of the
+view in every run of the method, a photo whose SFOs are not all stored yet left out. The view
+groups are frontal and lateral (left and right together), as in the tables.
+"""
+
+import csv
+import math
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from .config import ALL_METHODS, EXPERIMENTS, method_label
+
+#: View groups of the identification table (lateral = left and right).
+IDENTIFICATION_VIEWS = ("frontal", "lateral")
+
+
+def _score(row):
+    if row["success"] and row["score"] is not None and np.isfinite(row["score"]):
+        return float(row["score"])
+    return math.inf
+
+
+def photo_matches(rows):
+    """Counts of negatives better than / tied with the true skull, per photo-run.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Database rows (``experiment, method, variant, axes_set, repetition, photo, view,
+        subject, true_subject, success, score``).
+
+    Returns
+    -------
+    list of dict
+        ``experiment, method, variant, axes_set, repetition, photo, view, better, tied,
+        negatives`` (ints), for every photo-run whose SFOs against every skull of the
+        experiment are stored and include the true skull.
+    """
+    skulls = defaultdict(set)
+    groups = defaultdict(dict)
+    meta = {}
+    for r in rows:
+        skulls[r["experiment"]].add(r["subject"])
+        key = (r["experiment"], r["method"], r["variant"], r["axes_set"], r["repetition"])
+        key = key + (r["photo"],)
+        groups[key][r["subject"]] = _score(r)
+        meta[key] = (r["view"], r["true_subject"])
+    out = []
+    for key, scores in sorted(groups.items()):
+        view, true = meta[key]
+        if set(scores) != skulls[key[0]] or true not in scores:
+            continue
+        target = scores[true]
+        negatives = [s for name, s in scores.items() if name != true]
+        exp, method, variant, axes_set, rep, photo = key
+        out.append(
+            dict(
+                experiment=exp,
+                method=method,
+                variant=variant,
+                axes_set=axes_set,
+                repetition=rep,
+                photo=photo,
+                view=view,
+                better=sum(1 for s in negatives if s < target),
+                tied=sum(1 for s in negatives if s == target),
+                negatives=len(negatives),
+            )
+        )
+    return out
+
+
+def cmc_values(better, tied, max_rank):
+    """CMC of one photo-run at ranks ``1..max_rank`` (random tie-breaking).
+
+    Parameters
+    ----------
+    better, tied : int
+        Negatives strictly better than / tied with the true skull.
+    max_rank : int
+
+    Returns
+    -------
+    ndarray of shape (max_rank,)
+
+    Examples
+    --------
+    >>> cmc_values(0, 1, 3).tolist()
+    [0.5, 1.0, 1.0]
+    """
+    r = np.arange(1, max_rank + 1, dtype=float)
+    return np.clip((r - better) / (tied + 1.0), 0.0, 1.0)
+
+
+def _view_group(view):
+    return "frontal" if view == "frontal" else "lateral"
+
+
+def _grouped(matches):
+    groups = defaultdict(list)
+    for m in matches:
+        groups[(m["experiment"], m["method"], m["variant"], _view_group(m["view"]))].append(m)
+    return groups
+
+
+def _order(keys):
+    """Keys sorted by experiment, then the protocol's method order, then view."""
+    out = []
+    for exp in EXPERIMENTS:
+        present = {(m, v) for (e, m, v, _) in keys if e == exp}
+        pairs = [p for p in ALL_METHODS if p in present] + sorted(present - set(ALL_METHODS))
+        for method, variant in pairs:
+            out += [
+                (exp, method, variant, view)
+                for view in IDENTIFICATION_VIEWS
+                if (exp, method, variant, view) in keys
+            ]
+    return out
+
+
+def identification_table(rows):
+    """Rank-1 rate, mean rank and ROC AUC per method, experiment and view group.
+
+    Returns
+    -------
+    list of dict
+        ``method, experiment, view, rank1_rate, mean_rank, auc, photo_runs, runs, skulls``.
+    """
+    groups = _grouped(photo_matches(rows))
+    table = []
+    for key in _order(set(groups)):
+        exp, method, variant, view = key
+        items = groups[key]
+        b = np.array([m["better"] for m in items], dtype=float)
+        k = np.array([m["tied"] for m in items], dtype=float)
+        n = np.array([m["negatives"] for m in items], dtype=float)
+        rank = 1.0 + b + k / 2.0
+        auc = np.where(n > 0, (n - b - k / 2.0) / np.maximum(n, 1.0), np.nan)
+        table.append(
+            {
+                "method": method_label(method, variant),
+                "experiment": exp,
+                "view": view,
+                "rank1_rate": float(np.mean(np.clip((1.0 - b) / (k + 1.0), 0.0, 1.0))),
+                "mean_rank": float(np.mean(rank)),
+                "auc": float(np.nanmean(auc)) if np.any(n > 0) else None,
+                "photo_runs": len(items),
+                "runs": len({(m["axes_set"], m["repetition"]) for m in items}),
+                "skulls": int(n.max()) + 1,
+            }
+        )
+    return table
+
+
+def cmc_table(rows):
+    """The cumulative match curves: one row per method, experiment, view group and rank.
+
+    Returns
+    -------
+    list of dict
+        ``method, experiment, view, rank, rate`` with ``rank`` = 1 .. number of skulls.
+    """
+    groups = _grouped(photo_matches(rows))
+    table = []
+    for key in _order(set(groups)):
+        exp, method, variant, view = key
+        items = groups[key]
+        max_rank = max(m["negatives"] for m in items) + 1
+        curve = np.mean([cmc_values(m["better"], m["tied"], max_rank) for m in items], axis=0)
+        label = method_label(method, variant)
+        table += [
+            {"method": label, "experiment": exp, "view": view, "rank": r + 1, "rate": float(c)}
+            for r, c in enumerate(curve)
+        ]
+    return table
+
+
+def plot_cmc(cmc, path):
+    """Cumulative match curves, one panel per experiment: frontal solid, lateral dashed.
+
+    The curve is defined at the integer ranks (markers); each method is shifted by a few
+    hundredths of a rank so that equal curves stay visible.
+
+    Parameters
+    ----------
+    cmc : list of dict
+        :func:`cmc_table`.
+    path : path of the PNG to write
+
+    Returns
+    -------
+    Path
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    exps = [e for e in EXPERIMENTS if any(c["experiment"] == e for c in cmc)] or ["A"]
+    fig, axes = plt.subplots(1, len(exps), figsize=(4.8 * len(exps), 4.0), squeeze=False)
+    for ax, exp in zip(axes[0], exps, strict=True):
+        items = [c for c in cmc if c["experiment"] == exp]
+        methods = list(dict.fromkeys(c["method"] for c in items))
+        colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+        max_rank = max((c["rank"] for c in items), default=1)
+        for i, method in enumerate(methods):
+            for view, style in (("frontal", "-"), ("lateral", "--")):
+                curve = [c for c in items if c["method"] == method and c["view"] == view]
+                if not curve:
+                    continue
+                ax.plot(
+                    [c["rank"] + 0.04 * (i - (len(methods) - 1) / 2) for c in curve],
+                    [c["rate"] for c in curve],
+                    linestyle=style,
+                    marker="o" if view == "frontal" else "s",
+                    markersize=4,
+                    color=colours[i % len(colours)],
+                    label=f"{method}, {view}",
+                )
+        ax.set_title(f"Exp. {exp}: cumulative match curve")
+        ax.set_xlabel("rank r")
+        ax.set_xlim(0.5, max_rank + 0.5)
+        ax.set_ylim(0.0, 1.02)
+        ax.set_xticks(range(1, max_rank + 1, max(1, max_rank // 10)))
+        ax.grid(alpha=0.3)
+    axes[0][0].set_ylabel("share of photos with the true skull in the r best")
+    axes[0][-1].legend(fontsize=7, loc="lower right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def _fmt(value):
+    return "-" if value is None or not np.isfinite(value) else f"{value:.3f}"
+
+
+def identification_markdown(identification):
+    """The report's identification section (rank-1 rate, mean rank, ROC AUC), markdown."""
+    out = [
+        "\n\n## Identification\n",
+        "Rank-1 rate and cumulative match curve with ties broken at random (a tie counts in "
+        "part), ROC AUC of the true skull's score against the other skulls' for the same photo "
+        "(a tie counts 0.5); means over the photos of a view in every run.\n",
+        "| exp | method | view | rank-1 rate | mean rank | ROC AUC | photo-runs |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    out += [
+        f"| {i['experiment']} | {i['method']} | {i['view']} | {_fmt(i['rank1_rate'])} | "
+        f"{_fmt(i['mean_rank'])} | {_fmt(i['auc'])} | {i['photo_runs']} |"
+        for i in identification
+    ]
+    out.append("\n![cumulative match curve](cmc.png)\n")
+    return "\n".join(out)
+
+
+def _write_csv(path, table, keys):
+    with Path(path).open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=keys)
+        writer.writeheader()
+        writer.writerows(table)
+    return Path(path)
+
+
+def write_identification(rows, identification, out_dir):
+    """Write ``identification.csv``, ``cmc.csv`` and ``cmc.png`` into ``out_dir``.
+
+    Returns
+    -------
+    dict of str -> Path
+        ``identification``, ``cmc``, ``cmc_plot``.
+    """
+    out_dir = Path(out_dir)
+    cmc = cmc_table(rows)
+    keys = ["method", "experiment", "view", "rank1_rate", "mean_rank", "auc"]
+    keys += ["photo_runs", "runs", "skulls"]
+    return {
+        "identification": _write_csv(out_dir / "identification.csv", identification, keys),
+        "cmc": _write_csv(
+            out_dir / "cmc.csv", cmc, ["method", "experiment", "view", "rank", "rate"]
+        ),
+        "cmc_plot": plot_cmc(cmc, out_dir / "cmc.png"),
+    }
