@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+from ..experiments.config import PRESETS
+
 
 def register(subparsers):
     p = subparsers.add_parser(
@@ -10,11 +12,11 @@ def register(subparsers):
         description=(
             "Run every photo against every skull with the configured methods and repetitions; "
             "each finished SFO is stored at once in a SQLite database, and running the same "
-            "command again resumes. CONFIG is a TOML file or a preset (quick, paper); see "
-            "docs/experiments.md."
+            f"command again resumes. CONFIG is a TOML file or a preset ({', '.join(PRESETS)}); "
+            "see docs/experiments.md."
         ),
     )
-    p.add_argument("config", help="TOML config file, or a preset name: quick, paper")
+    p.add_argument("config", help=f"TOML config file, or a preset name: {', '.join(PRESETS)}")
     p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
