@@ -11,8 +11,8 @@ Cameras (defaults of :class:`CameraRanges`, every draw uniform in its interval):
   upright: the face looks at the camera, the subject's left on the image's right). Yaw turns the
   head about its vertical axis, pitch nods it, roll tilts it;
 - frontal: yaw in [-15, 15] deg; lateral_left (the face points towards the image's left edge,
-  -u; the camera sees the subject's left side): yaw in [-105, -75] deg; lateral_right: yaw in
-  [75, 105] deg; every view: pitch in [-10, 10] deg, roll in [-5, 5] deg;
+  -u; the camera sees the subject's left side): yaw in [-95, -75] deg; lateral_right: yaw in
+  [75, 95] deg; every view: pitch in [-10, 10] deg, roll in [-5, 5] deg;
 - subject-to-camera distance (SCD, camera centre to the facial nasion) in [500, 3000] mm;
 - focal length in [1000, 6000] px, principal point at the image centre;
 - image size drawn from :data:`IMAGE_SIZES` (640 x 480 to 4000 x 3000, landscape, or portrait
@@ -87,7 +87,9 @@ class CameraRanges:
     """Intervals (degrees, mm, px) the random photo cameras are drawn from."""
 
     frontal_yaw_deg: tuple = (-15.0, 15.0)
-    lateral_yaw_deg: tuple = (75.0, 105.0)  # magnitude; lateral_left uses the negative
+    # Magnitude (lateral_left uses the negative). At most 95 so that, with the pitch, a true
+    # camera stays within SPEC 10's 110 deg of the skull's anterior direction.
+    lateral_yaw_deg: tuple = (75.0, 95.0)
     pitch_deg: tuple = (-10.0, 10.0)
     roll_deg: tuple = (-5.0, 5.0)
     scd_mm: tuple = (500.0, 3000.0)
