@@ -1,5 +1,6 @@
 """Every SFO of a user's case, written as it goes, and one HTML report for them all."""
 
+from dataclasses import replace
 from pathlib import Path
 
 from ..io.case import read_depth_table
@@ -11,6 +12,7 @@ from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
 from .folders import labelled_skull
 from .inputs import check_runnable, load_photos, load_skull
+from .prepared import check_photo_extra
 
 
 def term_label(term):
@@ -18,6 +20,26 @@ def term_label(term):
     if term.startswith("p_cam_"):
         return f"P_cam ({term[len('p_cam_') :]})"
     return "P_" + term[2:] if term.startswith("p_") else term
+
+
+def _landmark_info(origin, out):
+    """The report's facts about the landmarks' origin (:class:`ReportEntry` fields)."""
+    if origin is None:
+        return {}
+    review = ""
+    if origin.review_page is not None:
+        try:  # a link when the page lies in the output folder (--auto-landmarks)
+            review = Path(origin.review_page).resolve().relative_to(out.resolve()).as_posix()
+        except ValueError:
+            review = ""
+        else:  # the report names it as it links it, relative: the folder can move
+            origin = replace(origin, review_page=Path(review))
+    return {
+        "landmarks_note": origin.line(),
+        "landmarks_unreviewed": bool(origin.unreviewed),
+        "landmark_tags": dict(origin.tags),
+        "review_href": review,
+    }
 
 
 def run_case(
@@ -33,6 +55,7 @@ def run_case(
     title=None,
     command=None,
     log=print,
+    auto_landmarks=False,
     **photo_options,
 ):
     """Read and check every input, run every SFO, write each result and the report.
@@ -57,8 +80,13 @@ def run_case(
     title, command : str, optional
         Report title and the equivalent command line (provenance).
     log : callable
-        Receives one line per sidecar file found beside a mesh or an image, one per SFO
-        and one per warning of that SFO.
+        Receives one line per sidecar file found beside a mesh or an image, one per photo
+        prepared automatically, one per photo with automatic, unreviewed landmarks, one per
+        SFO and one per warning of that SFO.
+    auto_landmarks : bool
+        Prepare each image without a landmark file with ``lilium photo`` into
+        ``out/<photo>/prepared/`` (:func:`~lilium.casework.inputs.load_photos`); fails at once,
+        before reading anything, when ``lilium[photo]`` is not installed.
 
     Returns
     -------
@@ -75,15 +103,18 @@ def run_case(
     methods = list(dict.fromkeys(methods)) or ["lilium"]
     for method in methods:
         check_method(method, options.variant)
+    if auto_landmarks:
+        check_photo_extra()
     skull, skull_inputs = load_skull(skull_path, landmarks, axes, log=log)
     skull = labelled_skull(skull, skull_inputs)
-    records = load_photos(photos, log=log, **photo_options)
+    out = Path(out)
+    records = load_photos(
+        photos, log=log, skull=skull, auto_landmarks=auto_landmarks, out=out, **photo_options
+    )
     if depth_table:
-        from dataclasses import replace
-
         options = replace(options, depth_table=read_depth_table(depth_table))
     planned = {}
-    for photo, inputs, _ in records:  # every problem before any long run
+    for photo, inputs, _, _ in records:  # every problem before any long run
         planned[photo.id] = check_runnable(
             skull, photo, methods, options.variant, skull_inputs, inputs
         )
@@ -91,9 +122,12 @@ def run_case(
     for photo_id, off in planned.items():
         for term, why in off.items():
             log(f"{photo_id}: lilium {options.variant}: {term_label(term)} switched off: {why}")
-    out = Path(out)
+    for photo, _, _, origin in records:
+        if origin is not None and origin.unreviewed:
+            log(f"{photo.id}: {origin.line()}")
     entries = []
-    for photo, inputs, notes in records:
+    for photo, inputs, notes, origin in records:
+        landmark_info = _landmark_info(origin, out)
         for method in methods:
             result = run_sfo(method, skull, photo, options, seed)
             tag = method_tag(method, options.variant)
@@ -114,7 +148,15 @@ def run_case(
             for warning in result.warnings:
                 log(f"  warning {warning.code}: {warning.message}")
             entries.append(
-                ReportEntry(skull, photo, result, {**skull_inputs, **inputs}, notes, outputs)
+                ReportEntry(
+                    skull,
+                    photo,
+                    result,
+                    {**skull_inputs, **inputs},
+                    notes,
+                    outputs,
+                    **landmark_info,
+                )
             )
     report = write_report(out / "report.html", entries, title=title, command=command)
     log(f"report: {report}")

@@ -32,8 +32,10 @@ def sfo_on_folders(
     """Read a subject and a photo folder, check them, run the method, write ``out_dir``.
 
     The photo's priors come from ``photo.json``, or its focal prior from the image's EXIF
-    (:func:`~lilium.casework.inputs.with_priors`); the left/right checks of SPEC section 10
-    run before the SFO (:func:`~lilium.methods.checks.check_inputs`).
+    (:func:`~lilium.casework.inputs.with_priors`), those of a ``lilium photo`` folder with
+    ``"source": "automatic"`` and its head orientation converted through the skull's frame
+    (:func:`~lilium.casework.prepared.with_automatic_priors`); the left/right checks of SPEC
+    section 10 run before the SFO (:func:`~lilium.methods.checks.check_inputs`).
 
     Parameters
     ----------
@@ -65,7 +67,9 @@ def sfo_on_folders(
             read(folder)  # raises its "not a folder" message
     skull, skull_inputs = load_skull(skull_dir, axes=axes)
     skull = labelled_skull(skull, skull_inputs)
-    ((photo, _, _),) = load_photos([photo_dir])
+    # A lilium photo folder's automatic head orientation is paired with this skull's frame.
+    (record,) = load_photos([photo_dir], skull=skull)
+    photo = record.photo
     check_inputs(skull, photo)
     if depth_table is not None:
         options = replace(options, depth_table=read_depth_table(depth_table))

@@ -13,22 +13,36 @@ has one.
 
 from dataclasses import replace
 from pathlib import Path
+from typing import NamedTuple
 
 from ..inputs import CaseWarning
 from ..io.case import (
     IMAGE_NAMES,
     check_axes_file,
     photo_from_files,
+    read_mask,
     read_photo,
+    read_prepared,
     read_skull,
     skull_from_files,
 )
 from ..io.curves import read_face_curve
 from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
+from ..io.paths import safe_id
 from ..validation import check_interval
+from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
+
+
+class PhotoRecord(NamedTuple):
+    """One photo of a case as :func:`load_photos` read it."""
+
+    photo: object
+    inputs: dict
+    notes: dict
+    origin: object = None
 
 
 def _first_file(folder, names):
@@ -137,6 +151,9 @@ def load_photos(
     sensor_width_mm=None,
     face_curves=(),
     log=None,
+    skull=None,
+    auto_landmarks=False,
+    out=None,
 ):
     """Read every photo (folders and image files) with its priors.
 
@@ -157,14 +174,27 @@ def load_photos(
         For the EXIF focal prior.
     log : callable, optional
         Receives one line per sidecar file found beside an image (not named on the command
-        line), e.g. ``"front: using mask front_mask.png (found beside the photo)"``.
+        line), e.g. ``"front: using mask front_mask.png (found beside the photo)"``, one per
+        photo prepared with ``auto_landmarks`` and one per automatic prior switched off.
+    skull : Skull, optional
+        The paired skull: the automatic head orientation of a ``lilium photo`` folder becomes
+        ``head_rotation_skull2cam`` through its frame
+        (:func:`~lilium.casework.prepared.with_automatic_priors`).
+    auto_landmarks : bool
+        Prepare each image without a landmark file (none given, none beside it) with
+        ``lilium photo`` into ``out/<photo>/prepared/`` and use that folder, with the image's
+        own ``--mask``, ``--face-curve`` and ``--view`` where given (the mask beside it too).
+    out : path, optional
+        The case's output folder (needed with ``auto_landmarks``).
 
     Returns
     -------
-    list of (Photo, dict inputs, dict notes)
-        ``inputs``: the files used, labelled (provenance); ``notes``: where each prior came from,
-        as text for the report. Each photo carries its priors' sources (``prior_sources``), its
-        ``landmarks_file`` and its input warnings (:func:`with_priors`).
+    list of PhotoRecord
+        ``(photo, inputs, notes, origin)``: ``inputs`` the files used, labelled (provenance);
+        ``notes`` where each prior came from, as text for the report; ``origin`` the
+        :class:`~lilium.casework.prepared.LandmarkOrigin` of a ``lilium photo`` folder's
+        landmarks (None for landmarks placed by hand). Each photo carries its priors' sources
+        (``prior_sources``), its ``landmarks_file`` and its input warnings (:func:`with_priors`).
     """
     photos = [Path(p) for p in photos]
     image_files = [p for p in photos if not p.is_dir()]
@@ -176,14 +206,17 @@ def load_photos(
     scd_cli = _check_interval(scd_mm, "--scd-mm")
     records, k_file = [], 0
     for path in photos:
-        inputs, notes = {}, {}
+        inputs, notes, facts, origin = {}, {}, None, None
         if path.is_dir():
             photo = read_photo(path)
             image = _first_file(path, IMAGE_NAMES)
             inputs["photo"] = image
             inputs["photo.json"] = path / "photo.json"
+            facts = read_prepared(path)
             lm_file = find_landmark_file(path, ["facial_landmarks", "landmarks"])
-            if lm_file is not None and "landmarks" not in _json_keys(path / "photo.json"):
+            if "landmarks" in _json_keys(path / "photo.json"):
+                origin = landmark_origin(photo, facts)
+            elif lm_file is not None:
                 inputs["facial landmarks"] = lm_file
             for name, label in (("face_mask.png", "face mask"), ("face_curve.json", "face curve")):
                 if (path / name).is_file():
@@ -199,12 +232,13 @@ def load_photos(
                 [path.stem, f"{path.stem}_landmarks", f"{path.stem}.landmarks"],
                 (".csv", ".json", ".tsv", ".txt"),
             )
-            if lm_file is None:
+            if lm_file is None and not auto_landmarks:
                 raise ValueError(
                     f"{path}: no facial landmark file for this photo; give it with "
-                    "--photo-landmarks FILE (CSV name,u,v or JSON), once per --photo image"
+                    "--photo-landmarks FILE (CSV name,u,v or JSON), once per --photo image, or "
+                    "let --auto-landmarks find them (pip install 'lilium[photo]')"
                 )
-            if lm_files[k_file] is None:
+            if lm_file is not None and lm_files[k_file] is None:
                 _found(log, path.stem, "facial landmarks", lm_file, "the photo")
             mask = masks[k_file] or _sibling(
                 path, [f"{path.stem}_mask", f"{path.stem}.mask"], (".png",)
@@ -215,10 +249,17 @@ def load_photos(
             if curve is not None and curves[k_file] is None:
                 _found(log, path.stem, "face curve", curve, "the photo")
             view = views[k_file] or "frontal"
+            if lm_file is None:  # --auto-landmarks: lilium photo into OUT/<photo>/prepared/
+                photo, inputs, facts = _prepared_image(
+                    path, records, out, views[k_file], mask, sensor_width_mm, log
+                )
+                origin = landmark_origin(photo, facts)
+                view = photo.view
+            else:
+                photo = photo_from_files(path, lm_file, view, mask)
+                inputs["photo"] = path
+                inputs["facial landmarks"] = lm_file
             k_file += 1
-            photo = photo_from_files(path, lm_file, view, mask)
-            inputs["photo"] = path
-            inputs["facial landmarks"] = lm_file
             if mask is not None:
                 inputs["face mask"] = mask
             if curve is not None:
@@ -229,17 +270,48 @@ def load_photos(
         photo, notes = with_priors(
             photo, image, focal_cli, scd_cli, use_exif=use_exif, sensor_width_mm=sensor_width_mm
         )
+        photo, notes = with_automatic_priors(
+            photo, notes, facts, skull, scd_from_cli=scd_cli is not None, log=log
+        )
         photo = replace(
             photo, landmarks_file=str(inputs.get("facial landmarks") or inputs["photo.json"])
         )
-        records.append((photo, inputs, notes))
+        records.append(PhotoRecord(photo, inputs, notes, origin))
     seen = {}
-    for i, (photo, inputs, notes) in enumerate(records):  # unique photo ids for the outputs
-        n = seen.get(photo.id, 0)
-        seen[photo.id] = n + 1
+    for i, record in enumerate(records):  # unique photo ids for the outputs
+        n = seen.get(record.photo.id, 0)
+        seen[record.photo.id] = n + 1
         if n:
-            records[i] = (replace(photo, id=f"{photo.id}_{n + 1}"), inputs, notes)
+            records[i] = record._replace(
+                photo=replace(record.photo, id=_nth_id(record.photo.id, n))
+            )
     return records
+
+
+def _nth_id(photo_id, n_before):
+    """The output id of a photo whose id ``n_before`` earlier photos share (``front_2``, ...)."""
+    return f"{photo_id}_{n_before + 1}" if n_before else photo_id
+
+
+def _prepared_image(path, records, out, view, mask, sensor_width_mm, log):
+    """``--auto-landmarks`` for one bare image: prepare, read back, keep the user's mask.
+
+    Returns the photo (its id the image's stem, as for an image with a landmark file), its
+    labelled inputs and the folder's :class:`~lilium.io.case.PreparedFacts`.
+    """
+    if out is None:
+        raise ValueError("--auto-landmarks needs the output folder (--out) to prepare photos in")
+    photo_id = safe_id(path.stem, "photo")
+    n_before = sum(r.photo.id == photo_id for r in records)
+    folder = Path(out) / _nth_id(photo_id, n_before) / "prepared"
+    prepare_bare_photo(path, folder, view=view, sensor_width_mm=sensor_width_mm, log=log)
+    photo = replace(read_photo(folder), id=photo_id)
+    if mask is not None:  # the user's own mask wins over the automatic one
+        photo = replace(photo, face_mask=read_mask(mask, photo.image_size_wh))
+    inputs = {"photo": path, "photo.json": folder / "photo.json"}
+    if mask is None and (folder / "face_mask.png").is_file():
+        inputs["face mask"] = folder / "face_mask.png"
+    return photo, inputs, read_prepared(folder)
 
 
 def with_priors(photo, image, focal_px=None, scd_mm=None, use_exif=True, sensor_width_mm=None):

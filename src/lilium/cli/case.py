@@ -3,6 +3,7 @@
 Inputs are SPEC section 8 folders or the files a practitioner already has::
 
     lilium case --skull SUBJECT_DIR --photo PHOTO_DIR [--photo PHOTO_DIR ...] --out DIR
+    lilium case --skull SUBJECT_DIR --auto-landmarks --photo portrait.jpg --out DIR
     lilium case --skull skull.stl --landmarks skull.mrk.json \\
         --photo front.jpg --photo-landmarks front.csv [--mask front_mask.png] \\
         [--face-curve front_face_curve.json] --out DIR
@@ -55,6 +56,13 @@ sidecar files (used when the option is not given; each one found is printed, e.g
                             --mask), NAME_face_curve.json (facial curve, --face-curve)
   in a photo folder         image.png/.jpg, photo.json, face_mask.png, face_curve.json
 
+automatic landmarks (lilium photo, SPEC section 11): a folder written by lilium photo is a
+  photo folder; its tracked landmarks are used, its template ones only once confirmed in
+  review.html, its priors with "source": "automatic", its head orientation turned into
+  head_rotation_skull2cam through the skull's frame. --auto-landmarks prepares each bare
+  image itself into OUT/<photo>/prepared/ (nothing is written beside the image); the report
+  says the landmarks are automatic and unreviewed and links the review page (docs/photo.md).
+
 facial curve (face_curve.json format): {"chin_jaw": [[u, v], ...]} for a frontal photo,
   {"forehead": [[u, v], ...]} for a lateral one (pixels); without one, the pll variants
   derive it from the face mask.
@@ -96,6 +104,16 @@ def register(subparsers):
         action="append",
         type=Path,
         help="photo folder or image (PNG/JPEG); repeat for several photos of the person",
+    )
+    p.add_argument(
+        "--auto-landmarks",
+        action="store_true",
+        help=(
+            "prepare each --photo image that has no landmark file (none given, none beside it) "
+            "with lilium photo into OUT/<photo>/prepared/ and use its tracked landmarks, head "
+            "mask and priors; the report says they are automatic and unreviewed (needs "
+            "pip install 'lilium[photo]')"
+        ),
     )
     p.add_argument(
         "--photo-landmarks",
@@ -175,6 +193,8 @@ def command_line(args, methods):
             parts += [f"--{option.replace('_', '-')}", str(getattr(args, option))]
     for photo in args.photo:
         parts += ["--photo", str(photo)]
+    if args.auto_landmarks:
+        parts.append("--auto-landmarks")
     for option in ("photo_landmarks", "mask", "face_curve", "view"):
         for value in getattr(args, option):
             parts += [f"--{option.replace('_', '-')}", str(value)]
@@ -218,5 +238,6 @@ def run(args):
         scd_mm=args.scd_mm,
         use_exif=not args.no_exif,
         sensor_width_mm=args.sensor_width_mm,
+        auto_landmarks=args.auto_landmarks,
     )
     return 0 if all(e.result for e in entries) else 1

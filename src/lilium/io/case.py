@@ -4,6 +4,7 @@ Every problem found is a ``ValueError`` whose message names the file, the field 
 """
 
 import csv
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +40,7 @@ __all__ = [
     "read_image",
     "read_mask",
     "read_photo",
+    "read_prepared",
     "read_skull",
     "skull_from_files",
 ]
@@ -289,6 +291,110 @@ def _without_unconfirmed_templates(landmarks, sources):
             and sources[name].get("confirmed") is not True
         )
     }
+
+
+@dataclass(frozen=True)
+class PreparedFacts:
+    """What ``lilium photo`` wrote into a photo folder beyond SPEC section 8 (SPEC section 11).
+
+    Attributes
+    ----------
+    landmark_sources : dict of str -> dict
+        ``photo.json``'s ``landmark_sources`` (every landmark written, used or not): ``{name:
+        {"source": "automatic" | "reviewed", "quality": "tracked" | "template" | "manual",
+        "confirmed": bool}}``.
+    automatic_priors : dict of str -> str
+        The priors ``lilium photo`` found (``focal_px``, ``scd_mm``, ``head_rotation_face2cam``)
+        and where from (its ``priors.sources`` text), when ``priors.source`` is
+        ``"automatic"``; a prior the user added to ``photo.json`` without a ``sources`` entry
+        is not in it.
+    head_rotation_face2cam : ndarray of shape (3, 3) or None
+        The face frame in the camera frame (:mod:`lilium.photo.headpose`).
+    head_tolerance_deg : float or None
+        ``priors.head_tolerance_face_deg``.
+    head_angles_deg : dict of str -> float
+        ``yaw``, ``pitch``, ``roll`` (degrees), for the report.
+    iris_diameter_px : float or None
+        Mean iris diameter (pixels), for the distance prior once a focal is known.
+    review_page : Path or None
+        The folder's ``review.html``.
+    """
+
+    landmark_sources: dict
+    automatic_priors: dict
+    head_rotation_face2cam: np.ndarray | None = None
+    head_tolerance_deg: float | None = None
+    head_angles_deg: dict = field(default_factory=dict)
+    iris_diameter_px: float | None = None
+    review_page: Path | None = None
+
+
+def read_prepared(folder):
+    """The facts of a photo folder written by ``lilium photo`` (:class:`PreparedFacts`).
+
+    Parameters
+    ----------
+    folder : str or Path
+        A photo folder (read it with :func:`read_photo` too: this reads only the extras).
+
+    Returns
+    -------
+    PreparedFacts or None
+        None for a folder without ``landmark_sources`` or automatic priors (a hand-made one).
+
+    Raises
+    ------
+    ValueError
+        Naming ``photo.json`` and the field, for an automatic head orientation that is not a
+        rotation, a tolerance outside (0, 180] degrees or an iris diameter that is not positive.
+    """
+    from ..geometry.rotations import check_rotation
+
+    meta_path = Path(folder) / "photo.json"
+    meta = read_json(meta_path)
+    sources = meta.get("landmark_sources") if isinstance(meta, dict) else None
+    priors = meta.get("priors") if isinstance(meta, dict) else None
+    sources = sources if isinstance(sources, dict) else {}
+    sources = {k: v for k, v in sources.items() if isinstance(v, dict)}
+    automatic = {}
+    if isinstance(priors, dict) and priors.get("source") == "automatic":
+        texts = priors.get("sources") if isinstance(priors.get("sources"), dict) else {}
+        automatic = {k: str(texts[k]) for k in texts if k in priors}
+    else:
+        priors = {}
+    if not sources and not automatic:
+        return None
+    face2cam = tolerance = iris = None
+    if "head_rotation_face2cam" in automatic:
+        try:
+            face2cam = check_rotation(
+                priors["head_rotation_face2cam"], name="priors.head_rotation_face2cam"
+            )
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"{meta_path}: {exc}") from None
+        tolerance = priors.get("head_tolerance_face_deg", 15.0)
+        if not (isinstance(tolerance, (int, float)) and 0 < tolerance <= 180):
+            raise ValueError(
+                f"{meta_path}: priors.head_tolerance_face_deg must be in (0, 180] degrees"
+            )
+        tolerance = float(tolerance)
+    if priors.get("iris_diameter_px") is not None:
+        iris = priors["iris_diameter_px"]
+        if not (isinstance(iris, (int, float)) and np.isfinite(iris) and iris > 0):
+            raise ValueError(f"{meta_path}: priors.iris_diameter_px must be a positive number")
+        iris = float(iris)
+    angles = priors.get("head_angles_deg") if face2cam is not None else None
+    angles = {k: float(v) for k, v in angles.items()} if isinstance(angles, dict) else {}
+    review = Path(folder) / "review.html"
+    return PreparedFacts(
+        sources,
+        automatic,
+        face2cam,
+        tolerance,
+        angles,
+        iris,
+        review if review.is_file() else None,
+    )
 
 
 def _min_extent_px(image_size_wh):

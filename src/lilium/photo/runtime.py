@@ -49,6 +49,12 @@ def _interpreter_class():
     return Interpreter
 
 
+def check_runtime():
+    """Raise the one-line ``ValueError`` naming ``pip install 'lilium[photo]'`` when LiteRT
+    (``ai-edge-litert``) is not installed; nothing is loaded."""
+    _interpreter_class()
+
+
 @cache
 def _model(kind):
     path = resources.files("lilium.photo") / "models" / MODEL_FILES[kind]

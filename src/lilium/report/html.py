@@ -14,6 +14,9 @@ Formats the plain records of :mod:`lilium.report.records` into the templates shi
   labelled (numbered as in the landmark table where the SFO used them), so a misplaced or
   mislabelled landmark shows; each view's picture is embedded once per page (an SVG
   ``<image>`` that every SFO's view ``<use>``-s);
+- above the landmark table, where the landmarks came from when ``lilium photo`` placed them
+  ("facial landmarks automatic, unreviewed: ...", with a link to the review page), which the
+  summary repeats; the table then gives each landmark's source (``automatic, tracked``);
 - the landmark table (photo point, projected estimate, error in pixels), the camera (focal
   length, subject-to-camera distance, rotation, ``skull2cam``), each fitness term, the fitness
   curve (inline SVG);
@@ -39,6 +42,10 @@ import numpy as np
 
 from .records import ReportEntry, report_record
 from .svg import curve_svg, marks_svg, skull_view_defs, skull_view_svg
+
+#: How the report names facial landmarks found by ``lilium photo`` that nobody confirmed
+#: (the same words as :data:`lilium.casework.prepared.UNREVIEWED`).
+UNREVIEWED = "automatic, unreviewed"
 
 #: Initial skull-layer opacity (percent).
 DEFAULT_OPACITY_PCT = 60
@@ -128,9 +135,41 @@ def _summary_row(sfo):
         _num(s.mean_error_mm, "{:.2f}"),
         f"{_num(s.fitness, '{:.4g}')} <span class='muted'>({_e(s.score_label)})</span>",
         _num(s.outside_pct, "{:.2f}"),
-        _warning_codes(s.warnings),
+        _warning_codes(s.warnings) + _unreviewed_mark(sfo),
         f"{s.seconds:.2f}",
     ]
+
+
+def _unreviewed_mark(sfo):
+    if not sfo.landmarks_unreviewed:
+        return ""
+    return f' <span class="warn" title="{_e(sfo.landmarks_note)}">landmarks {UNREVIEWED}</span>'
+
+
+def _review_link(sfo):
+    if not sfo.review_href:
+        return ""
+    return f' (<a href="{_e(relative_href(sfo.review_href))}">review page</a>)'
+
+
+def _landmarks_note(sfo):
+    """The line on the landmarks' origin, above the landmark table ("" when placed by hand)."""
+    if not sfo.landmarks_note:
+        return ""
+    cls = "warnings" if sfo.landmarks_unreviewed else "muted"
+    return f"<p class='{cls} landmarks-origin'>{_e(sfo.landmarks_note)}{_review_link(sfo)}</p>"
+
+
+def _summary_notes(page):
+    """One line under the summary per photo whose landmarks are automatic and unreviewed."""
+    lines = {}
+    for sfo in page.sfos:
+        if sfo.landmarks_unreviewed and sfo.photo_id not in lines:
+            lines[sfo.photo_id] = (
+                f"<p class='warnings landmarks-origin'>Photo <b>{_e(sfo.photo_id)}</b>: "
+                f"{_e(sfo.landmarks_note)}{_review_link(sfo)}</p>"
+            )
+    return "\n".join(lines.values())
 
 
 def _alerts(sfo):
@@ -196,6 +235,7 @@ def _controls(sfo):
 
 
 def _landmark_table(sfo):
+    tags = dict(sfo.landmark_tags)
     rows = []
     for k, row in enumerate(sfo.landmarks, start=1):
         (pu, pv), (eu, ev) = row.photo_uv, row.estimate_uv
@@ -207,11 +247,13 @@ def _landmark_table(sfo):
                 f"{_num(eu, '{:.1f}')}, {_num(ev, '{:.1f}')}",
                 _num(row.error_px, "{:.2f}"),
             ]
+            + ([_e(tags.get(row.name, ""))] if tags else [])
         )
     if sfo.mean_error_px is not None:
-        rows.append(["", "<b>mean</b>", "", "", f"<b>{sfo.mean_error_px:.2f}</b>"])
+        mean = ["", "<b>mean</b>", "", "", f"<b>{sfo.mean_error_px:.2f}</b>"]
+        rows.append(mean + ([""] if tags else []))
     header = ["#", "facial landmark", "photo (u, v) px", "estimate (u, v) px", "error px"]
-    return _table(header, rows, "num")
+    return _table(header + (["source"] if tags else []), rows, "num")
 
 
 def _in_prior(bounds, inside):
@@ -389,7 +431,7 @@ def format_sfo(sfo):
         layers=_layers(sfo),
         controls=_controls(sfo),
         skull_views=_skull_views(sfo),
-        landmarks=_landmark_table(sfo),
+        landmarks=_landmarks_note(sfo) + _landmark_table(sfo),
         camera=_camera_table(sfo),
         terms=_terms_table(sfo),
         curve="" if sfo.history is None else curve_svg(sfo.history),
@@ -429,7 +471,8 @@ def format_report(page):
         date=_e(page.date),
         count=len(page.sfos),
         skulls=_e(", ".join(page.skull_ids)),
-        summary=_table(SUMMARY_HEADER, [_summary_row(s) for s in page.sfos], "num"),
+        summary=_table(SUMMARY_HEADER, [_summary_row(s) for s in page.sfos], "num")
+        + _summary_notes(page),
         sections=_skull_view_defs(page) + "\n".join(format_sfo(s) for s in page.sfos),
         provenance=_table(["", ""], provenance, "kv"),
     )

@@ -174,6 +174,14 @@ class SfoRecord:
         for the landmarks this SFO used.
     terms_off : tuple of (str, str)
         Terms switched off because their inputs are missing, and why (``SfoResult.terms_off``).
+    landmarks_note : str
+        Where the facial landmarks came from ("" for landmarks placed by hand).
+    landmarks_unreviewed : bool
+        Some are automatic and unconfirmed (``lilium photo``): said in the summary too.
+    landmark_tags : tuple of (str, str)
+        Facial landmark and its source (``"automatic, tracked"``); empty for hand-placed ones.
+    review_href : str
+        The review page, relative to the report ("" when it lies elsewhere).
     """
 
     index: int
@@ -205,6 +213,10 @@ class SfoRecord:
     warnings: tuple = ()
     priors: tuple = ()
     terms_off: tuple = ()
+    landmarks_note: str = ""
+    landmarks_unreviewed: bool = False
+    landmark_tags: tuple = ()
+    review_href: str = ""
 
 
 @dataclass(frozen=True)

@@ -44,6 +44,15 @@ class ReportEntry:
         Extra facts shown with the camera (e.g. where each prior came from).
     outputs : dict of str -> str
         Output files, labelled, as links relative to the report.
+    landmarks_note : str
+        Where the facial landmarks came from, one sentence ("" for landmarks placed by hand),
+        e.g. "facial landmarks automatic, unreviewed: ..." for a ``lilium photo`` folder.
+    landmarks_unreviewed : bool
+        Some landmarks are automatic and nobody confirmed them: the summary says so too.
+    landmark_tags : dict of str -> str
+        Per facial landmark, its source (``"automatic, tracked"``, ...), shown in the table.
+    review_href : str
+        The review page as a link relative to the report ("" when it lies elsewhere).
     """
 
     skull: object
@@ -52,6 +61,10 @@ class ReportEntry:
     inputs: dict = field(default_factory=dict)
     notes: dict = field(default_factory=dict)
     outputs: dict = field(default_factory=dict)
+    landmarks_note: str = ""
+    landmarks_unreviewed: bool = False
+    landmark_tags: dict = field(default_factory=dict)
+    review_href: str = ""
 
 
 def _floats(values):
@@ -283,6 +296,10 @@ def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
         warnings=warnings,
         priors=prior_rows(result),
         terms_off=tuple((str(k), str(v)) for k, v in result.terms_off.items()),
+        landmarks_note=str(entry.landmarks_note),
+        landmarks_unreviewed=bool(entry.landmarks_unreviewed),
+        landmark_tags=tuple((str(k), str(v)) for k, v in entry.landmark_tags.items()),
+        review_href=str(entry.review_href),
     )
 
 
