@@ -33,6 +33,7 @@ def run_case(
     title=None,
     command=None,
     log=print,
+    joint=False,
     **photo_options,
 ):
     """Read and check every input, run every SFO, write each result and the report.
@@ -59,6 +60,13 @@ def run_case(
     log : callable
         Receives one line per sidecar file found beside a mesh or an image, one per SFO
         and one per warning of that SFO.
+    joint : bool
+        Run each method that has a joint form (Lilium) as one joint SFO of all the photos
+        (SPEC section 9: one soft tissue shared by the photos, one camera each), written to
+        ``<out>/joint/<method tag>/`` (``result.json`` with ``"joint": true`` and
+        ``overlay_<photo id>.png`` per photo); the other methods run per photo as usual. The
+        report shows every photo's overlay and terms from the shared soft tissue, and its 3D
+        facial landmarks. Needs two or more distinct photos.
 
     Returns
     -------
@@ -75,6 +83,10 @@ def run_case(
     methods = list(dict.fromkeys(methods)) or ["lilium"]
     for method in methods:
         check_method(method, options.variant)
+    if joint:
+        from .joint_case import check_joint_case
+
+        check_joint_case(photos, methods)
     skull, skull_inputs = load_skull(skull_path, landmarks, axes, log=log)
     skull = labelled_skull(skull, skull_inputs)
     records = load_photos(photos, log=log, **photo_options)
@@ -93,8 +105,17 @@ def run_case(
             log(f"{photo_id}: lilium {options.variant}: {term_label(term)} switched off: {why}")
     out = Path(out)
     entries = []
-    for photo, inputs, notes in records:
+    joints = {}  # method -> (JointSfoResult, folder), for the joint methods
+    if joint:
+        from .joint_case import joint_entry, run_joint_methods
+
+        joints = run_joint_methods(skull, records, methods, options, seed, out, log)
+    for k, (photo, inputs, notes) in enumerate(records):
         for method in methods:
+            if method in joints:
+                labelled = {**skull_inputs, **inputs}
+                entries.append(joint_entry(joints[method], k, skull, photo, labelled, notes, out))
+                continue
             result = run_sfo(method, skull, photo, options, seed)
             tag = method_tag(method, options.variant)
             folder = out / safe_id(photo.id) / tag  # ids read from files are safe already

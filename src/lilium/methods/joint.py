@@ -195,7 +195,10 @@ class JointSfoResult:
     photos : tuple of SfoResult
         Per photo (in the order given): its camera, its own fitness (unweighted) and terms,
         ``terms_off``, error and warnings; its ``facial_landmarks_mm`` are the shared ones it
-        sees (its landmarks), so every per-photo tool (overlay, BPE, landmark error) takes it.
+        sees (its landmarks), so every per-photo tool (overlay, BPE, landmark error, report)
+        takes it. Its ``seconds`` are the joint run's, its ``extra`` says it is part of a joint
+        SFO: ``joint_photos`` (the ids), ``joint_fitness``, and the joint ``history``,
+        ``generations``, ``evaluations``, ``stop``.
     fitness : float
         The joint fitness DE ranked (``sum_p w_p fitness_p``; equals ``history[-1]``).
     facial_landmarks_mm : dict of str -> ndarray of shape (3,)
@@ -329,12 +332,22 @@ def joint_lilium_sfo(
             )
         )
     seconds = time.perf_counter() - start
+    ids = [r.photo_id for r in results]
+    shared_extra = {
+        "joint_photos": ids,
+        "joint_fitness": de.fun,
+        "history": de.history.tolist(),
+        "generations": de.nit,
+        "evaluations": de.nfev,
+        "stop": de.message,
+    }
+    results = [replace(r, seconds=seconds, extra=dict(shared_extra)) for r in results]
     return JointSfoResult(
         method="lilium",
         variant=options.variant,
         seed=seed,
         skull_id=skull.id,
-        photos=tuple(replace(r, seconds=seconds) for r in results),
+        photos=tuple(results),
         fitness=de.fun,
         facial_landmarks_mm=dict(zip(problem.facial_names, shared, strict=True)),
         seconds=seconds,
