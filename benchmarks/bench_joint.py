@@ -165,8 +165,9 @@ def summarise(rows, designs):
 
             wins += pair_bpe(m) < pair_bpe("independent")
         print(
-            f"{m:<20} BPE x{s['both'] / base['both']:.3f} (frontal x{s['front'] / base['front']:.3f},"
-            f" lateral x{s['lat'] / base['lat']:.3f}), failures {s['fail']} vs {base['fail']}, "
+            f"{m:<20} BPE x{s['both'] / base['both']:.3f} "
+            f"(frontal x{s['front'] / base['front']:.3f}, lateral x{s['lat'] / base['lat']:.3f}), "
+            f"failures {s['fail']} vs {base['fail']}, "
             f"time x{s['seconds'] / base['seconds']:.3f}, pairs better {wins}/{len(keys)}"
         )
 
