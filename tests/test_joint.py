@@ -74,7 +74,8 @@ def test_genes_span_the_union_of_the_photos_landmarks(pair):
 
 def test_fitness_is_the_sum_of_the_photos_fitnesses(pair):
     skull, photos, _, _ = pair
-    problem = JointLiliumProblem(skull, photos, SfoOptions("skof+pll", TINY_DE))
+    problem = JointLiliumProblem(skull, photos, SfoOptions("skof+pll", TINY_DE), weighting="sum")
+    assert list(problem.weights) == [1.0, 1.0]
     rng = np.random.default_rng(1)
     members = problem.evaluate(rng.random((6, problem.n_genes)))
     genes = rng.random((6, problem.n_genes))
@@ -111,8 +112,10 @@ def test_joint_result_is_the_member_de_ranked_and_reproducible(pair):
     a = joint_lilium_sfo(skull, photos, options, seed=4)
     b = joint_lilium_sfo(skull, photos, options, seed=4)
     assert a.fitness == b.fitness and a.extra["genes"] == b.extra["genes"]
-    assert a.fitness == a.extra["history"][-1]
-    assert a.fitness == pytest.approx(sum(r.fitness for r in a.photos), rel=1e-12)
+    assert a.fitness == a.extra["history"][-1] and a.extra["weighting"] == "scale"
+    weighted = sum(w * r.fitness for w, r in zip(a.weights, a.photos, strict=True))
+    assert a.fitness == pytest.approx(weighted, rel=1e-12)
+    assert a.weights[0] != a.weights[1]  # the toy photos differ in scale
     for r in a.photos:
         assert r.fitness == pytest.approx(sum(v for v in r.terms.values() if v is not None))
         # The photo's landmarks are the shared ones it sees; its camera fits them as reported.
@@ -170,7 +173,8 @@ def test_sfo_cli_writes_the_joint_contract(pair, tmp_path, capsys):
             "skull2cam",
         }
         assert (out / f"overlay_{p['photo']}.png").is_file()
-    assert data["fitness"] == pytest.approx(sum(p["fitness"] for p in data["photos"]))
+    weighted = sum(p["weight"] * p["fitness"] for p in data["photos"])
+    assert data["fitness"] == pytest.approx(weighted) and data["weighting"] == "scale"
     assert data["fitness"] == data["history"][-1]
     assert not (out / "overlay.png").exists()
     printed = capsys.readouterr().out

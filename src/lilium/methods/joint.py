@@ -16,11 +16,14 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   member it competes with, so each photo has its own chain, as in a single SFO. The initial
   population gets one POSEST per photo.
 - **Fitness.** ``sum_p w_p fitness_p`` with each photo's fitness as in a single SFO (MSE_pix,
-  P_cam, P_skof, P_pll with its camera, mask, curve and priors). ``weighting="sum"`` (the
-  default, SPEC section 9): ``w_p = 1``. ``weighting="scale"``: ``w_p = (k / k_p)^2`` with
-  ``k_p`` the photo's pixels per millimetre (:func:`photo_scale_px_per_mm`) and ``k`` their
-  geometric mean, so a photo whose face is twice as large in pixels does not weigh four
-  times as much.
+  P_cam, P_skof, P_pll with its camera, mask, curve and priors). ``weighting="scale"`` (the
+  default, :data:`DEFAULT_WEIGHTING`): ``w_p = (k / k_p)^2`` with ``k_p`` the photo's pixels
+  per millimetre at the face (:func:`photo_scale_px_per_mm`) and ``k`` their geometric mean,
+  so the sum is in the same units for every photo: a photo whose face is twice as large in
+  pixels (MSE_pix and P_skof four times larger for the same error in mm) does not weigh four
+  times as much. Equal-scale photos get ``w_p = 1``, the plain sum; ``weighting="sum"`` is
+  the plain sum always. ``result.json`` gives each photo's own (unweighted) fitness and its
+  ``weight``; the total is the weighted sum DE ranked.
 - **Early exit.** A trial's image penalties of photo ``p`` are skipped when the partial sum
   over all photos already exceeds its threshold (the other photos' partial sums are the
   offset): the run is the same, with fewer P_skof/P_pll evaluations.
@@ -43,6 +46,13 @@ from .result import SfoResult, finite_or_none
 
 #: How the photos' fitnesses are summed (see the module notes).
 WEIGHTINGS = ("sum", "scale")
+
+#: The default weighting and DE budget factor, chosen by ``benchmarks/bench_joint.py`` (8
+#: generated Exp. C frontal + lateral pairs, DE 30 x 750, skof+pll; docs/method.md): mean BPE
+#: against the independent SFOs x0.917 with ``sum``, x0.867 with ``scale``, x0.857 with
+#: ``scale`` and 1.25 x the generations (time x0.70, x0.82, x1.11 of the two SFOs together).
+DEFAULT_WEIGHTING = "scale"
+DEFAULT_GENERATIONS_FACTOR = 1.0
 
 #: Per-photo arrays of the DE payload, shape ``(S, P, ...)``.
 PHOTO_KEYS = ("fitness", "mse_pix", "p_cam", "p_skof", "p_pll", "R", "t", "focal_px", "success")
@@ -96,7 +106,7 @@ class JointLiliumProblem:
         :class:`LiliumProblem` refuses (an unknown variant, too few landmarks in a photo).
     """
 
-    def __init__(self, skull, photos, options=SfoOptions(), rng=0, weighting="sum"):
+    def __init__(self, skull, photos, options=SfoOptions(), rng=0, weighting=DEFAULT_WEIGHTING):
         photos = list(photos)
         if len(photos) < 2:
             raise ValueError(f"a joint SFO needs two or more photos, got {len(photos)}")
@@ -274,7 +284,12 @@ class JointSfoResult:
 
 
 def joint_lilium_sfo(
-    skull, photos, options=SfoOptions(), seed=0, weighting="sum", generations_factor=1.0
+    skull,
+    photos,
+    options=SfoOptions(),
+    seed=0,
+    weighting=DEFAULT_WEIGHTING,
+    generations_factor=DEFAULT_GENERATIONS_FACTOR,
 ):
     """Run one joint Lilium SFO of a skull against several photos of one person.
 

@@ -411,9 +411,10 @@ def format_joint(joint):
     -------
     str
     """
-    parts = ", ".join(
-        f"{_e(pid)} {_num(f, '{:.4g}')}"
-        for pid, f in zip(joint.photo_ids, joint.photo_fitness, strict=True)
+    weights = joint.weights or (1.0,) * len(joint.photo_ids)
+    parts = " + ".join(
+        f"{w:.3g} &times; {_num(f, '{:.4g}')} ({_e(pid)})"
+        for pid, f, w in zip(joint.photo_ids, joint.photo_fitness, weights, strict=True)
     )
     rows = [
         [str(k), _e(r.name), *(f"{x:.2f}" for x in r.position_mm), _e(", ".join(r.photos))]
@@ -425,8 +426,9 @@ def format_joint(joint):
         f"<section><h2>Joint SFO: {_e(joint.method_label)}, skull {_e(joint.skull_id)}, "
         f"photos {_e(', '.join(joint.photo_ids))}{status}</h2>\n"
         "<p>One soft tissue shared by every photo, one camera per photo (SPEC section 9). "
-        f"Joint fitness {_num(joint.fitness, '{:.4g}')} = the sum of the photos' fitnesses "
-        f"({parts}). Each photo's section below shows its overlay and terms from this soft "
+        f"Joint fitness {_num(joint.fitness, '{:.4g}')} = {parts}: each photo's fitness "
+        "weighted by its scale (pixels per mm at the face) so that photos of different sizes "
+        "count alike. Each photo's section below shows its overlay and terms from this soft "
         "tissue.</p>\n"
         "<p>Estimated 3D facial landmarks (skull frame, mm):</p>\n"
         + _table(header, rows, "num")

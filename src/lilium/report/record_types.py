@@ -242,6 +242,8 @@ class JointRecord:
     ok : bool
         Every photo has a camera.
     landmarks : tuple of JointLandmarkRow
+    weights : tuple of float
+        Each photo's weight in the joint fitness (:mod:`lilium.methods.joint`).
     """
 
     method_label: str
@@ -251,6 +253,7 @@ class JointRecord:
     photo_fitness: tuple
     ok: bool
     landmarks: tuple
+    weights: tuple = ()
 
 
 @dataclass(frozen=True)

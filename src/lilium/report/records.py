@@ -366,6 +366,7 @@ def joint_record(joint):
         photo_fitness=tuple(float(r.fitness) for r in joint.photos),
         ok=bool(joint),
         landmarks=rows,
+        weights=tuple(float(w) for w in joint.weights),
     )
 
 
