@@ -174,15 +174,18 @@ class JointLiliumProblem:
                 mine = {k: np.asarray(members[k])[:, p] for k in ("R", "t", "focal_px", "success")}
             per.append(problem.camera_terms(facial[:, self.rows[p]], mine))
         w = self.weights
-        partial = np.array([w[p] * per[p]["fitness"] for p in range(len(per))])
-        for p, problem in enumerate(self.problems):
-            offset = partial.sum(axis=0) - partial[p]
-            bound = None if thresholds is None else np.asarray(thresholds, float) / w[p]
-            problem.add_image_terms(per[p], bound, offset / w[p])
-            partial[p] = w[p] * per[p]["fitness"]
+        # Fitnesses of hopeless trials reach 1e60 and more (P_cam of a run-off camera); their
+        # weighted sums may overflow to inf, which ranks them last as it should.
+        with np.errstate(over="ignore", invalid="ignore"):
+            partial = np.array([w[p] * per[p]["fitness"] for p in range(len(per))])
+            for p, problem in enumerate(self.problems):
+                offset = np.delete(partial, p, axis=0).sum(axis=0)  # the other photos' bounds
+                problem.add_image_terms(per[p], thresholds, offset, w[p])
+                partial[p] = w[p] * per[p]["fitness"]
+            total = partial.sum(axis=0)
         out = {k: np.stack([t[k] for t in per], axis=1) for k in PHOTO_KEYS}
         out["photo_fitness"] = out.pop("fitness")
-        out["fitness"] = partial.sum(axis=0)
+        out["fitness"] = total
         return out
 
     def __call__(self, genes, members=None, thresholds=None):

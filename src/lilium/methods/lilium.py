@@ -265,7 +265,7 @@ class LiliumProblem:
             "success": ok,
         }
 
-    def add_image_terms(self, terms, thresholds=None, offset=0.0):
+    def add_image_terms(self, terms, thresholds=None, offset=0.0, weight=1.0):
         """Add P_skof and P_pll to :meth:`camera_terms`' dictionary (in place; returned).
 
         Parameters
@@ -274,10 +274,12 @@ class LiliumProblem:
             From :meth:`camera_terms`.
         thresholds : ndarray of shape (S,), optional
             As in :meth:`evaluate`: a term is skipped (NaN) for a trial whose
-            ``offset + fitness`` already exceeds its threshold.
+            ``offset + weight * fitness`` already exceeds its threshold.
         offset : float or ndarray of shape (S,)
             A lower bound of the rest of the trial's fitness (a joint SFO: the other photos'
-            partial sums); 0 for one photo.
+            weighted partial sums); 0 for one photo.
+        weight : float
+            This photo's weight in the trial's fitness (a joint SFO); 1 for one photo.
         """
         fitness, ok = terms["fitness"], terms["success"]
         R, t, f = terms["R"], terms["t"], terms["focal_px"]
@@ -287,7 +289,8 @@ class LiliumProblem:
             values = terms[name]
             if term is None:
                 continue
-            todo = ok & (offset + fitness <= bound)
+            with np.errstate(over="ignore", invalid="ignore"):
+                todo = ok & (offset + weight * fitness <= bound)
             if todo.any():
                 values[todo] = term(Cameras(R[todo], t[todo], f[todo], self.centre))
                 fitness[todo] += values[todo]
