@@ -56,6 +56,7 @@ def run_case(
     command=None,
     log=print,
     auto_landmarks=False,
+    joint=False,
     **photo_options,
 ):
     """Read and check every input, run every SFO, write each result and the report.
@@ -87,6 +88,13 @@ def run_case(
         Prepare each image without a landmark file with ``lilium photo`` into
         ``out/<photo>/prepared/`` (:func:`~lilium.casework.inputs.load_photos`); fails at once,
         before reading anything, when ``lilium[photo]`` is not installed.
+    joint : bool
+        Run each method that has a joint form (Lilium) as one joint SFO of all the photos
+        (SPEC section 9: one soft tissue shared by the photos, one camera each), written to
+        ``<out>/joint/<method tag>/`` (``result.json`` with ``"joint": true`` and
+        ``overlay_<photo id>.png`` per photo); the other methods run per photo as usual. The
+        report shows every photo's overlay and terms from the shared soft tissue, and its 3D
+        facial landmarks. Needs two or more distinct photos.
 
     Returns
     -------
@@ -105,6 +113,10 @@ def run_case(
         check_method(method, options.variant)
     if auto_landmarks:
         check_photo_extra()
+    if joint:
+        from .joint_case import check_joint_case
+
+        check_joint_case(photos, methods)
     skull, skull_inputs = load_skull(skull_path, landmarks, axes, log=log)
     skull = labelled_skull(skull, skull_inputs)
     out = Path(out)
@@ -126,9 +138,18 @@ def run_case(
         if origin is not None and origin.unreviewed:
             log(f"{photo.id}: {origin.line()}")
     entries = []
-    for photo, inputs, notes, origin in records:
+    joints = {}  # method -> (JointSfoResult, folder), for the joint methods
+    if joint:
+        from .joint_case import joint_entry, run_joint_methods
+
+        joints = run_joint_methods(skull, records, methods, options, seed, out, log)
+    for k, (photo, inputs, notes, origin) in enumerate(records):
         landmark_info = _landmark_info(origin, out)
         for method in methods:
+            if method in joints:
+                labelled = {**skull_inputs, **inputs}
+                entries.append(joint_entry(joints[method], k, skull, photo, labelled, notes, out))
+                continue
             result = run_sfo(method, skull, photo, options, seed)
             tag = method_tag(method, options.variant)
             folder = out / safe_id(photo.id) / tag  # ids read from files are safe already

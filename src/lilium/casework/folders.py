@@ -4,11 +4,13 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..io.case import read_depth_table, read_photo, read_skull
-from ..io.results import write_result
+from ..io.jsonio import write_json
+from ..io.paths import safe_id
+from ..io.results import write_png, write_result
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
-from ..methods.registry import check_method, run_sfo
+from ..methods.registry import check_joint_method, check_method, run_joint_sfo, run_sfo
 from .inputs import load_photos, load_skull
 
 
@@ -75,4 +77,100 @@ def sfo_on_folders(
         options = replace(options, depth_table=read_depth_table(depth_table))
     result = run_sfo(method, skull, photo, options, seed)
     write_result(out_dir, result, result_overlay(result, skull, photo) if overlay else None)
+    return result
+
+
+def joint_overlay_name(photo_id):
+    """File name of a photo's overlay in a joint SFO's folder: ``overlay_<photo id>.png``."""
+    return f"overlay_{safe_id(photo_id)}.png"
+
+
+def write_joint_result(out_dir, result, skull, photos, overlay=True):
+    """Write a joint SFO's ``result.json`` (SPEC section 9) and ``overlay_<photo id>.png`` per
+    photo (the photo's plain image when its camera failed).
+
+    Without overlays, an ``overlay_<photo id>.png`` of these photos left in ``out_dir`` by an
+    earlier run is removed (it would show another camera than the ``result.json`` beside it).
+
+    Returns
+    -------
+    dict of str -> Path
+        ``result.json`` and each photo id's overlay path (when written).
+    """
+    out_dir = Path(out_dir)
+    written = {"result.json": out_dir / "result.json"}
+    write_json(written["result.json"], result.to_dict())
+    for single, photo in zip(result.photos, photos, strict=True):
+        path = out_dir / joint_overlay_name(photo.id)
+        if overlay:
+            write_png(path, result_overlay(single, skull, photo))
+            written[photo.id] = path
+        elif path.is_file() or path.is_symlink():
+            path.unlink()
+    return written
+
+
+def check_distinct_photos(paths):
+    """Refuse a photo given twice to a joint SFO (it would count its landmarks twice).
+
+    Raises
+    ------
+    ValueError
+        Naming the repeated path.
+    """
+    seen = {}
+    for path in paths:
+        key = Path(path).resolve()
+        if key in seen:
+            raise ValueError(
+                f"--photo {path}: the same photo as --photo {seen[key]}; a joint SFO takes each "
+                "photo of the person once"
+            )
+        seen[key] = path
+
+
+def joint_sfo_on_folders(
+    skull_dir,
+    photo_dirs,
+    out_dir,
+    method="lilium",
+    options=SfoOptions(),
+    seed=0,
+    axes=None,
+    depth_table=None,
+    overlay=True,
+):
+    """One joint SFO (SPEC section 9) of a subject folder and two or more photo folders of the
+    same person: read, check, run, write ``out_dir``.
+
+    As :func:`sfo_on_folders`, with ``photo_dirs`` a list; writes ``result.json`` with
+    ``"joint": true`` and ``overlay_<photo id>.png`` per photo (:func:`write_joint_result`).
+
+    Returns
+    -------
+    JointSfoResult
+
+    Raises
+    ------
+    ValueError
+        An invalid input (naming the file), a method without a joint form, fewer than two
+        photos, or a photo given twice.
+    """
+    check_joint_method(method, options.variant)
+    photo_dirs = [Path(d) for d in photo_dirs]
+    if len(photo_dirs) < 2:
+        raise ValueError("a joint SFO needs two or more --photo folders")
+    check_distinct_photos(photo_dirs)
+    for folder, read in ((skull_dir, read_skull), *((d, read_photo) for d in photo_dirs)):
+        if not Path(folder).is_dir():
+            read(folder)  # raises its "not a folder" message
+    skull, skull_inputs = load_skull(skull_dir, axes=axes)
+    skull = labelled_skull(skull, skull_inputs)
+    photos = [record.photo for record in load_photos(photo_dirs, skull=skull)]
+    for photo in photos:
+        check_inputs(skull, photo)
+    if depth_table is not None:
+        options = replace(options, depth_table=read_depth_table(depth_table))
+    result = run_joint_sfo(method, skull, photos, options, seed)
+    write_joint_result(out_dir, result, skull, photos, overlay=overlay)
     return result

@@ -181,6 +181,15 @@ def register(subparsers):
     p.add_argument(
         "--depth-table", type=DEPTH_TABLE_FILE, help="CSV: landmark,mean,sd,min,max (mm)"
     )
+    p.add_argument(
+        "--joint",
+        action="store_true",
+        help=(
+            "run Lilium as one joint SFO of all the photos (two or more of the same person): "
+            "one soft tissue shared by the photos, one camera each; outputs in "
+            "DIR/joint/lilium-<variant>/ (SPEC section 9)"
+        ),
+    )
     p.add_argument("--title", help="report title")
     p.set_defaults(func=run)
 
@@ -212,6 +221,8 @@ def command_line(args, methods):
         parts += ["--sensor-width-mm", f"{args.sensor_width_mm:g}"]
     if args.no_exif:
         parts.append("--no-exif")
+    if getattr(args, "joint", False):
+        parts.append("--joint")
     parts += ["--out", str(args.out)]
     return " ".join(shlex.quote(p) for p in parts)
 
@@ -239,5 +250,6 @@ def run(args):
         use_exif=not args.no_exif,
         sensor_width_mm=args.sensor_width_mm,
         auto_landmarks=args.auto_landmarks,
+        joint=args.joint,
     )
     return 0 if all(e.result for e in entries) else 1

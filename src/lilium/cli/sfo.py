@@ -1,9 +1,14 @@
-"""``lilium sfo``: one skull-face overlay from a subject folder and a photo folder."""
+"""``lilium sfo``: one skull-face overlay from a subject folder and a photo folder.
+
+With two or more ``--photo`` folders of the same person, ``--method lilium`` runs one joint SFO
+(SPEC section 9): one soft tissue shared by the photos, one camera each; ``OUT/result.json``
+has ``"joint": true`` and a ``photos`` list, with ``OUT/overlay_<photo id>.png`` per photo.
+"""
 
 import sys
 from pathlib import Path
 
-from ..casework.folders import sfo_on_folders
+from ..casework.folders import joint_sfo_on_folders, sfo_on_folders
 from ..methods import METHODS, SfoOptions
 from ..optimisation.de import DEOptions
 from .argtypes import existing_file, int_in, output_folder, positive_float, seed
@@ -22,10 +27,24 @@ def register(subparsers):
     p = subparsers.add_parser(
         "sfo",
         help="run one skull-face overlay",
-        description="Superimpose a skull on a photo; writes OUT/result.json and OUT/overlay.png.",
+        description=(
+            "Superimpose a skull on a photo; writes OUT/result.json and OUT/overlay.png. With "
+            "two or more --photo (photos of the same person) and --method lilium, one joint SFO: "
+            "one soft tissue shared by the photos, one camera each; writes OUT/result.json "
+            '("joint": true) and OUT/overlay_<photo id>.png per photo.'
+        ),
     )
     p.add_argument("--skull", required=True, type=Path, help="subject folder (SPEC section 8)")
-    p.add_argument("--photo", required=True, type=Path, help="photo folder (SPEC section 8)")
+    p.add_argument(
+        "--photo",
+        required=True,
+        action="append",
+        type=Path,
+        help=(
+            "photo folder (SPEC section 8); repeat for a joint SFO of several photos of the "
+            "same person (--method lilium)"
+        ),
+    )
     p.add_argument("--out", required=True, type=output_folder, help="output folder")
     p.add_argument("--method", default="posest-sfo", choices=list(METHODS))
     p.add_argument(
@@ -74,9 +93,11 @@ def options_from(args):
 
 
 def run(args):
+    if len(args.photo) > 1:
+        return run_joint(args)
     result = sfo_on_folders(
         args.skull,
-        args.photo,
+        args.photo[0],
         args.out,
         method=args.method,
         options=options_from(args),
@@ -99,4 +120,46 @@ def run(args):
     )
     for term, why in result.terms_off.items():  # inputs missing: ran without it (SPEC 5)
         print(f"  {term} switched off: {why}")
+    return 0
+
+
+def run_joint(args):
+    """``lilium sfo`` with two or more ``--photo``: one joint SFO (SPEC section 9)."""
+    if args.method != "lilium":
+        raise ValueError(
+            f"--method {args.method}: a joint SFO of {len(args.photo)} photos runs with --method "
+            "lilium only; give one --photo for each SFO, or --method lilium"
+        )
+    result = joint_sfo_on_folders(
+        args.skull,
+        args.photo,
+        args.out,
+        method=args.method,
+        options=options_from(args),
+        seed=args.seed,
+        axes=args.axes,
+        depth_table=args.depth_table,
+        overlay=not args.no_overlay,
+    )
+    for single in result.photos:
+        for warning in single.warnings:
+            print(f"warning {warning.code} ({single.photo_id}): {warning.message}", file=sys.stderr)
+    print(
+        f"lilium {result.variant} joint ({len(result.photos)} photos): score "
+        f"{result.fitness:.3f}, {result.seconds:.2f} s -> {args.out}"
+    )
+    for single in result.photos:
+        if single:
+            line = f"focal {single.camera.focal_px:.0f} px, score {single.fitness:.3f}"
+        else:
+            line = f"FAILED ({single.error})"
+        print(f"  {single.photo_id}: {line}")
+        for term, why in single.terms_off.items():
+            print(f"    {term} switched off: {why}")
+    if not result:
+        print(
+            f"joint SFO failed for a photo: {result.error} (written to {args.out / 'result.json'})",
+            file=sys.stderr,
+        )
+        return 1
     return 0

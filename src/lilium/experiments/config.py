@@ -31,7 +31,9 @@ file's folder (to the current folder for a preset). Example::
     max_seconds = 10.0
 
 ``methods`` entries are ``"posest-sfo"``, ``"lilium:<variant>"`` (variant among ``base``,
-``pll``, ``skof``, ``skof+pll``) or ``"lilium"`` for all four variants.
+``pll``, ``skof``, ``skof+pll``) or ``"lilium"`` for all four variants; ``"lilium-joint:<variant>"``
+(or ``"lilium-joint"``, all variants) runs one joint SFO per subject's frontal + lateral photo
+pair and skull (SPEC section 9, :mod:`lilium.experiments.joint_tasks`).
 
 Every key is checked, with a message naming it: integers in the ranges of
 :data:`LIMITS` (seeds such that ``seed + run`` fits :data:`MAX_SEED`), ``max_seconds`` a finite
@@ -255,10 +257,15 @@ def parse_methods(entries, where="methods"):
             pairs = [("lilium", v) for v in LILIUM_VARIANTS]
         elif name.startswith("lilium:") and name[7:] in LILIUM_VARIANTS:
             pairs = [("lilium", name[7:])]
+        elif name == "lilium-joint":
+            pairs = [("lilium-joint", v) for v in LILIUM_VARIANTS]
+        elif name.startswith("lilium-joint:") and name[13:] in LILIUM_VARIANTS:
+            pairs = [("lilium-joint", name[13:])]
         else:
             raise ValueError(
-                f"{where}: unknown method {entry!r}; use 'posest-sfo', 'lilium' or "
-                f"'lilium:<variant>' with variant among {', '.join(LILIUM_VARIANTS)}"
+                f"{where}: unknown method {entry!r}; use 'posest-sfo', 'lilium', "
+                f"'lilium:<variant>', 'lilium-joint' or 'lilium-joint:<variant>' with variant "
+                f"among {', '.join(LILIUM_VARIANTS)}"
             )
         out.extend(p for p in pairs if p not in out)
     return tuple(out)
@@ -268,9 +275,10 @@ def method_label(method, variant):
     """Display name: ``POSEST-SFO``, ``Lilium``, ``Lilium+P_pll``, ``Lilium+P_skof+P_pll``."""
     if method == "posest-sfo":
         return "POSEST-SFO"
+    name = "Lilium joint" if method == "lilium-joint" else "Lilium"
     if not variant or variant == "base":
-        return "Lilium"
-    return "Lilium+" + "+".join(f"P_{part}" for part in variant.split("+"))
+        return name
+    return name + "+" + "+".join(f"P_{part}" for part in variant.split("+"))
 
 
 def check_int(where, value, key):

@@ -7,6 +7,9 @@ Tasks: every photo x every skull x every method, for each experiment:
 - C: for each perturbed axis set ``k = 1..axes_sets`` (``axes_C<k>.json`` of the *tested*
   skull): POSEST-SFO once, each Lilium variant ``runs_per_axes_set`` times.
 
+A joint method (``lilium-joint``, :mod:`lilium.experiments.joint_tasks`) runs once per
+subject's frontal + lateral photo pair and skull, and stores one row per photo.
+
 The worker (:func:`run_task`) reads the case (cached per process), runs the method and scores
 it: the ranking score, the BPE for positive pairs (photo of this skull's subject) and the
 projected-skull pixels outside the face mask (implausible SFOs). The parent writes each row to
@@ -37,6 +40,7 @@ import numpy as np
 
 from ..optimisation.de import DEOptions
 from .dataset import check_index, check_task_files, dataset_fingerprint
+from .joint_tasks import JOINT_METHODS, partner_tasks, photo_pairs, run_joint_task
 from .processes import exit_with_parent
 from .store import KEY_COLUMNS, ResultStore, RunLock, database_error
 
@@ -71,6 +75,9 @@ class Task:
     subject_dir, photo_dir : str
     axes_file : str or None
     de : DEOptions
+    joint_with : tuple of (str, str, str)
+        A joint task's other photos, ``(photo id, view, photo_dir)`` each (``photo`` is the
+        pair's frontal photo); empty for a single-photo SFO.
     """
 
     experiment: str
@@ -87,6 +94,7 @@ class Task:
     photo_dir: str
     axes_file: str | None
     de: DEOptions
+    joint_with: tuple = ()
 
     @property
     def key(self):
@@ -153,6 +161,12 @@ def enumerate_tasks(cfg, root, index):
     root = Path(root)
     check_index(index, root / "dataset.json")
     subjects = index["subjects"]
+    pairs = photo_pairs(index)
+    if not pairs and any(m in JOINT_METHODS for m, _ in cfg.methods):
+        raise ValueError(
+            f"{root / 'dataset.json'}: a joint method needs subjects with a frontal and a "
+            "lateral photo, the dataset has none; generate both views (lilium synth)"
+        )
     tasks = []
     for exp in cfg.experiments:
         for photo in index["photos"]:
@@ -179,6 +193,14 @@ def enumerate_tasks(cfg, root, index):
                             )
                         axes_file = str(root / subject["path"] / names[k - 1])
                     for method, variant in cfg.methods:
+                        partners = ()
+                        if method in JOINT_METHODS:  # one task per pair, led by its frontal
+                            if photo["id"] not in pairs:
+                                continue
+                            other = pairs[photo["id"]]
+                            partners = (
+                                (other["id"], other["view"], str(root / other["paths"][exp])),
+                            )
                         reps = [0] if method == "posest-sfo" else range(runs)
                         for r in reps:
                             tasks.append(
@@ -197,6 +219,7 @@ def enumerate_tasks(cfg, root, index):
                                     photo_dir=str(root / photo["paths"][exp]),
                                     axes_file=axes_file,
                                     de=cfg.de,
+                                    joint_with=partners,
                                 )
                             )
     return tasks
@@ -298,8 +321,11 @@ def run_task(task):
 
     An invalid case (a ``ValueError``: too few landmarks, no face mask for P_skof, ...) is a
     finished SFO with its ``error``; any other exception propagates (the task is not stored and
-    a rerun tries it again).
+    a rerun tries it again). A joint task returns a list of rows, one per photo
+    (:func:`~lilium.experiments.joint_tasks.run_joint_task`).
     """
+    if task.joint_with:
+        return run_joint_task(task)
     start = time.perf_counter()
     row = {c: getattr(task, c) for c in KEY_COLUMNS}
     row.update(
@@ -531,8 +557,8 @@ def run_experiment(cfg, scheduler=None, workers=None, db=None, progress=True, lo
     with RunLock(db):
         root, index = load_dataset(cfg, workers=workers, log=log)
         tasks = enumerate_tasks(cfg, root, index)
-        check_task_files(tasks)
-        fingerprint = dataset_fingerprint(root, index, tasks)
+        check_task_files(tasks + partner_tasks(tasks))
+        fingerprint = dataset_fingerprint(root, index, tasks + partner_tasks(tasks))
         try:
             with ResultStore(db) as store:
                 return _run(
@@ -582,8 +608,9 @@ def _run(cfg, store, tasks, root, fingerprint, scheduler, workers, progress, log
                 errors.append((task.key, f"{type(outcome).__name__}: {outcome}"))
                 if len(errors) <= 5:
                     log(f"SFO {task.key} raised {type(outcome).__name__}: {outcome}")
-            else:
-                stored += store.insert(outcome)
+            else:  # a joint task's rows end with the one of its key (joint_tasks)
+                rows = outcome if isinstance(outcome, list) else [outcome]
+                stored += [store.insert(row) for row in rows][-1]
             if bar is not None:
                 bar.update(1)
     finally:

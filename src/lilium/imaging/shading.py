@@ -134,7 +134,9 @@ def render_surface(vertices_mm, faces, camera, image_size_wh, *, topology=None):
     # Slivers the painter's fill missed inside the exact raster take a neighbour's triangle.
     gaps = covered & (face_index < 0)
     if gaps.any():
-        grown = cv2.dilate(face_index, np.ones((3, 3), np.uint8))
+        # OpenCV's dilate takes no int32: dilate the float32 copy (indices < 2^24 stay exact).
+        grown = cv2.dilate(face_index.astype(np.float32), np.ones((3, 3), np.uint8))
+        grown = grown.astype(np.int32)
         face_index[gaps] = grown[gaps]
     face_index[~covered] = -1
     rows, cols = np.nonzero(face_index >= 0)

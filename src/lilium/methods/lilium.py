@@ -56,7 +56,8 @@ VARIANTS = {
 
 
 def build_cones(skull, corr, depth_table=None):
-    """Cones of the usable landmarks, twins with mirror-consistent bases."""
+    """Cones of the usable landmarks (``corr``: anything with ``cranial_names`` and ``axes``, a
+    :class:`~lilium.inputs.Correspondences`), twins with mirror-consistent bases."""
     stats = [depth_stats(c, depth_table) for c in corr.cranial_names]
     _, normal = midsagittal_plane(skull.landmarks_mm)
     return make_cones(
@@ -221,39 +222,80 @@ class LiliumProblem:
             ``fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (NaN when off or
             skipped), ``success`` and the cameras ``R``, ``t``, ``focal_px``.
         """
-        facial = self.facial_landmarks(genes)
-        R, t, f, ok, sq = self.cameras(facial, members)
+        terms = self.camera_terms(self.facial_landmarks(genes), members)
+        return self.add_image_terms(terms, thresholds)
+
+    def camera_terms(self, facial_mm, members=None):
+        """The cheap terms of a population given its facial landmarks: cameras, MSE, P_cam.
+
+        The first half of :meth:`evaluate`; :meth:`add_image_terms` completes it. A joint SFO
+        (:mod:`lilium.methods.joint`) calls both per photo with that photo's rows of the shared
+        soft tissue.
+
+        Parameters
+        ----------
+        facial_mm : ndarray of shape (S, N, 3)
+            Facial 3D landmarks of this photo's correspondences (skull frame).
+        members : dict or None
+            As in :meth:`evaluate`.
+
+        Returns
+        -------
+        dict of str -> ndarray of shape (S, ...)
+            As :meth:`evaluate`, with ``fitness = mse_pix + p_cam`` and the image penalties NaN.
+        """
+        R, t, f, ok, sq = self.cameras(facial_mm, members)
         S = len(R)
         mse = np.where(ok, np.mean(sq, axis=1), C_INF)
         mse = np.where(np.isfinite(mse), mse, C_INF)
-        centre = facial[:, self.scd_index].mean(axis=1)
+        centre = facial_mm[:, self.scd_index].mean(axis=1)
         # Cameras that ran off (huge focal and depth) overflow here; P_cam gives them C_INF.
         with np.errstate(over="ignore", invalid="ignore"):
             scd = np.linalg.norm(np.einsum("sij,sj->si", R, centre) + t, axis=1)
             p_cam = camera_penalty_from_priors(f, scd, R, ok, self.photo.priors)
-        fitness = mse + p_cam
-        bound = np.full(S, np.inf) if thresholds is None else np.asarray(thresholds, float)
-        terms = {"p_skof": self.skof, "p_pll": self.pll}
-        values = {}
-        for name, term in terms.items():
-            values[name] = np.full(S, np.nan)
-            if term is None:
-                continue
-            todo = ok & (fitness <= bound)
-            if todo.any():
-                values[name][todo] = term(Cameras(R[todo], t[todo], f[todo], self.centre))
-                fitness[todo] += values[name][todo]
-            values[name][~ok] = 0.0
         return {
-            "fitness": fitness,
+            "fitness": mse + p_cam,
             "mse_pix": mse,
             "p_cam": p_cam,
-            **values,
+            "p_skof": np.full(S, np.nan),
+            "p_pll": np.full(S, np.nan),
             "R": R,
             "t": t,
             "focal_px": f,
             "success": ok,
         }
+
+    def add_image_terms(self, terms, thresholds=None, offset=0.0, weight=1.0):
+        """Add P_skof and P_pll to :meth:`camera_terms`' dictionary (in place; returned).
+
+        Parameters
+        ----------
+        terms : dict
+            From :meth:`camera_terms`.
+        thresholds : ndarray of shape (S,), optional
+            As in :meth:`evaluate`: a term is skipped (NaN) for a trial whose
+            ``offset + weight * fitness`` already exceeds its threshold.
+        offset : float or ndarray of shape (S,)
+            A lower bound of the rest of the trial's fitness (a joint SFO: the other photos'
+            weighted partial sums); 0 for one photo.
+        weight : float
+            This photo's weight in the trial's fitness (a joint SFO); 1 for one photo.
+        """
+        fitness, ok = terms["fitness"], terms["success"]
+        R, t, f = terms["R"], terms["t"], terms["focal_px"]
+        S = len(fitness)
+        bound = np.full(S, np.inf) if thresholds is None else np.asarray(thresholds, float)
+        for name, term in (("p_skof", self.skof), ("p_pll", self.pll)):
+            values = terms[name]
+            if term is None:
+                continue
+            with np.errstate(over="ignore", invalid="ignore"):
+                todo = ok & (offset + weight * fitness <= bound)
+            if todo.any():
+                values[todo] = term(Cameras(R[todo], t[todo], f[todo], self.centre))
+                fitness[todo] += values[todo]
+            values[~ok] = 0.0
+        return terms
 
     def __call__(self, genes, members=None, thresholds=None):
         """DE's objective: ``(fitness (S,), payload)``, the payload being :meth:`evaluate`'s
@@ -292,23 +334,8 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     )
     de = solver.solve()
     best = de.payload
-    ok = bool(best["success"])
-    camera = None
-    if ok:
-        camera = Camera.from_rt(best["R"], best["t"], best["focal_px"], problem.centre)
-    terms = {
-        k: (None if np.isnan(best[k]) else float(best[k]))
-        for k in ("mse_pix", "p_cam", "p_skof", "p_pll")
-    }
+    camera, terms, error, warnings = photo_outcome(problem, best, seed)
     facial = problem.facial_landmarks(de.x)[0]
-    error, warnings = "", ()
-    if not ok:
-        error = _failure_message(problem, best)
-    elif photo.priors.focal_px is None:
-        if problem.capped_mse < terms["mse_pix"]:
-            warnings = (focal_cap_warning(problem.capped_focal_px, photo),)
-        elif (long_lens := long_lens_focal_px(skull, photo, options, seed)) is not None:
-            warnings = (focal_cap_warning(long_lens, photo),)
     return SfoResult(
         method="lilium",
         variant=options.variant,
@@ -332,6 +359,47 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
             "fallbacks": problem.n_fallbacks,
         },
     )
+
+
+def photo_outcome(problem, best, seed):
+    """The camera, terms, error and warnings of one photo's best member.
+
+    Parameters
+    ----------
+    problem : LiliumProblem
+    best : dict
+        The best member's payload for this photo (``R``, ``t``, ``focal_px``, ``success``,
+        ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll``; scalars).
+    seed : int
+        For the long-lens check (:func:`~lilium.methods.posest_sfo.long_lens_focal_px`).
+
+    Returns
+    -------
+    camera : Camera or None
+    terms : dict of str -> float or None
+    error : str
+        "" when the photo has a camera.
+    warnings : tuple of CaseWarning
+        ``focal_cap`` (no focal prior, and a better fit above the cap).
+    """
+    ok = bool(best["success"])
+    camera = None
+    if ok:
+        camera = Camera.from_rt(best["R"], best["t"], best["focal_px"], problem.centre)
+    terms = {
+        k: (None if np.isnan(best[k]) else float(best[k]))
+        for k in ("mse_pix", "p_cam", "p_skof", "p_pll")
+    }
+    error, warnings = "", ()
+    photo, skull = problem.photo, problem.skull
+    if not ok:
+        error = _failure_message(problem, best)
+    elif photo.priors.focal_px is None:
+        if problem.capped_mse < terms["mse_pix"]:
+            warnings = (focal_cap_warning(problem.capped_focal_px, photo),)
+        elif (long_lens := long_lens_focal_px(skull, photo, problem.options, seed)) is not None:
+            warnings = (focal_cap_warning(long_lens, photo),)
+    return camera, terms, error, warnings
 
 
 def _failure_message(problem, best):

@@ -8,6 +8,7 @@ runs a method through :func:`run_sfo` with one :class:`~lilium.methods.options.S
 from dataclasses import dataclass
 
 from .checks import check_inputs, finish_result
+from .joint import joint_lilium_sfo
 from .lilium import VARIANTS, lilium_sfo
 from .options import SfoOptions
 from .posest_sfo import posest_sfo
@@ -27,12 +28,17 @@ class Method:
         Fitness variants (empty for a method without variants).
     stochastic : bool
         Whether the seed changes the result (repetitions make sense).
+    run_joint : callable or None
+        ``run_joint(skull, photos, options, seed) -> JointSfoResult``: one SFO of several
+        photos of one person with one shared soft tissue (SPEC section 9); None when the
+        method has no joint form.
     """
 
     name: str
     run: object
     variants: tuple = ()
     stochastic: bool = False
+    run_joint: object = None
 
 
 def _posest_sfo(skull, photo, options, seed):
@@ -44,10 +50,14 @@ def _lilium(skull, photo, options, seed):
     return lilium_sfo(skull, photo, options, seed=seed)
 
 
+def _joint_lilium(skull, photos, options, seed):
+    return joint_lilium_sfo(skull, photos, options, seed=seed)
+
+
 #: The methods, by name.
 METHODS = {
     "posest-sfo": Method("posest-sfo", _posest_sfo),
-    "lilium": Method("lilium", _lilium, tuple(VARIANTS), stochastic=True),
+    "lilium": Method("lilium", _lilium, tuple(VARIANTS), stochastic=True, run_joint=_joint_lilium),
 }
 
 
@@ -98,3 +108,54 @@ def run_sfo(method, skull, photo, options=SfoOptions(), seed=0):
     m = check_method(method, options.variant)
     check_inputs(skull, photo)
     return finish_result(m.run(skull, photo, options, seed), skull, photo)
+
+
+def check_joint_method(method, variant=None):
+    """Validate a method for a joint SFO (it must have a joint form); returns the
+    :class:`Method`."""
+    m = check_method(method, variant)
+    if m.run_joint is None:
+        joint = [name for name, other in METHODS.items() if other.run_joint is not None]
+        raise ValueError(
+            f"method {method!r} has no joint SFO of several photos; use {', '.join(joint)}, or "
+            "give one photo"
+        )
+    return m
+
+
+def run_joint_sfo(method, skull, photos, options=SfoOptions(), seed=0):
+    """Run one joint SFO: several photos of one person, one shared soft tissue (SPEC section 9).
+
+    Parameters
+    ----------
+    method : str
+        A key of :data:`METHODS` whose method has a joint form (``lilium``).
+    skull : lilium.inputs.Skull
+    photos : sequence of lilium.inputs.Photo
+        Two or more photos of the same person, distinct ids.
+    options : SfoOptions
+    seed : int
+
+    Returns
+    -------
+    JointSfoResult
+        Each photo's result with its warnings, priors' provenance and landmark error
+        (:func:`~lilium.methods.checks.finish_result`, as :func:`run_sfo`).
+
+    Raises
+    ------
+    ValueError
+        As :func:`run_sfo` for each photo; a method without a joint form; fewer than two
+        photos or a repeated photo id.
+    """
+    from dataclasses import replace
+
+    m = check_joint_method(method, options.variant)
+    photos = list(photos)
+    for photo in photos:
+        check_inputs(skull, photo)
+    result = m.run_joint(skull, photos, options, seed)
+    finished = tuple(
+        finish_result(r, skull, photo) for r, photo in zip(result.photos, photos, strict=True)
+    )
+    return replace(result, photos=finished)

@@ -79,8 +79,8 @@ class SfoResult:
             "subject": self.skull_id,
             "photo": self.photo_id,
             "camera": camera,
-            "fitness": _finite_or_none(self.fitness),
-            "terms": {k: _finite_or_none(v) for k, v in self.terms.items()},
+            "fitness": finite_or_none(self.fitness),
+            "terms": {k: finite_or_none(v) for k, v in self.terms.items()},
             **(
                 {"terms_off": {str(k): str(v) for k, v in self.terms_off.items()}}
                 if self.terms_off
@@ -101,7 +101,8 @@ class SfoResult:
         return out
 
 
-def _finite_or_none(value):
+def finite_or_none(value):
+    """``float(value)``, or None for None, NaN and infinities (JSON has no inf)."""
     if value is None:
         return None
     value = float(value)

@@ -441,6 +441,43 @@ def format_sfo(sfo):
     )
 
 
+def format_joint(joint):
+    """The ``<section>`` of a joint SFO's shared soft tissue: its photos and the estimated 3D
+    facial landmarks (each photo's own section shows its overlay and terms).
+
+    Parameters
+    ----------
+    joint : JointRecord
+
+    Returns
+    -------
+    str
+    """
+    weights = joint.weights or (1.0,) * len(joint.photo_ids)
+    parts = " + ".join(
+        f"{w:.3g} &times; {_num(f, '{:.4g}')} ({_e(pid)})"
+        for pid, f, w in zip(joint.photo_ids, joint.photo_fitness, weights, strict=True)
+    )
+    rows = [
+        [str(k), _e(r.name), *(f"{x:.2f}" for x in r.position_mm), _e(", ".join(r.photos))]
+        for k, r in enumerate(joint.landmarks, start=1)
+    ]
+    header = ["#", "facial landmark", "x mm", "y mm", "z mm", "seen in"]
+    status = "" if joint.ok else " <span class='fail'>(a photo has no camera)</span>"
+    return (
+        f"<section><h2>Joint SFO: {_e(joint.method_label)}, skull {_e(joint.skull_id)}, "
+        f"photos {_e(', '.join(joint.photo_ids))}{status}</h2>\n"
+        "<p>One soft tissue shared by every photo, one camera per photo (SPEC section 9). "
+        f"Joint fitness {_num(joint.fitness, '{:.4g}')} = {parts}: each photo's fitness "
+        "weighted by its scale (pixels per mm at the face) so that photos of different sizes "
+        "count alike. Each photo's section below shows its overlay and terms from this soft "
+        "tissue.</p>\n"
+        "<p>Estimated 3D facial landmarks (skull frame, mm):</p>\n"
+        + _table(header, rows, "num")
+        + "</section>\n"
+    )
+
+
 def _skull_view_defs(page):
     """The page's skull-alone pictures, embedded once (each SFO's views refer to them)."""
     unique = {p.key: p for sfo in page.sfos for p in sfo.skull_views}
@@ -473,7 +510,9 @@ def format_report(page):
         skulls=_e(", ".join(page.skull_ids)),
         summary=_table(SUMMARY_HEADER, [_summary_row(s) for s in page.sfos], "num")
         + _summary_notes(page),
-        sections=_skull_view_defs(page) + "\n".join(format_sfo(s) for s in page.sfos),
+        sections=_skull_view_defs(page)
+        + "".join(format_joint(j) for j in page.joints)
+        + "\n".join(format_sfo(s) for s in page.sfos),
         provenance=_table(["", ""], provenance, "kv"),
     )
 
@@ -506,4 +545,11 @@ def write_report(path, entries, **kwargs):
     return path
 
 
-__all__ = ["ReportEntry", "build_report", "format_report", "format_sfo", "write_report"]
+__all__ = [
+    "ReportEntry",
+    "build_report",
+    "format_joint",
+    "format_report",
+    "format_sfo",
+    "write_report",
+]

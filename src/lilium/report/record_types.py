@@ -220,6 +220,55 @@ class SfoRecord:
 
 
 @dataclass(frozen=True)
+class JointLandmarkRow:
+    """One estimated 3D facial landmark of a joint SFO's shared soft tissue.
+
+    Attributes
+    ----------
+    name : str
+        Facial landmark.
+    position_mm : tuple of 3 float
+        Skull frame, millimetres.
+    photos : tuple of str
+        The photos that see it (used it in their fitness).
+    """
+
+    name: str
+    position_mm: tuple
+    photos: tuple
+
+
+@dataclass(frozen=True)
+class JointRecord:
+    """A joint SFO: one soft tissue shared by several photos (SPEC section 9).
+
+    Attributes
+    ----------
+    method_label : str
+    skull_id : str
+    photo_ids : tuple of str
+    fitness : float
+        The joint fitness (sum over the photos).
+    photo_fitness : tuple of float
+        Each photo's own fitness, in ``photo_ids`` order.
+    ok : bool
+        Every photo has a camera.
+    landmarks : tuple of JointLandmarkRow
+    weights : tuple of float
+        Each photo's weight in the joint fitness (:mod:`lilium.methods.joint`).
+    """
+
+    method_label: str
+    skull_id: str
+    photo_ids: tuple
+    fitness: float
+    photo_fitness: tuple
+    ok: bool
+    landmarks: tuple
+    weights: tuple = ()
+
+
+@dataclass(frozen=True)
 class ReportRecord:
     """A report page: its SFOs and the provenance shared by all of them.
 
@@ -233,6 +282,8 @@ class ReportRecord:
     versions : tuple of (str, str)
         Python, platform and package versions.
     sfos : tuple of SfoRecord
+    joints : tuple of JointRecord
+        The joint SFOs (SPEC section 9) whose photos the page shows; empty without any.
     """
 
     title: str
@@ -241,6 +292,7 @@ class ReportRecord:
     skull_ids: tuple
     versions: tuple
     sfos: tuple
+    joints: tuple = ()
 
     @property
     def lilium_version(self):

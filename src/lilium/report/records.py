@@ -19,7 +19,15 @@ from ..geometry.rotations import geodesic_angle_deg, matrix_to_rotvec
 from ..io.provenance import input_files, software_versions
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
 from .pictures import sfo_pictures, skull_view_pictures, skull_views_for, view_box
-from .record_types import CameraFacts, LandmarkRow, ReportRecord, SfoRecord, Summary
+from .record_types import (
+    CameraFacts,
+    JointLandmarkRow,
+    JointRecord,
+    LandmarkRow,
+    ReportRecord,
+    SfoRecord,
+    Summary,
+)
 
 #: Extra run facts of ``SfoResult.extra`` the report lists, in this order.
 RUN_EXTRAS = ("generations", "evaluations", "stop", "fallbacks")
@@ -53,6 +61,9 @@ class ReportEntry:
         Per facial landmark, its source (``"automatic, tracked"``, ...), shown in the table.
     review_href : str
         The review page as a link relative to the report ("" when it lies elsewhere).
+    joint : lilium.methods.joint.JointSfoResult or None
+        The joint SFO (SPEC section 9) that ``result`` is this photo's part of; None for a
+        single-photo SFO. The page then lists the shared soft tissue's 3D facial landmarks.
     """
 
     skull: object
@@ -65,6 +76,7 @@ class ReportEntry:
     landmarks_unreviewed: bool = False
     landmark_tags: dict = field(default_factory=dict)
     review_href: str = ""
+    joint: object = None
 
 
 def _floats(values):
@@ -72,8 +84,10 @@ def _floats(values):
 
 
 def method_label(result):
-    """Method and variant of an SFO, e.g. ``"lilium skof+pll"``."""
-    return result.method + (f" {result.variant}" if result.variant else "")
+    """Method and variant of an SFO, e.g. ``"lilium skof+pll"``; ``"lilium skof+pll joint"``
+    for a photo's part of a joint SFO."""
+    joint = " joint" if result.extra.get("joint_photos") else ""
+    return result.method + (f" {result.variant}" if result.variant else "") + joint
 
 
 def landmark_rows(result, photo):
@@ -329,12 +343,54 @@ def report_record(entries, title=None, command=None, date=None):
     cache, views = {}, {}
     sfos = tuple(sfo_record(e, i, cache, views) for i, e in enumerate(entries, start=1))
     versions = tuple(software_versions().items())
-    return ReportRecord(title, date, command, skull_ids, versions, sfos)
+    joints = tuple(joint_record(j) for j in _unique_joints(entries))
+    return ReportRecord(title, date, command, skull_ids, versions, sfos, joints)
+
+
+def _unique_joints(entries):
+    found = {}
+    for e in entries:
+        if e.joint is not None:
+            found.setdefault(id(e.joint), e.joint)
+    return list(found.values())
+
+
+def joint_record(joint):
+    """The record of a joint SFO's shared soft tissue (the page lists it once).
+
+    Parameters
+    ----------
+    joint : lilium.methods.joint.JointSfoResult
+
+    Returns
+    -------
+    JointRecord
+    """
+    seen = {r.photo_id: set(r.facial_landmarks_mm) for r in joint.photos}
+    rows = tuple(
+        JointLandmarkRow(
+            name=str(name),
+            position_mm=_floats(xyz),
+            photos=tuple(pid for pid, names in seen.items() if name in names),
+        )
+        for name, xyz in joint.facial_landmarks_mm.items()
+    )
+    return JointRecord(
+        method_label=method_label(joint.photos[0]),
+        skull_id=str(joint.skull_id),
+        photo_ids=tuple(str(r.photo_id) for r in joint.photos),
+        fitness=float(joint.fitness),
+        photo_fitness=tuple(float(r.fitness) for r in joint.photos),
+        ok=bool(joint),
+        landmarks=rows,
+        weights=tuple(float(w) for w in joint.weights),
+    )
 
 
 __all__ = [
     "ReportEntry",
     "camera_facts",
+    "joint_record",
     "landmark_rows",
     "method_label",
     "prior_rows",

@@ -1,0 +1,218 @@
+"""Joint SFO against the same photos run independently, on generated Exp. C data (a script).
+
+For every subject of a generated dataset it takes one frontal and one lateral Exp. C photo
+(positive pairs: the subject's own skull, axes set ``--axes-set``) and runs, with the same
+variant and seeds, in one run:
+
+- the two independent Lilium SFOs (``lilium.methods.run_sfo``, one per photo);
+- one joint SFO per design (``lilium.methods.joint.joint_lilium_sfo``): a design is
+  ``WEIGHTING:GENERATIONS_FACTOR`` (``sum:1``, ``scale:1.25``, ...).
+
+It prints, per method: the mean BPE (mm) of the frontal and the lateral photos and of both, the
+failures (no camera), the implausible SFOs (any skull pixel outside the face mask,
+``lilium.evaluation.outside_face``) and their mean % outside, and the time; then each joint
+design's ratios against the independent runs (mean BPE, and time against the two independent
+SFOs together), with the issue's targets (BPE <= 0.9 x, no more failures, time <= 1.25 x).
+
+    python benchmarks/bench_joint.py --subjects 8 --jobs 2
+    python benchmarks/bench_joint.py --dataset DIR --generations 150 --designs sum:1 scale:1
+"""
+
+import argparse
+import statistics
+import tempfile
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from lilium.evaluation import outside_face, score
+from lilium.io.case import read_photo, read_skull
+from lilium.io.jsonio import read_json
+from lilium.io.truth import read_ground_truth
+from lilium.methods import SfoOptions, run_sfo
+from lilium.methods.joint import joint_lilium_sfo
+from lilium.optimisation import DEOptions
+
+#: Issue 16's targets for the joint SFO against the independent ones.
+TARGET_BPE_RATIO = 0.9
+TARGET_TIME_RATIO = 1.25
+
+
+def _one_thread():
+    import os
+
+    import cv2
+
+    os.environ["OMP_NUM_THREADS"] = "1"
+    cv2.setNumThreads(1)
+
+
+def _metrics(result, skull, photo, truth):
+    if not result:
+        return dict(bpe=np.nan, failed=True, implausible=True, pct=np.nan)
+    imp = outside_face(result.camera, skull.vertices_mm, skull.faces, photo.face_mask)
+    return dict(
+        bpe=score(result, truth).bpe_mm,
+        failed=False,
+        implausible=imp.outside_px > 0,
+        pct=imp.percent_outside,
+    )
+
+
+def run_pair(task):
+    """The independent and joint SFOs of one subject's frontal + lateral pair, one seed."""
+    root, subject, photo_ids, axes_set, variant, de, seed, designs = task
+    _one_thread()
+    subject_dir = root / "subjects" / subject
+    skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{axes_set}.json")
+    index = {p["id"]: p for p in read_json(root / "dataset.json")["photos"]}
+    dirs = [root / index[i]["paths"]["C"] for i in photo_ids]
+    photos = [read_photo(d) for d in dirs]
+    truths = [read_ground_truth(d, subject_dir) for d in dirs]
+    options = SfoOptions(variant, de)
+    rows = []
+    for photo, truth in zip(photos, truths, strict=True):
+        t0 = time.perf_counter()
+        result = run_sfo("lilium", skull, photo, options, seed)
+        seconds = time.perf_counter() - t0
+        view = "frontal" if photo.view == "frontal" else "lateral"
+        rows.append(
+            dict(method="independent", subject=subject, seed=seed, view=view, seconds=seconds)
+            | _metrics(result, skull, photo, truth)
+        )
+    for design in designs:
+        weighting, factor = design.split(":")
+        t0 = time.perf_counter()
+        joint = joint_lilium_sfo(
+            skull, photos, options, seed, weighting=weighting, generations_factor=float(factor)
+        )
+        seconds = time.perf_counter() - t0
+        for result, photo, truth in zip(joint.photos, photos, truths, strict=True):
+            view = "frontal" if photo.view == "frontal" else "lateral"
+            rows.append(
+                dict(method=f"joint {design}", subject=subject, seed=seed, view=view)
+                | dict(seconds=seconds / len(photos))  # the pair's time, split evenly
+                | _metrics(result, skull, photo, truth)
+            )
+    return rows
+
+
+def pairs_of(index, n_subjects):
+    """``(subject, (frontal id, lateral id))`` for the first ``n_subjects`` subjects."""
+    out = []
+    for subject in index["subjects"][:n_subjects]:
+        mine = [p for p in index["photos"] if p["subject"] == subject["id"] and "C" in p["paths"]]
+        frontal = [p["id"] for p in mine if p["view"] == "frontal"]
+        lateral = [p["id"] for p in mine if p["view"] != "frontal"]
+        if frontal and lateral:
+            out.append((subject["id"], (frontal[0], lateral[0])))
+    return out
+
+
+def _mean(values):
+    values = [v for v in values if np.isfinite(v)]
+    return statistics.fmean(values) if values else float("nan")
+
+
+def summarise(rows, designs):
+    methods = ["independent"] + [f"joint {d}" for d in designs]
+    print(
+        f"{'method':<20} {'BPE front':>9} {'BPE lat':>8} {'BPE both':>8} {'fail':>5} "
+        f"{'impl %':>7} {'% out':>6} {'s/pair':>7}"
+    )
+    stats = {}
+    for m in methods:
+        mine = [r for r in rows if r["method"] == m]
+        front = [r["bpe"] for r in mine if r["view"] == "frontal"]
+        lat = [r["bpe"] for r in mine if r["view"] == "lateral"]
+        n_pairs = len(mine) / 2
+        s = dict(
+            front=_mean(front),
+            lat=_mean(lat),
+            both=_mean(front + lat),
+            fail=sum(r["failed"] for r in mine),
+            impl=100.0 * sum(r["implausible"] for r in mine) / max(len(mine), 1),
+            pct=_mean([r["pct"] for r in mine if r["implausible"] and not r["failed"]]),
+            seconds=sum(r["seconds"] for r in mine) / max(n_pairs, 1),
+        )
+        stats[m] = s
+        print(
+            f"{m:<20} {s['front']:9.3f} {s['lat']:8.3f} {s['both']:8.3f} {s['fail']:5d} "
+            f"{s['impl']:7.1f} {s['pct']:6.2f} {s['seconds']:7.2f}"
+        )
+    base = stats["independent"]
+    print(
+        f"\nagainst independent (targets: BPE <= {TARGET_BPE_RATIO} x, no more failures, time "
+        f"<= {TARGET_TIME_RATIO} x the two SFOs together); per-pair wins = joint mean BPE of the "
+        "pair lower"
+    )
+    for m in methods[1:]:
+        s = stats[m]
+        wins = 0
+        keys = {(r["subject"], r["seed"]) for r in rows if r["method"] == m}
+        for key in keys:
+
+            def pair_bpe(method, key=key):
+                return _mean(
+                    [
+                        r["bpe"]
+                        for r in rows
+                        if r["method"] == method and (r["subject"], r["seed"]) == key
+                    ]
+                )
+
+            wins += pair_bpe(m) < pair_bpe("independent")
+        print(
+            f"{m:<20} BPE x{s['both'] / base['both']:.3f} "
+            f"(frontal x{s['front'] / base['front']:.3f}, lateral x{s['lat'] / base['lat']:.3f}), "
+            f"failures {s['fail']} vs {base['fail']}, "
+            f"time x{s['seconds'] / base['seconds']:.3f}, pairs better {wins}/{len(keys)}"
+        )
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--dataset", type=Path, help="existing dataset folder (default: generate)")
+    p.add_argument("--subjects", type=int, default=8)
+    p.add_argument("--axes-set", type=int, default=1, help="Exp. C perturbed axes set")
+    p.add_argument("--variant", default="skof+pll")
+    p.add_argument("--seeds", type=int, nargs="+", default=[1])
+    p.add_argument("--generations", type=int, default=DEOptions().max_generations)
+    p.add_argument("--population", type=int, default=DEOptions().population_size)
+    p.add_argument("--designs", nargs="+", default=["sum:1"], help="WEIGHTING:GENERATIONS_FACTOR")
+    p.add_argument("--jobs", type=int, default=1)
+    args = p.parse_args(argv)
+    root = args.dataset
+    if root is None:
+        from lilium.synthetic.dataset import generate_dataset
+
+        root = Path(tempfile.mkdtemp(prefix="bench_joint_"))
+        generate_dataset(root, args.subjects, 1, seed=0, experiments=("C",), workers=args.jobs)
+    index = read_json(root / "dataset.json")
+    de = DEOptions(
+        population_size=args.population, max_generations=args.generations, max_seconds=None
+    )
+    tasks = [
+        (root, subject, ids, args.axes_set, args.variant, de, seed, args.designs)
+        for subject, ids in pairs_of(index, args.subjects)
+        for seed in args.seeds
+    ]
+    print(
+        f"{len(tasks)} pairs ({args.subjects} subjects x {len(args.seeds)} seed(s)), Lilium "
+        f"{args.variant}, DE {args.population} x {args.generations}, axes C{args.axes_set}, "
+        f"{args.jobs} job(s)"
+    )
+    t0 = time.perf_counter()
+    if args.jobs > 1:
+        with ProcessPoolExecutor(args.jobs) as pool:
+            rows = [r for pair in pool.map(run_pair, tasks) for r in pair]
+    else:
+        rows = [r for task in tasks for r in run_pair(task)]
+    summarise(rows, args.designs)
+    print(f"\n{time.perf_counter() - t0:.0f} s in all")
+
+
+if __name__ == "__main__":
+    main()

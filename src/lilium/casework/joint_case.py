@@ -1,0 +1,107 @@
+"""The ``--joint`` path of a user's case (``lilium case --joint``, SPEC section 9).
+
+Each method that has a joint form (Lilium) runs once for all the photos of the person: one soft
+tissue shared by the photos, one camera each. Its outputs go to ``<out>/joint/<method tag>/``:
+``result.json`` (``"joint": true``, a ``photos`` list) and ``overlay_<photo id>.png`` per photo.
+Methods without a joint form (POSEST-SFO) run per photo as without ``--joint``.
+"""
+
+from pathlib import Path
+
+from ..methods.registry import METHODS, method_tag, run_joint_sfo
+from .folders import check_distinct_photos, joint_overlay_name, write_joint_result
+
+#: Folder of the joint SFOs in a case's output folder.
+JOINT_FOLDER = "joint"
+
+
+def check_joint_case(photos, methods):
+    """Refuse a ``--joint`` case that cannot run, before any file is read.
+
+    Raises
+    ------
+    ValueError
+        Fewer than two photos, a photo given twice, no method with a joint form among
+        ``methods``.
+    """
+    if len(photos) < 2:
+        raise ValueError(
+            f"--joint needs two or more --photo of the same person, got {len(photos)}; drop "
+            "--joint for one photo"
+        )
+    check_distinct_photos(photos)
+    if not any(METHODS[m].run_joint is not None for m in methods):
+        joint = [name for name, m in METHODS.items() if m.run_joint is not None]
+        raise ValueError(
+            f"--joint: none of the methods ({', '.join(methods)}) has a joint SFO; add --method "
+            f"{' or --method '.join(joint)}"
+        )
+
+
+def run_joint_methods(skull, records, methods, options, seed, out, log=print):
+    """Run every joint-capable method of ``methods`` once on all the photos; write each.
+
+    Parameters
+    ----------
+    skull : Skull
+    records : list of (Photo, dict, dict)
+        From :func:`~lilium.casework.inputs.load_photos`.
+    methods : sequence of str
+    options : SfoOptions
+    seed : int
+    out : Path
+        The case's output folder.
+    log : callable
+
+    Returns
+    -------
+    dict of str -> (JointSfoResult, Path)
+        Per joint method, its result and its output folder.
+
+    Raises
+    ------
+    ValueError
+        A photo id ``joint`` (it would share the joint folder's name).
+    """
+    photos = [record.photo for record in records]
+    if any(p.id == JOINT_FOLDER for p in photos):
+        raise ValueError(
+            f"--joint: a photo is named {JOINT_FOLDER!r}, the name of the joint results' folder; "
+            "rename the photo (folder or image)"
+        )
+    done = {}
+    for method in methods:
+        if METHODS[method].run_joint is None:
+            continue
+        result = run_joint_sfo(method, skull, photos, options, seed)
+        folder = Path(out) / JOINT_FOLDER / method_tag(method, options.variant)
+        write_joint_result(folder, result, skull, photos)
+        name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
+        log(
+            f"joint ({', '.join(p.id for p in photos)}): {name}: score {result.fitness:.4g}, "
+            f"{result.seconds:.2f} s -> {folder}"
+        )
+        for single in result.photos:
+            status = (
+                f"focal {single.camera.focal_px:.0f} px, score {single.fitness:.4g}"
+                if single
+                else f"FAILED ({single.error})"
+            )
+            off = f", off: {', '.join(single.terms_off)}" if single.terms_off else ""
+            log(f"  {single.photo_id}: {status}{off}")
+            for warning in single.warnings:
+                log(f"  warning {warning.code}: {warning.message}")
+        done[method] = (result, folder)
+    return done
+
+
+def joint_entry(joint_run, k, skull, photo, inputs, notes, out):
+    """The report entry of photo ``k`` of a joint SFO ``joint_run = (result, folder)``."""
+    from ..report.html import ReportEntry
+
+    result, folder = joint_run
+    rel = folder.relative_to(out).as_posix()
+    outputs = {"result.json (joint)": f"{rel}/result.json"}
+    if (folder / joint_overlay_name(photo.id)).is_file():
+        outputs["overlay.png"] = f"{rel}/{joint_overlay_name(photo.id)}"
+    return ReportEntry(skull, photo, result.photos[k], inputs, notes, outputs, joint=result)

@@ -1,0 +1,390 @@
+"""Joint Lilium: one soft tissue shared by every photo of a person (SPEC section 9).
+
+One DE genotype (the soft tissue) for all photos, one camera per photo. The genes are defined
+over the *union* of the cranial landmarks any photo uses (in the order of
+:data:`~lilium.softtissue.landmarks.CRANIAL_TO_FACIAL`, the bilateral hybrid over the union's
+twins), decoded once per member; each photo uses the rows of its own visible landmarks. Each
+photo keeps its own :class:`~lilium.methods.lilium.LiliumProblem` (its correspondences, priors,
+focal cap, P_skof and P_pll, terms switched off): the joint problem calls its two halves,
+:meth:`~LiliumProblem.camera_terms` then :meth:`~LiliumProblem.add_image_terms`, with that
+photo's rows of the shared facial landmarks.
+
+Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``):
+
+- **Camera chains.** The DE payload holds one camera per photo per member (arrays of shape
+  ``(S, P, ...)``); photo ``p``'s trial camera is warm-started from photo ``p``'s camera of the
+  member it competes with, so each photo has its own chain, as in a single SFO. The initial
+  population gets one POSEST per photo.
+- **Fitness.** ``sum_p w_p fitness_p`` with each photo's fitness as in a single SFO (MSE_pix,
+  P_cam, P_skof, P_pll with its camera, mask, curve and priors). ``weighting="scale"`` (the
+  default, :data:`DEFAULT_WEIGHTING`): ``w_p = (k / k_p)^2`` with ``k_p`` the photo's pixels
+  per millimetre at the face (:func:`photo_scale_px_per_mm`) and ``k`` their geometric mean,
+  so the sum is in the same units for every photo: a photo whose face is twice as large in
+  pixels (MSE_pix and P_skof four times larger for the same error in mm) does not weigh four
+  times as much. Equal-scale photos get ``w_p = 1``, the plain sum; ``weighting="sum"`` is
+  the plain sum always. ``result.json`` gives each photo's own (unweighted) fitness and its
+  ``weight``; the total is the weighted sum DE ranked.
+- **Early exit.** A trial's image penalties of photo ``p`` are skipped when the partial sum
+  over all photos already exceeds its threshold (the other photos' partial sums are the
+  offset): the run is the same, with fewer P_skof/P_pll evaluations.
+- **Budget.** ``generations_factor`` scales the DE generations (default 1: one generation of
+  the joint costs about the sum of the photos' single generations). The wall-clock limit
+  (``options.de.max_seconds``) bounds the joint run as a whole.
+"""
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..optimisation.de import DifferentialEvolution
+from ..softtissue.cones import decode
+from ..softtissue.landmarks import CRANIAL_TO_FACIAL
+from .lilium import LiliumProblem, build_cones, photo_outcome
+from .options import SfoOptions
+from .result import SfoResult, finite_or_none
+
+#: How the photos' fitnesses are summed (see the module notes).
+WEIGHTINGS = ("sum", "scale")
+
+#: The default weighting and DE budget factor, chosen by ``benchmarks/bench_joint.py`` (8
+#: generated Exp. C frontal + lateral pairs, DE 30 x 750, skof+pll; docs/method.md): mean BPE
+#: against the independent SFOs x0.917 with ``sum``, x0.867 with ``scale``, x0.857 with
+#: ``scale`` and 1.25 x the generations (time x0.70, x0.82, x1.11 of the two SFOs together).
+DEFAULT_WEIGHTING = "scale"
+DEFAULT_GENERATIONS_FACTOR = 1.0
+
+#: Per-photo arrays of the DE payload, shape ``(S, P, ...)``.
+PHOTO_KEYS = ("fitness", "mse_pix", "p_cam", "p_skof", "p_pll", "R", "t", "focal_px", "success")
+
+
+@dataclass(frozen=True)
+class _Union:
+    """The cranial landmarks any photo uses (what :func:`build_cones` needs)."""
+
+    cranial_names: tuple
+    axes: np.ndarray
+    cranial_mm: np.ndarray
+
+
+def photo_scale_px_per_mm(corr):
+    """Pixels per millimetre of a photo at the face: the RMS spread of its 2D landmarks (px)
+    over the RMS spread of their cranial landmarks (mm), both about their centroids.
+
+    Parameters
+    ----------
+    corr : Correspondences
+
+    Returns
+    -------
+    float
+    """
+    uv = corr.uv_px - corr.uv_px.mean(axis=0)
+    xyz = corr.cranial_mm - corr.cranial_mm.mean(axis=0)
+    return float(np.sqrt(np.mean(np.sum(uv**2, axis=1)) / np.mean(np.sum(xyz**2, axis=1))))
+
+
+class JointLiliumProblem:
+    """Fitness of a population of shared genotypes for one skull and several photos.
+
+    ``(S, D) -> (S,)`` with a payload of one camera (and the terms) per photo per member.
+
+    Parameters
+    ----------
+    skull : Skull
+    photos : sequence of Photo
+        Two or more, with distinct ids.
+    options : SfoOptions
+    rng : seed or numpy Generator
+        For the RANSAC of the initial and fallback POSEST runs (shared by the photos).
+    weighting : {"sum", "scale"}
+
+    Raises
+    ------
+    ValueError
+        Fewer than two photos, repeated photo ids, an unknown weighting, or what a single
+        :class:`LiliumProblem` refuses (an unknown variant, too few landmarks in a photo).
+    """
+
+    def __init__(self, skull, photos, options=SfoOptions(), rng=0, weighting=DEFAULT_WEIGHTING):
+        photos = list(photos)
+        if len(photos) < 2:
+            raise ValueError(f"a joint SFO needs two or more photos, got {len(photos)}")
+        ids = [p.id for p in photos]
+        if len(set(ids)) != len(ids):
+            raise ValueError(
+                f"photo ids repeat in the joint SFO ({', '.join(ids)}); give each photo once"
+            )
+        if weighting not in WEIGHTINGS:
+            raise ValueError(f"unknown weighting {weighting!r}; use one of {', '.join(WEIGHTINGS)}")
+        self.rng = np.random.default_rng(rng)
+        self.skull, self.photos, self.options = skull, photos, options
+        self.problems = [LiliumProblem(skull, p, options, rng=self.rng) for p in photos]
+        used = set().union(*(pr.corr.cranial_names for pr in self.problems))
+        names = tuple(c for c in CRANIAL_TO_FACIAL if c in used)
+        self.union = _Union(
+            names,
+            np.array([skull.axes[c] for c in names], dtype=float),
+            np.array([skull.landmarks_mm[c] for c in names], dtype=float),
+        )
+        self.facial_names = tuple(CRANIAL_TO_FACIAL[c] for c in names)
+        self.cones = build_cones(skull, self.union, options.depth_table)
+        self.periodic = np.tile([False, False, True], len(names))
+        self.rows = [
+            np.array([names.index(c) for c in pr.corr.cranial_names]) for pr in self.problems
+        ]
+        scale = np.array([photo_scale_px_per_mm(pr.corr) for pr in self.problems])
+        if weighting == "scale":
+            self.weights = np.exp(np.mean(np.log(scale))) ** 2 / scale**2
+        else:
+            self.weights = np.ones(len(photos))
+        self.scale_px_per_mm = scale
+
+    @property
+    def n_genes(self):
+        return self.cones.n_genes
+
+    def facial_landmarks(self, genes):
+        """Shared facial 3D landmarks ``(S, U, 3)`` of a population ``(S, 3U)`` (the union)."""
+        return self.union.cranial_mm + decode(np.atleast_2d(genes), self.cones)
+
+    def evaluate(self, genes, members=None, thresholds=None):
+        """Every photo's terms for a population, and the weighted sum.
+
+        Parameters
+        ----------
+        genes : ndarray of shape (S, 3U)
+        members : dict or None
+            Payload of the members the trials compete with; None = initial population.
+        thresholds : ndarray of shape (S,), optional
+            As in :meth:`LiliumProblem.evaluate`, on the joint fitness.
+
+        Returns
+        -------
+        dict of str -> ndarray
+            ``fitness`` (S,) the joint fitness; per photo (axis 1, in photo order)
+            ``photo_fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (S, P),
+            ``success`` (S, P), cameras ``R`` (S, P, 3, 3), ``t`` (S, P, 3), ``focal_px`` (S, P).
+        """
+        facial = self.facial_landmarks(genes)
+        per = []
+        for p, problem in enumerate(self.problems):
+            mine = None
+            if members is not None:
+                mine = {k: np.asarray(members[k])[:, p] for k in ("R", "t", "focal_px", "success")}
+            per.append(problem.camera_terms(facial[:, self.rows[p]], mine))
+        w = self.weights
+        # Fitnesses of hopeless trials reach 1e60 and more (P_cam of a run-off camera); their
+        # weighted sums may overflow to inf, which ranks them last as it should.
+        with np.errstate(over="ignore", invalid="ignore"):
+            partial = np.array([w[p] * per[p]["fitness"] for p in range(len(per))])
+            for p, problem in enumerate(self.problems):
+                offset = np.delete(partial, p, axis=0).sum(axis=0)  # the other photos' bounds
+                problem.add_image_terms(per[p], thresholds, offset, w[p])
+                partial[p] = w[p] * per[p]["fitness"]
+            total = partial.sum(axis=0)
+        out = {k: np.stack([t[k] for t in per], axis=1) for k in PHOTO_KEYS}
+        out["photo_fitness"] = out.pop("fitness")
+        out["fitness"] = total
+        return out
+
+    def __call__(self, genes, members=None, thresholds=None):
+        """DE's objective: ``(fitness (S,), payload)``."""
+        terms = self.evaluate(genes, members, thresholds)
+        return terms["fitness"], terms
+
+
+@dataclass(frozen=True)
+class JointSfoResult:
+    """Outcome of a joint SFO: one shared soft tissue, one :class:`SfoResult` per photo.
+
+    Falsy when any photo has no camera.
+
+    Attributes
+    ----------
+    method, variant : str
+    seed : int
+    skull_id : str
+    photos : tuple of SfoResult
+        Per photo (in the order given): its camera, its own fitness (unweighted) and terms,
+        ``terms_off``, error and warnings; its ``facial_landmarks_mm`` are the shared ones it
+        sees (its landmarks), so every per-photo tool (overlay, BPE, landmark error, report)
+        takes it. Its ``seconds`` are the joint run's, its ``extra`` says it is part of a joint
+        SFO: ``joint_photos`` (the ids), ``joint_fitness``, and the joint ``history``,
+        ``generations``, ``evaluations``, ``stop``.
+    fitness : float
+        The joint fitness DE ranked (``sum_p w_p fitness_p``; equals ``history[-1]``).
+    facial_landmarks_mm : dict of str -> ndarray of shape (3,)
+        The shared soft tissue's facial landmarks (the union of the photos'), skull frame.
+    seconds : float
+    weights : tuple of float
+        ``w_p`` of each photo (all 1 for ``weighting="sum"``).
+    extra : dict
+        ``history``, ``generations``, ``evaluations``, ``stop``, ``genes``, ``fallbacks``,
+        ``weighting``.
+    """
+
+    method: str
+    variant: str
+    seed: int
+    skull_id: str
+    photos: tuple
+    fitness: float
+    facial_landmarks_mm: dict
+    seconds: float
+    weights: tuple = ()
+    extra: dict = field(default_factory=dict)
+
+    def __bool__(self):
+        return all(bool(r) for r in self.photos)
+
+    @property
+    def joint(self):
+        return True
+
+    @property
+    def error(self):
+        """The photos' errors, ``"<photo>: <error>"`` joined ("" when every photo has a camera)."""
+        return "; ".join(f"{r.photo_id}: {r.error}" for r in self.photos if r.error)
+
+    @property
+    def warnings(self):
+        """Every photo's warnings, in photo order."""
+        return tuple(w for r in self.photos for w in r.warnings)
+
+    def to_dict(self):
+        """The ``result.json`` dictionary of SPEC section 9.
+
+        Each photo's ``fitness`` is its share of the total, ``weight x`` its own fitness, so
+        that the total is the sum of the photos' fitnesses as SPEC section 9 states; its own
+        (unweighted) fitness, the sum of its ``terms``, is ``fitness_unweighted``.
+        """
+        photos = []
+        for r, w in zip(self.photos, self.weights, strict=True):
+            d = r.to_dict()
+            own = d["fitness"]
+            share = None if own is None else float(w) * own
+            entry = {"photo": d["photo"], "camera": d["camera"], "fitness": share}
+            entry["fitness_unweighted"] = own
+            entry["terms"] = d["terms"]
+            entry["terms_off"] = d.get("terms_off", {})
+            if r.error:
+                entry["error"] = r.error
+            entry["weight"] = float(w)
+            for key in ("landmark_error", "warnings", "priors"):
+                if key in d:
+                    entry[key] = d[key]
+            photos.append(entry)
+        out = {
+            "method": self.method,
+            "variant": self.variant,
+            "seed": self.seed,
+            "subject": self.skull_id,
+            "joint": True,
+            "photos": photos,
+            "fitness": finite_or_none(self.fitness),
+            "facial_landmarks_3d": {
+                k: [float(x) for x in v] for k, v in self.facial_landmarks_mm.items()
+            },
+            "seconds": float(self.seconds),
+        }
+        if self.error:
+            out["error"] = self.error
+        out.update(self.extra)
+        return out
+
+
+def joint_lilium_sfo(
+    skull,
+    photos,
+    options=SfoOptions(),
+    seed=0,
+    weighting=DEFAULT_WEIGHTING,
+    generations_factor=DEFAULT_GENERATIONS_FACTOR,
+):
+    """Run one joint Lilium SFO of a skull against several photos of one person.
+
+    Parameters
+    ----------
+    skull : Skull
+    photos : sequence of Photo
+        Two or more, distinct ids.
+    options : SfoOptions
+        The variant and DE settings (the same for every photo).
+    seed : int
+        Seeds DE and the RANSAC of the POSEST calls: the same seed gives the same result.
+    weighting : {"sum", "scale"}
+        How the photos' fitnesses are summed (module notes).
+    generations_factor : float
+        DE generations = ``round(factor x options.de.max_generations)``.
+
+    Returns
+    -------
+    JointSfoResult
+        Per photo as :func:`~lilium.methods.lilium.lilium_sfo` reports one SFO (without the
+        warnings, priors and landmark error that :func:`lilium.methods.run_joint_sfo` adds).
+    """
+    start = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    problem = JointLiliumProblem(skull, photos, options, rng=rng, weighting=weighting)
+    de_options = options.de
+    if generations_factor != 1.0:
+        generations = max(1, round(generations_factor * de_options.max_generations))
+        de_options = replace(de_options, max_generations=generations)
+    solver = DifferentialEvolution(problem, problem.n_genes, problem.periodic, de_options, rng=rng)
+    de = solver.solve()
+    best = de.payload
+    shared = problem.facial_landmarks(de.x)[0]
+    results = []
+    for p, single in enumerate(problem.problems):
+        mine = {k: np.asarray(best[k])[p] for k in PHOTO_KEYS if k != "fitness"}
+        camera, terms, error, warnings = photo_outcome(single, mine, seed)
+        rows = problem.rows[p]
+        results.append(
+            SfoResult(
+                method="lilium",
+                variant=options.variant,
+                seed=seed,
+                skull_id=skull.id,
+                photo_id=single.photo.id,
+                camera=camera,
+                fitness=float(np.asarray(best["photo_fitness"])[p]),
+                terms=terms,
+                facial_landmarks_mm=dict(zip(single.corr.facial_names, shared[rows], strict=True)),
+                seconds=0.0,  # the joint run's, below
+                error=error,
+                warnings=warnings,
+                terms_off=dict(single.terms_off),
+            )
+        )
+    seconds = time.perf_counter() - start
+    ids = [r.photo_id for r in results]
+    shared_extra = {
+        "joint_photos": ids,
+        "joint_fitness": de.fun,
+        "history": de.history.tolist(),
+        "generations": de.nit,
+        "evaluations": de.nfev,
+        "stop": de.message,
+    }
+    results = [replace(r, seconds=seconds, extra=dict(shared_extra)) for r in results]
+    return JointSfoResult(
+        method="lilium",
+        variant=options.variant,
+        seed=seed,
+        skull_id=skull.id,
+        photos=tuple(results),
+        fitness=de.fun,
+        facial_landmarks_mm=dict(zip(problem.facial_names, shared, strict=True)),
+        seconds=seconds,
+        weights=tuple(float(w) for w in problem.weights),
+        extra={
+            "history": de.history.tolist(),
+            "generations": de.nit,
+            "evaluations": de.nfev,
+            "stop": de.message,
+            "genes": de.x.tolist(),
+            "fallbacks": sum(pr.n_fallbacks for pr in problem.problems),
+            "weighting": weighting,
+        },
+    )
