@@ -165,3 +165,92 @@ def boundary_kernel(u, v, corners, face_edges, face_dirs, edges_a, edges_b, lo, 
                     total += 1
                     break
     return out_member[:total].copy(), out[:total].copy()
+
+
+@njit
+def windows_kernel(u, v, height, width, max_window):
+    """:func:`lilium.fitness.curves._windows` (``height`` < 0: no image to clip to).
+
+    Returns ``lo``, ``hi`` (S, 2) of int64, ``empty`` and ``clipped`` (S,) of bool.
+    """
+    S, K = u.shape
+    lo = np.zeros((S, 2), np.int64)
+    hi = np.ones((S, 2), np.int64)
+    empty = np.ones(S, np.bool_)
+    clipped = np.zeros(S, np.bool_)
+    for m in range(S):
+        u_lo, v_lo, u_hi, v_hi = np.inf, np.inf, -np.inf, -np.inf
+        for k in range(K):
+            x, y = u[m, k], v[m, k]
+            if np.isfinite(x) and np.isfinite(y):
+                empty[m] = False
+                u_lo, u_hi = min(u_lo, x), max(u_hi, x)
+                v_lo, v_hi = min(v_lo, y), max(v_hi, y)
+        if empty[m]:
+            continue
+        box0, box1 = np.int64(np.floor(u_lo)), np.int64(np.floor(v_lo))
+        box2, box3 = np.int64(np.ceil(u_hi) + 1), np.int64(np.ceil(v_hi) + 1)
+        a0, a1, b0, b1 = box0, box1, box2, box3
+        if height >= 0:
+            a0, a1 = max(a0, -width), max(a1, -height)
+            b0, b1 = min(b0, 2 * width), min(b1, 2 * height)
+        b0, b1 = min(b0, a0 + max_window), min(b1, a1 + max_window)
+        lo[m, 0], lo[m, 1], hi[m, 0], hi[m, 1] = a0, a1, b0, b1
+        empty[m] = b0 <= a0 or b1 <= a1
+        changed = a0 != box0 or a1 != box1 or b0 != box2 or b1 != box3
+        clipped[m] = changed and not empty[m]
+    return lo, hi, empty, clipped
+
+
+@njit
+def span_join_kernel(member, points, span_v, has_span, S):
+    """:func:`lilium.fitness.curves._span_and_join` of the boundary pixels ``points`` (N, 2)
+    (integer-valued) of members ``member`` (N,), sorted: the span filter (``span_v`` (S, 2),
+    when ``has_span``), then :func:`~lilium.fitness.curves.join_fragments_batch`.
+
+    Returns the joined points ``(N', 2)`` and their offsets ``(S + 1,)``.
+    """
+    N = points.shape[0]
+    keep = np.ones(N, np.bool_)
+    if has_span:
+        for i in range(N):
+            a, b = span_v[member[i], 0], span_v[member[i], 1]
+            y = points[i, 1]
+            keep[i] = y >= np.minimum(a, b) and y <= np.maximum(a, b)
+    idx = np.flatnonzero(keep)
+    p = points[idx]
+    mem = member[idx]
+    n = p.shape[0]
+    offset = np.searchsorted(mem, np.arange(S + 1))
+    if n == 0:
+        return np.zeros((0, 2)), np.zeros_like(offset)
+    # Steps between consecutive points: the last point of a member emits itself alone.
+    is_last = np.zeros(n, np.bool_)
+    for m in range(1, S):
+        if 0 < offset[m] <= n - 1:
+            is_last[offset[m] - 1] = True
+    first = np.zeros(n, np.int64)  # output position of every input point
+    total = 0
+    for i in range(n - 1):
+        first[i] = total
+        if is_last[i]:
+            total += 1
+        else:
+            total += np.int64(max(abs(p[i + 1, 0] - p[i, 0]), abs(p[i + 1, 1] - p[i, 1])))
+    first[n - 1] = total
+    out = np.empty((total + 1, 2))
+    for i in range(n - 1):
+        if is_last[i]:
+            out[first[i], 0], out[first[i], 1] = np.rint(p[i, 0]), np.rint(p[i, 1])
+            continue
+        du, dv = p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1]
+        steps = first[i + 1] - first[i]
+        for k in range(steps):
+            t = k / steps
+            out[first[i] + k, 0] = np.rint(p[i, 0] + t * du)
+            out[first[i] + k, 1] = np.rint(p[i, 1] + t * dv)
+    out[total, 0], out[total, 1] = p[n - 1, 0], p[n - 1, 1]
+    new_offset = np.empty(S + 1, np.int64)
+    for m in range(S + 1):
+        new_offset[m] = first[offset[m]] if offset[m] < n else total + 1
+    return out, new_offset

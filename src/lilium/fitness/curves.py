@@ -30,7 +30,7 @@ import numpy as np
 from .. import jit
 from ..constants import VIEWS
 from ..imaging.raster import scan_crossings, winding_intervals
-from ._curve_kernels import VIEW_CODES, boundary_kernel
+from ._curve_kernels import VIEW_CODES, boundary_kernel, span_join_kernel, windows_kernel
 
 #: Largest side (pixels) of the window a region is rasterised in; beyond, it is clipped.
 MAX_WINDOW_PX = 8192
@@ -271,6 +271,10 @@ def _windows(uv, image_shape):
         The window was clipped: its raster is scanned on its own (crossings outside it).
     """
     u, v = uv[..., 0], uv[..., 1]
+    if jit.compiled():
+        height, width = (-1, -1) if image_shape is None else image_shape
+        u, v = np.ascontiguousarray(u), np.ascontiguousarray(v)
+        return windows_kernel(u, v, int(height), int(width), MAX_WINDOW_PX)
     finite = np.isfinite(u) & np.isfinite(v)
     empty = ~finite.any(axis=1)
     lo = np.stack([np.where(finite, x, np.inf).min(axis=1) for x in (u, v)], axis=1)
@@ -520,6 +524,16 @@ def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
 
 def _span_and_join(member, points, span_v, S):
     """Boundary pixels ``(N, 2)`` of members ``(N,)``: span filter, then joined fragments."""
+    if jit.compiled():
+        has_span = span_v is not None
+        span = (
+            np.ascontiguousarray(np.reshape(span_v, (S, 2)), float)
+            if has_span
+            else np.zeros((S, 2))
+        )
+        member = np.ascontiguousarray(member, np.int64)
+        points = np.ascontiguousarray(points, dtype=float).reshape(-1, 2)
+        return CurveBatch(*span_join_kernel(member, points, span, has_span, S))
     if span_v is not None and len(points):
         span_v = np.asarray(span_v, dtype=float).reshape(S, 2)
         a, b = span_v[member, 0], span_v[member, 1]

@@ -43,8 +43,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import jit
 from ..constants import C_INF
 from ..imaging.raster import mesh_edge_topology
+from ._pll_kernels import SIDE_CODES, pair_kernel, terms_kernel, trim_kernel
 from .curves import CurveBatch, check_view, detect_curves_batch, refine_curve
 
 #: Fraction of a curve's length whose mean tangent defines its end normal (SPEC: 20 %).
@@ -259,11 +261,15 @@ def trim_curves_batch(curves, face_index):
     face_lo, face_hi : ndarray of shape (S,) of int64
         Member ``m``'s trimmed facial curve is ``face_index.curve[face_lo[m] : face_hi[m]]``.
     """
-    P = curves.points
-    offset = np.asarray(curves.offset, np.int64)
+    P = np.ascontiguousarray(curves.points, dtype=float)
+    offset = np.ascontiguousarray(curves.offset, np.int64)
+    face = np.ascontiguousarray(face_index.curve, dtype=float)
+    if jit.compiled():
+        ends = np.zeros((4, 2)) if face_index.ends is None else np.array(face_index.ends, float)
+        points, kept, lo, hi = trim_kernel(P, offset, face, ends, face_index.ends is not None)
+        return CurveBatch(points, kept), lo, hi
     S = len(offset) - 1
     n = np.diff(offset)
-    face = face_index.curve
     M = len(face)
     head_s, tail_s = np.zeros(S, np.int64), np.zeros(S, np.int64)
     face_lo, face_hi = np.zeros(S, np.int64), np.full(S, M, np.int64)
@@ -334,14 +340,19 @@ def pair_curves_batch(skull, face_index, face_lo=None, face_hi=None):
     -------
     PairBatch
     """
-    P = skull.points
-    offset = np.asarray(skull.offset, np.int64)
+    P = np.ascontiguousarray(skull.points, dtype=float)
+    offset = np.ascontiguousarray(skull.offset, np.int64)
     S = len(offset) - 1
     n = np.diff(offset)
-    face = face_index.curve
+    face = np.ascontiguousarray(face_index.curve, dtype=float)
     M = len(face)
     face_lo = np.zeros(S, np.int64) if face_lo is None else np.asarray(face_lo, np.int64)
     face_hi = np.full(S, M, np.int64) if face_hi is None else np.asarray(face_hi, np.int64)
+    if jit.compiled():
+        u0, v0 = face_index.origin
+        table = np.ascontiguousarray(face_index.table, np.int64)
+        lo, hi = np.ascontiguousarray(face_lo), np.ascontiguousarray(face_hi)
+        return PairBatch(*pair_kernel(P, offset, face, lo, hi, table, int(u0), int(v0)))
     if M == 0 or not n.any():
         return PairBatch(np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(S + 1, np.int64))
     member = np.repeat(np.arange(S), n)
@@ -447,7 +458,12 @@ def wrong_side(skull, face, view):
 
 def terms_from_pairs(pairs, view):
     """:class:`PllTerms` of every member, fields of shape (S,), from its pairs (step 3)."""
-    offset = np.asarray(pairs.offset, np.int64)
+    offset = np.ascontiguousarray(pairs.offset, np.int64)
+    if jit.compiled():
+        skull, face = (np.ascontiguousarray(x, dtype=float) for x in (pairs.skull, pairs.face))
+        distance = np.ascontiguousarray(pairs.distance, dtype=float)
+        side = SIDE_CODES[check_view(view)]
+        return PllTerms(*terms_kernel(skull, face, distance, offset, side, PLL_NO_CURVE))
     S = len(offset) - 1
     terms = _failed(S)
     count = np.diff(offset)
