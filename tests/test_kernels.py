@@ -281,3 +281,24 @@ def test_pll_kernels_give_the_numpy_trims_pairs_and_terms(view):
     assert ((lo > 0) | (hi < len(index.curve))).any()
     assert np.isnan(terms.delta_d).sum() == 1 and (terms.p_int > 0).any()
     assert (terms.p_conv > 0).any()
+
+
+@needs_numba
+def test_distance_to_background_is_scipys_exactly():
+    """The compiled distance transform of the face mask index is scipy's EDT, exactly."""
+    from scipy import ndimage
+
+    from lilium.fitness._skof_kernels import squared_distance_to_background
+    from lilium.fitness.skof import face_mask_index
+
+    rng = np.random.default_rng(12)
+    masks = [rng.random((31, 47)) > p for p in (0.002, 0.05, 0.6)] + [face_mask()]
+    masks.append(np.ones((5, 6), bool))
+    for mask in masks:
+        got = np.sqrt(squared_distance_to_background(mask))
+        want = ndimage.distance_transform_edt(mask) if not mask.all() else np.inf
+        np.testing.assert_array_equal(got, np.broadcast_to(want, mask.shape))
+    compiled = face_mask_index(face_mask())
+    with jit.kernels("numpy"):
+        reference = face_mask_index(face_mask())
+    np.testing.assert_array_equal(compiled.clearance2, reference.clearance2)

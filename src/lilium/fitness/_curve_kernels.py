@@ -12,7 +12,7 @@ equals the numpy path's exactly.
 
 import numpy as np
 
-from ..imaging._raster_kernels import accumulate_face, edge_crossings, sort_rows
+from ..imaging._raster_kernels import edge_crossings, sort_rows
 from ..jit import njit
 
 #: View codes of :func:`boundary_kernel`.
@@ -40,17 +40,43 @@ def _isolated(runs, row_start, k, h):
     return True
 
 
+def edge_face_table(topology):
+    """The faces of every edge, padded: ``edge_face`` (E, D) of int64 (``F`` = no face) and
+    ``edge_dir`` (E, D) (+1 / -1, the face's side along / against the edge; 0 for padding);
+    ``D`` the largest number of faces of an edge (2 on a manifold mesh), at least 1.
+
+    From ``topology.incidence`` (:class:`lilium.imaging.raster.EdgeTopology`), once per region.
+    """
+    incidence = topology.incidence
+    E, F = incidence.shape
+    degree = np.diff(incidence.indptr)
+    D = max(1, int(degree.max()) if E else 1)
+    edge_face = np.full((E, D), F, np.int64)
+    edge_dir = np.zeros((E, D))
+    rows = np.repeat(np.arange(E), degree)
+    slot = np.arange(len(rows)) - np.repeat(incidence.indptr[:-1], degree)
+    edge_face[rows, slot] = incidence.indices
+    edge_dir[rows, slot] = incidence.data
+    return edge_face, edge_dir
+
+
 @njit
-def boundary_kernel(u, v, corners, face_edges, face_dirs, edges_a, edges_b, lo, hi, todo, view):
+def boundary_kernel(u, v, corners, edge_face, edge_dir, edges_a, edges_b, lo, hi, todo, view):
     """Skin-side boundary pixels of S projected regions.
+
+    The contour edges of a member come edge by edge from the face signs (``mult[e]``, the sum
+    of ``sign[f] * dir`` over the faces of edge ``e``): integers, so the same multiplicities as
+    the face-by-face accumulation of the numpy path.
 
     Parameters
     ----------
     u, v : ndarray of shape (S, K)
         Projected region vertices (NaN behind the camera).
     corners : ndarray of shape (3, F)
-    face_edges, face_dirs, edges_a, edges_b : the region's edge topology
-        (:class:`lilium.imaging.raster.EdgeTopology`).
+    edge_face, edge_dir : ndarray of shape (E, D) of int64, float64
+        :func:`edge_face_table` of the region's edge topology.
+    edges_a, edges_b : ndarray of shape (E,)
+        The edges' vertices (:class:`lilium.imaging.raster.EdgeTopology`).
     lo, hi : ndarray of shape (S, 2) of int64
         ``(u, v)`` of each member's window: first pixel and one past the last.
     todo : ndarray of shape (S,) of bool
@@ -67,8 +93,9 @@ def boundary_kernel(u, v, corners, face_edges, face_dirs, edges_a, edges_b, lo, 
     S = u.shape[0]
     F = corners.shape[1]
     E = edges_a.shape[0]
+    D = edge_face.shape[1]
+    sign = np.zeros(F + 1)  # sign[F] = 0: the padding face of edge_face
     mult = np.zeros(E)
-    mark = np.full(E, -1, np.int64)
     touched = np.empty(E, np.int64)
     buf = np.empty((1024, 3), np.int64)
     keys = np.empty(1024, np.int64)
@@ -81,21 +108,25 @@ def boundary_kernel(u, v, corners, face_edges, face_dirs, edges_a, edges_b, lo, 
         if not todo[m]:
             continue
         um, vm = u[m], v[m]
-        n_touched = 0
         for f in range(F):
             i0, i1, i2 = corners[0, f], corners[1, f], corners[2, f]
             du1, dv1 = um[i1] - um[i0], vm[i1] - vm[i0]
             du2, dv2 = um[i2] - um[i0], vm[i2] - vm[i0]
             area = du1 * dv2 - du2 * dv1
-            if area > 0.0:
-                s = 1.0
-            elif area < 0.0:
-                s = -1.0
+            sign[f] = 1.0 if area > 0.0 else (-1.0 if area < 0.0 else 0.0)
+        n_touched = 0
+        for e in range(E):
+            if D == 2:
+                w = sign[edge_face[e, 0]] * edge_dir[e, 0]
+                w += sign[edge_face[e, 1]] * edge_dir[e, 1]
             else:
-                continue
-            n_touched = accumulate_face(
-                f, s, face_edges, face_dirs, mult, mark, m, touched, n_touched
-            )
+                w = 0.0
+                for k in range(D):
+                    w += sign[edge_face[e, k]] * edge_dir[e, k]
+            if w != 0.0:
+                mult[e] = w
+                touched[n_touched] = e
+                n_touched += 1
         u0, v0 = lo[m, 0], lo[m, 1]
         w, h = hi[m, 0] - u0, hi[m, 1] - v0
         buf, n = edge_crossings(

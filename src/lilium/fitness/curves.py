@@ -30,7 +30,13 @@ import numpy as np
 from .. import jit
 from ..constants import VIEWS
 from ..imaging.raster import scan_crossings, winding_intervals
-from ._curve_kernels import VIEW_CODES, boundary_kernel, span_join_kernel, windows_kernel
+from ._curve_kernels import (
+    VIEW_CODES,
+    boundary_kernel,
+    edge_face_table,
+    span_join_kernel,
+    windows_kernel,
+)
 
 #: Largest side (pixels) of the window a region is rasterised in; beyond, it is clipped.
 MAX_WINDOW_PX = 8192
@@ -428,7 +434,7 @@ def join_fragments_batch(points, offset):
     return CurveBatch(out, new_offset)
 
 
-def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
+def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None, edge_faces=None):
     """The skin-side contours of a projected region (chin-jaw or forehead), for a population.
 
     The rasters of the members are scanned together and stacked in windows of a common size
@@ -451,6 +457,9 @@ def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
     image_shape : (int, int), optional
         ``(height, width)``: windows are clipped to the image grown by one image size on every
         side.
+    edge_faces : tuple, optional
+        ``edge_face_table(topology)`` (:mod:`lilium.fitness._curve_kernels`), for the compiled
+        path; computed here when not given.
 
     Returns
     -------
@@ -473,8 +482,7 @@ def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
             u,
             v,
             topology.corners,
-            topology.face_edges,
-            topology.face_dirs,
+            *(edge_face_table(topology) if edge_faces is None else edge_faces),
             topology.edges_a,
             topology.edges_b,
             np.ascontiguousarray(lo),

@@ -46,6 +46,7 @@ import numpy as np
 from .. import jit
 from ..constants import C_INF
 from ..imaging.raster import mesh_edge_topology
+from ._curve_kernels import edge_face_table
 from ._pll_kernels import SIDE_CODES, pair_kernel, terms_kernel, trim_kernel
 from .curves import CurveBatch, check_view, detect_curves_batch, refine_curve
 
@@ -552,6 +553,9 @@ class PllContext:
     image_shape : (int, int) or None
     face_index : FaceCurveIndex or None
         Built from ``face_curve`` when None.
+    edge_faces : tuple or None
+        The faces of every edge of ``topology`` (``edge_face_table``, for the compiled curve
+        detection); computed at each call when None.
     """
 
     faces: np.ndarray
@@ -560,19 +564,22 @@ class PllContext:
     view: str
     image_shape: tuple | None = None
     face_index: FaceCurveIndex | None = None
+    edge_faces: tuple | None = None
 
     @classmethod
     def build(cls, region_faces, face_curve, view, image_shape=None, ordered=True):
         """From a region's faces ``(G, 3)`` and a facial curve ``(M, 2)`` (refined here)."""
         check_view(view)
         curve = refine_curve(face_curve, view, ordered=ordered)
+        topology = mesh_edge_topology(region_faces)
         return cls(
             np.asarray(region_faces),
-            mesh_edge_topology(region_faces),
+            topology,
             curve,
             view,
             None if image_shape is None else tuple(image_shape),
             face_curve_index(curve),
+            edge_face_table(topology),
         )
 
     def skull_curves(self, region_uv, span_v=None):
@@ -583,6 +590,7 @@ class PllContext:
             topology=self.topology,
             span_v=span_v,
             image_shape=self.image_shape,
+            edge_faces=self.edge_faces,
         )
 
     def skull_curve(self, region_uv, span_v=None):
