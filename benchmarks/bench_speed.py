@@ -5,9 +5,9 @@ for each photo, POSEST-SFO (median of ``--posest-repeats`` runs, in-process) and
 variant at the default DE budget (750 generations x 30) on the compiled path; then the same
 SFOs on the numpy reference path (``lilium.jit.kernels("numpy")``) for ``--reference-generations``
 generations, next to the compiled path at that budget, which gives the speed-up ratio; and a
-per-term profile of the compiled run (where the time of an SFO goes: camera refinement,
-P_skof, P_pll, the rest). The numpy path is the one the compiled kernels replaced: it gives the
-same numbers (``tests/test_kernels.py``).
+per-term profile of the compiled run (where the time of an SFO goes: the set-up of the problem
+and its terms, camera refinement, P_skof, P_pll, the rest). The numpy path is the one the
+compiled kernels replaced: it gives the same numbers (``tests/test_kernels.py``).
 
     python benchmarks/bench_speed.py                       # generated Exp. C photos
     python benchmarks/bench_speed.py --dataset DIR --dataset DIR2   # e.g. a 150k-face skull

@@ -33,7 +33,9 @@ member's result does not depend on the population it is evaluated in. Skull-to-f
 a lookup in the face curve's nearest-point table (brute force where the table's answer was
 trimmed away or the point lies off the table or off the pixel grid); face-to-skull pairing a
 brute-force search over each member's curve (0.06-0.3 ms per member in populations of 30,
-``benchmarks/bench_terms.py``; 2-6x faster than the oracle's per-member loop).
+``benchmarks/bench_terms.py``; 2-6x faster than the oracle's per-member loop). The three steps
+are compiled (:mod:`lilium.fitness._pll_kernels`, one loop over the members, the same numbers);
+the numpy code here is their reference and the fallback (:mod:`lilium.jit`).
 
 When a curve is empty (a region projected off the image, say) no pair exists:
 :data:`PLL_NO_CURVE` is the total and the parts are NaN.
