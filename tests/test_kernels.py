@@ -198,7 +198,12 @@ def test_curve_detection_kernel_gives_the_numpy_curves(view):
     R, t, focal = cameras(40, rng=9)
     uv = project_vertices(vertices[used], R, t, focal, CENTRE)
     uv[3] += 5000.0  # a window clipped at the image's surroundings
-    span = uv[:, :2, 1] if view != "frontal" else None
+    uv[4] = np.nan  # behind the camera
+    uv[5, ::3] = np.nan  # partly behind
+    span = uv[:, :2, 1].copy() if view != "frontal" else None
+    if span is not None:
+        span[6, 0] = np.nan  # a span end behind the camera
+        span[7] = span[7, ::-1]
     compiled = detect_curves_batch(
         uv, view, topology=topology, span_v=span, image_shape=(HEIGHT, WIDTH)
     )
@@ -206,6 +211,94 @@ def test_curve_detection_kernel_gives_the_numpy_curves(view):
         reference = detect_curves_batch(
             uv, view, topology=topology, span_v=span, image_shape=(HEIGHT, WIDTH)
         )
-    assert len(reference.points) > 500
+    assert len(reference.points) > 400
     np.testing.assert_array_equal(compiled.offset, reference.offset)
     np.testing.assert_array_equal(compiled.points, reference.points)
+
+
+def _pll_cases(view, rng=10):
+    """Skull curves of 40 cameras of an open cap (30 near one camera, 10 anywhere), the facial
+    curve: the middle of that camera's curve, shifted; and the awkward members: empty, one to
+    three points, sub-pixel points, far off the face curve's table."""
+    from lilium.fitness.curves import CurveBatch, detect_curves_batch
+    from lilium.fitness.pll import face_curve_index
+
+    vertices, faces = shell_skull(n_lat=30, n_lon=40, rng=rng)
+    low = vertices[faces].mean(axis=1)[:, 1] < -20.0
+    used, region = np.unique(faces[low], return_inverse=True)
+    topology = mesh_edge_topology(region.reshape(-1, 3))
+    rng = np.random.default_rng(rng)
+    turn = {"frontal": [0.3, 0, 0], "lateral_left": [0, -1.4, 0], "lateral_right": [0, 1.4, 0]}
+    R = np.array([rotvec_to_matrix(turn[view] + rng.normal(scale=0.05, size=3)) for _ in range(30)])
+    t = np.column_stack([rng.normal(scale=8.0, size=(30, 2)), rng.uniform(800, 900, 30)])
+    focal = t[:, 2] * rng.uniform(1.8, 2.2, 30)
+    R2, t2, focal2 = cameras(10, rng=11)
+    R, t, focal = np.vstack([R, R2]), np.vstack([t, t2]), np.concatenate([focal, focal2])
+    uv = project_vertices(vertices[used], R, t, focal, CENTRE)
+    batch = detect_curves_batch(uv, view, topology=topology, image_shape=(HEIGHT, WIDTH))
+    curves = [batch.curve(m) for m in range(len(batch))]
+    c = curves[0]
+    face = c[len(c) // 5 : len(c) - len(c) // 6] + [3.0, 5.0]
+    curves += [np.zeros((0, 2)), curves[5][:1], curves[6][:2], curves[7][:3]]
+    curves += [curves[8] + rng.uniform(-0.5, 0.5, curves[8].shape), curves[9] + 900.0]
+    return CurveBatch.from_curves(curves), face_curve_index(face)
+
+
+@needs_numba
+@pytest.mark.parametrize("view", ["frontal", "lateral_left", "lateral_right"])
+def test_pll_kernels_give_the_numpy_trims_pairs_and_terms(view):
+    from lilium.fitness.pll import (
+        face_curve_index,
+        pair_curves_batch,
+        pll_terms_batch,
+        terms_from_pairs,
+        trim_curves_batch,
+    )
+
+    curves, index = _pll_cases(view)
+    assert len(curves.points) > 2000
+    short = face_curve_index(index.curve[:2])  # no end normals: nothing trimmed
+    for face_index in (index, short):
+        steps = {}
+        for name in ("numba", "numpy"):
+            with jit.kernels(name):
+                skull, lo, hi = trim_curves_batch(curves, face_index)
+                pairs = pair_curves_batch(skull, face_index, lo, hi)
+                untrimmed = pair_curves_batch(curves, face_index)
+                terms = terms_from_pairs(pairs, view)
+                batch = pll_terms_batch(curves, face_index, view)
+            steps[name] = (skull.points, skull.offset, lo, hi, *vars(pairs).values())
+            steps[name] += (*vars(untrimmed).values(), *vars(terms).values())
+            steps[name] += tuple(vars(batch).values())
+        for a, b in zip(steps["numba"], steps["numpy"], strict=True):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)
+    # The cases exercise every rule: trimmed on both curves, NaN terms, wrong-side pairs.
+    with jit.kernels("numba"):
+        skull, lo, hi = trim_curves_batch(curves, index)
+        terms = pll_terms_batch(curves, index, view)
+    assert (skull.lengths < curves.lengths).sum() >= 10
+    assert ((lo > 0) | (hi < len(index.curve))).any()
+    assert np.isnan(terms.delta_d).sum() == 1 and (terms.p_int > 0).any()
+    assert (terms.p_conv > 0).any()
+
+
+@needs_numba
+def test_distance_to_background_is_scipys_exactly():
+    """The compiled distance transform of the face mask index is scipy's EDT, exactly."""
+    from scipy import ndimage
+
+    from lilium.fitness._skof_kernels import squared_distance_to_background
+    from lilium.fitness.skof import face_mask_index
+
+    rng = np.random.default_rng(12)
+    masks = [rng.random((31, 47)) > p for p in (0.002, 0.05, 0.6)] + [face_mask()]
+    masks.append(np.ones((5, 6), bool))
+    for mask in masks:
+        got = np.sqrt(squared_distance_to_background(mask))
+        want = ndimage.distance_transform_edt(mask) if not mask.all() else np.inf
+        np.testing.assert_array_equal(got, np.broadcast_to(want, mask.shape))
+    compiled = face_mask_index(face_mask())
+    with jit.kernels("numpy"):
+        reference = face_mask_index(face_mask())
+    np.testing.assert_array_equal(compiled.clearance2, reference.clearance2)

@@ -12,7 +12,7 @@ equals the numpy path's exactly.
 
 import numpy as np
 
-from ..imaging._raster_kernels import accumulate_face, edge_crossings, sort_rows
+from ..imaging._raster_kernels import edge_crossings, sort_rows
 from ..jit import njit
 
 #: View codes of :func:`boundary_kernel`.
@@ -40,17 +40,43 @@ def _isolated(runs, row_start, k, h):
     return True
 
 
+def edge_face_table(topology):
+    """The faces of every edge, padded: ``edge_face`` (E, D) of int64 (``F`` = no face) and
+    ``edge_dir`` (E, D) (+1 / -1, the face's side along / against the edge; 0 for padding);
+    ``D`` the largest number of faces of an edge (2 on a manifold mesh), at least 1.
+
+    From ``topology.incidence`` (:class:`lilium.imaging.raster.EdgeTopology`), once per region.
+    """
+    incidence = topology.incidence
+    E, F = incidence.shape
+    degree = np.diff(incidence.indptr)
+    D = max(1, int(degree.max()) if E else 1)
+    edge_face = np.full((E, D), F, np.int64)
+    edge_dir = np.zeros((E, D))
+    rows = np.repeat(np.arange(E), degree)
+    slot = np.arange(len(rows)) - np.repeat(incidence.indptr[:-1], degree)
+    edge_face[rows, slot] = incidence.indices
+    edge_dir[rows, slot] = incidence.data
+    return edge_face, edge_dir
+
+
 @njit
-def boundary_kernel(u, v, corners, face_edges, face_dirs, edges_a, edges_b, lo, hi, todo, view):
+def boundary_kernel(u, v, corners, edge_face, edge_dir, edges_a, edges_b, lo, hi, todo, view):
     """Skin-side boundary pixels of S projected regions.
+
+    The contour edges of a member come edge by edge from the face signs (``mult[e]``, the sum
+    of ``sign[f] * dir`` over the faces of edge ``e``): integers, so the same multiplicities as
+    the face-by-face accumulation of the numpy path.
 
     Parameters
     ----------
     u, v : ndarray of shape (S, K)
         Projected region vertices (NaN behind the camera).
     corners : ndarray of shape (3, F)
-    face_edges, face_dirs, edges_a, edges_b : the region's edge topology
-        (:class:`lilium.imaging.raster.EdgeTopology`).
+    edge_face, edge_dir : ndarray of shape (E, D) of int64, float64
+        :func:`edge_face_table` of the region's edge topology.
+    edges_a, edges_b : ndarray of shape (E,)
+        The edges' vertices (:class:`lilium.imaging.raster.EdgeTopology`).
     lo, hi : ndarray of shape (S, 2) of int64
         ``(u, v)`` of each member's window: first pixel and one past the last.
     todo : ndarray of shape (S,) of bool
@@ -67,8 +93,9 @@ def boundary_kernel(u, v, corners, face_edges, face_dirs, edges_a, edges_b, lo, 
     S = u.shape[0]
     F = corners.shape[1]
     E = edges_a.shape[0]
+    D = edge_face.shape[1]
+    sign = np.zeros(F + 1)  # sign[F] = 0: the padding face of edge_face
     mult = np.zeros(E)
-    mark = np.full(E, -1, np.int64)
     touched = np.empty(E, np.int64)
     buf = np.empty((1024, 3), np.int64)
     keys = np.empty(1024, np.int64)
@@ -81,21 +108,25 @@ def boundary_kernel(u, v, corners, face_edges, face_dirs, edges_a, edges_b, lo, 
         if not todo[m]:
             continue
         um, vm = u[m], v[m]
-        n_touched = 0
         for f in range(F):
             i0, i1, i2 = corners[0, f], corners[1, f], corners[2, f]
             du1, dv1 = um[i1] - um[i0], vm[i1] - vm[i0]
             du2, dv2 = um[i2] - um[i0], vm[i2] - vm[i0]
             area = du1 * dv2 - du2 * dv1
-            if area > 0.0:
-                s = 1.0
-            elif area < 0.0:
-                s = -1.0
+            sign[f] = 1.0 if area > 0.0 else (-1.0 if area < 0.0 else 0.0)
+        n_touched = 0
+        for e in range(E):
+            if D == 2:
+                w = sign[edge_face[e, 0]] * edge_dir[e, 0]
+                w += sign[edge_face[e, 1]] * edge_dir[e, 1]
             else:
-                continue
-            n_touched = accumulate_face(
-                f, s, face_edges, face_dirs, mult, mark, m, touched, n_touched
-            )
+                w = 0.0
+                for k in range(D):
+                    w += sign[edge_face[e, k]] * edge_dir[e, k]
+            if w != 0.0:
+                mult[e] = w
+                touched[n_touched] = e
+                n_touched += 1
         u0, v0 = lo[m, 0], lo[m, 1]
         w, h = hi[m, 0] - u0, hi[m, 1] - v0
         buf, n = edge_crossings(
@@ -165,3 +196,92 @@ def boundary_kernel(u, v, corners, face_edges, face_dirs, edges_a, edges_b, lo, 
                     total += 1
                     break
     return out_member[:total].copy(), out[:total].copy()
+
+
+@njit
+def windows_kernel(u, v, height, width, max_window):
+    """:func:`lilium.fitness.curves._windows` (``height`` < 0: no image to clip to).
+
+    Returns ``lo``, ``hi`` (S, 2) of int64, ``empty`` and ``clipped`` (S,) of bool.
+    """
+    S, K = u.shape
+    lo = np.zeros((S, 2), np.int64)
+    hi = np.ones((S, 2), np.int64)
+    empty = np.ones(S, np.bool_)
+    clipped = np.zeros(S, np.bool_)
+    for m in range(S):
+        u_lo, v_lo, u_hi, v_hi = np.inf, np.inf, -np.inf, -np.inf
+        for k in range(K):
+            x, y = u[m, k], v[m, k]
+            if np.isfinite(x) and np.isfinite(y):
+                empty[m] = False
+                u_lo, u_hi = min(u_lo, x), max(u_hi, x)
+                v_lo, v_hi = min(v_lo, y), max(v_hi, y)
+        if empty[m]:
+            continue
+        box0, box1 = np.int64(np.floor(u_lo)), np.int64(np.floor(v_lo))
+        box2, box3 = np.int64(np.ceil(u_hi) + 1), np.int64(np.ceil(v_hi) + 1)
+        a0, a1, b0, b1 = box0, box1, box2, box3
+        if height >= 0:
+            a0, a1 = max(a0, -width), max(a1, -height)
+            b0, b1 = min(b0, 2 * width), min(b1, 2 * height)
+        b0, b1 = min(b0, a0 + max_window), min(b1, a1 + max_window)
+        lo[m, 0], lo[m, 1], hi[m, 0], hi[m, 1] = a0, a1, b0, b1
+        empty[m] = b0 <= a0 or b1 <= a1
+        changed = a0 != box0 or a1 != box1 or b0 != box2 or b1 != box3
+        clipped[m] = changed and not empty[m]
+    return lo, hi, empty, clipped
+
+
+@njit
+def span_join_kernel(member, points, span_v, has_span, S):
+    """:func:`lilium.fitness.curves._span_and_join` of the boundary pixels ``points`` (N, 2)
+    (integer-valued) of members ``member`` (N,), sorted: the span filter (``span_v`` (S, 2),
+    when ``has_span``), then :func:`~lilium.fitness.curves.join_fragments_batch`.
+
+    Returns the joined points ``(N', 2)`` and their offsets ``(S + 1,)``.
+    """
+    N = points.shape[0]
+    keep = np.ones(N, np.bool_)
+    if has_span:
+        for i in range(N):
+            a, b = span_v[member[i], 0], span_v[member[i], 1]
+            y = points[i, 1]
+            keep[i] = y >= np.minimum(a, b) and y <= np.maximum(a, b)
+    idx = np.flatnonzero(keep)
+    p = points[idx]
+    mem = member[idx]
+    n = p.shape[0]
+    offset = np.searchsorted(mem, np.arange(S + 1))
+    if n == 0:
+        return np.zeros((0, 2)), np.zeros_like(offset)
+    # Steps between consecutive points: the last point of a member emits itself alone.
+    is_last = np.zeros(n, np.bool_)
+    for m in range(1, S):
+        if 0 < offset[m] <= n - 1:
+            is_last[offset[m] - 1] = True
+    first = np.zeros(n, np.int64)  # output position of every input point
+    total = 0
+    for i in range(n - 1):
+        first[i] = total
+        if is_last[i]:
+            total += 1
+        else:
+            total += np.int64(max(abs(p[i + 1, 0] - p[i, 0]), abs(p[i + 1, 1] - p[i, 1])))
+    first[n - 1] = total
+    out = np.empty((total + 1, 2))
+    for i in range(n - 1):
+        if is_last[i]:
+            out[first[i], 0], out[first[i], 1] = np.rint(p[i, 0]), np.rint(p[i, 1])
+            continue
+        du, dv = p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1]
+        steps = first[i + 1] - first[i]
+        for k in range(steps):
+            t = k / steps
+            out[first[i] + k, 0] = np.rint(p[i, 0] + t * du)
+            out[first[i] + k, 1] = np.rint(p[i, 1] + t * dv)
+    out[total, 0], out[total, 1] = p[n - 1, 0], p[n - 1, 1]
+    new_offset = np.empty(S + 1, np.int64)
+    for m in range(S + 1):
+        new_offset[m] = first[offset[m]] if offset[m] < n else total + 1
+    return out, new_offset

@@ -66,17 +66,53 @@ class FaceClusters:
 
 
 @njit
+def _select(key, idx, lo, hi, k):
+    """Reorder ``idx[lo:hi]`` so that its first ``k`` entries are the ``k`` smallest by
+    ``(key[idx], idx)`` (a quickselect; the order inside each part is unspecified)."""
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        # Median of three as the pivot, compared by (key, index): every index is unique.
+        a, b, c = idx[lo], idx[mid], idx[hi - 1]
+        if (key[b], b) < (key[a], a):
+            a, b = b, a
+        if (key[c], c) < (key[b], b):
+            b, c = c, b
+            if (key[b], b) < (key[a], a):
+                a, b = b, a
+        pk, pi = key[b], b
+        i, j = lo, hi - 1
+        while i <= j:
+            while (key[idx[i]], idx[i]) < (pk, pi):
+                i += 1
+            while (pk, pi) < (key[idx[j]], idx[j]):
+                j -= 1
+            if i <= j:
+                idx[i], idx[j] = idx[j], idx[i]
+                i += 1
+                j -= 1
+        if lo + k <= j:
+            hi = j + 1
+        elif lo + k >= i:
+            k -= i - lo
+            lo = i
+        else:
+            return
+
+
+@njit
 def _kd_order(points, leaf_size):
     """Order of points ``(N, 3)`` in which every run of ``leaf_size`` is a compact k-d cell.
 
-    Splits along the longest side of each cell's bounding box, the left part a multiple of
-    ``leaf_size`` points (about half), until cells hold at most ``leaf_size``; consecutive
-    leaves are neighbours in the tree, so runs of leaves are compact too.
+    Splits along the longest side of each cell's bounding box, the left part the ``half``
+    smallest along it (ties by index; ``half`` a multiple of ``leaf_size``, about half), until
+    cells hold at most ``leaf_size``; consecutive leaves are neighbours in the tree, so runs of
+    leaves are compact too. A selection per cell (no sort): O(N log N) in all.
     """
     n_points = points.shape[0]
     order = np.arange(n_points)
     stack = np.empty((128, 2), np.int64)
     stack[0, 0], stack[0, 1] = 0, n_points
+    key = np.empty(n_points)
     depth = 1
     while depth > 0:
         depth -= 1
@@ -84,26 +120,84 @@ def _kd_order(points, leaf_size):
         n = hi - lo
         if n <= leaf_size:
             continue
-        idx = order[lo:hi].copy()
         best_axis, best_extent = 0, -1.0
         for axis in range(3):
             a_min, a_max = np.inf, -np.inf
-            for i in idx:
-                a_min = min(a_min, points[i, axis])
-                a_max = max(a_max, points[i, axis])
+            for i in range(lo, hi):
+                x = points[order[i], axis]
+                a_min = min(a_min, x)
+                a_max = max(a_max, x)
             if a_max - a_min > best_extent:
                 best_axis, best_extent = axis, a_max - a_min
-        key = np.empty(n)
-        for k in range(n):
-            key[k] = points[idx[k], best_axis]
-        order[lo:hi] = idx[np.argsort(key, kind="mergesort")]
+        for i in range(lo, hi):
+            key[order[i]] = points[order[i], best_axis]
         half = max(leaf_size, (n // 2 + leaf_size - 1) // leaf_size * leaf_size)
         if half >= n:
             half = n - leaf_size
+        _select(key, order, lo, hi, half)
         stack[depth, 0], stack[depth, 1] = lo + half, hi
         stack[depth + 1, 0], stack[depth + 1, 1] = lo, lo + half
         depth += 2
     return order
+
+
+@njit
+def squared_distance_to_background(mask):
+    """Exact squared distance (square pixels) from every pixel centre of ``mask``
+    ``(height, width)`` (True = face) to the nearest False pixel centre; ``inf`` without one.
+
+    Felzenszwalb and Huttenlocher's two passes (columns, then the lower envelope of parabolas
+    along the rows). Integers below 2**53: exact, the square of
+    ``scipy.ndimage.distance_transform_edt``'s distance.
+    """
+    height, width = mask.shape
+    big = np.inf
+    g = np.empty((height, width))  # squared distance along the column
+    last = np.full(width, -1, np.int64)  # row of the last background pixel seen per column
+    for r in range(height):
+        for c in range(width):
+            if not mask[r, c]:
+                last[c] = r
+            g[r, c] = big if last[c] < 0 else float((r - last[c]) * (r - last[c]))
+    last[:] = -1
+    for r in range(height - 1, -1, -1):
+        for c in range(width):
+            if not mask[r, c]:
+                last[c] = r
+            if last[c] >= 0:
+                d = float((last[c] - r) * (last[c] - r))
+                if d < g[r, c]:
+                    g[r, c] = d
+    out = np.empty((height, width))
+    v = np.empty(width, np.int64)
+    z = np.empty(width + 1)
+    for r in range(height):
+        f = g[r]
+        k = -1
+        s = 0.0
+        for q in range(width):
+            if f[q] == big:
+                continue
+            while k >= 0:
+                s = ((f[q] + q * q) - (f[v[k]] + v[k] * v[k])) / (2.0 * (q - v[k]))
+                if s <= z[k]:
+                    k -= 1
+                else:
+                    break
+            k += 1
+            v[k] = q
+            z[k] = -big if k == 0 else s
+            z[k + 1] = big
+        if k < 0:
+            out[r, :] = big
+            continue
+        j = 0
+        for q in range(width):
+            while z[j + 1] < q:
+                j += 1
+            d = q - v[j]
+            out[r, q] = d * d + f[v[j]]
+    return out
 
 
 @njit

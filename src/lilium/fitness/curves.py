@@ -30,7 +30,13 @@ import numpy as np
 from .. import jit
 from ..constants import VIEWS
 from ..imaging.raster import scan_crossings, winding_intervals
-from ._curve_kernels import VIEW_CODES, boundary_kernel
+from ._curve_kernels import (
+    VIEW_CODES,
+    boundary_kernel,
+    edge_face_table,
+    span_join_kernel,
+    windows_kernel,
+)
 
 #: Largest side (pixels) of the window a region is rasterised in; beyond, it is clipped.
 MAX_WINDOW_PX = 8192
@@ -271,6 +277,10 @@ def _windows(uv, image_shape):
         The window was clipped: its raster is scanned on its own (crossings outside it).
     """
     u, v = uv[..., 0], uv[..., 1]
+    if jit.compiled():
+        height, width = (-1, -1) if image_shape is None else image_shape
+        u, v = np.ascontiguousarray(u), np.ascontiguousarray(v)
+        return windows_kernel(u, v, int(height), int(width), MAX_WINDOW_PX)
     finite = np.isfinite(u) & np.isfinite(v)
     empty = ~finite.any(axis=1)
     lo = np.stack([np.where(finite, x, np.inf).min(axis=1) for x in (u, v)], axis=1)
@@ -424,7 +434,7 @@ def join_fragments_batch(points, offset):
     return CurveBatch(out, new_offset)
 
 
-def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
+def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None, edge_faces=None):
     """The skin-side contours of a projected region (chin-jaw or forehead), for a population.
 
     The rasters of the members are scanned together and stacked in windows of a common size
@@ -447,6 +457,9 @@ def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
     image_shape : (int, int), optional
         ``(height, width)``: windows are clipped to the image grown by one image size on every
         side.
+    edge_faces : tuple, optional
+        ``edge_face_table(topology)`` (:mod:`lilium.fitness._curve_kernels`), for the compiled
+        path; computed here when not given.
 
     Returns
     -------
@@ -469,8 +482,7 @@ def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
             u,
             v,
             topology.corners,
-            topology.face_edges,
-            topology.face_dirs,
+            *(edge_face_table(topology) if edge_faces is None else edge_faces),
             topology.edges_a,
             topology.edges_b,
             np.ascontiguousarray(lo),
@@ -520,6 +532,16 @@ def detect_curves_batch(uv, view, *, topology, span_v=None, image_shape=None):
 
 def _span_and_join(member, points, span_v, S):
     """Boundary pixels ``(N, 2)`` of members ``(N,)``: span filter, then joined fragments."""
+    if jit.compiled():
+        has_span = span_v is not None
+        span = (
+            np.ascontiguousarray(np.reshape(span_v, (S, 2)), float)
+            if has_span
+            else np.zeros((S, 2))
+        )
+        member = np.ascontiguousarray(member, np.int64)
+        points = np.ascontiguousarray(points, dtype=float).reshape(-1, 2)
+        return CurveBatch(*span_join_kernel(member, points, span, has_span, S))
     if span_v is not None and len(points):
         span_v = np.asarray(span_v, dtype=float).reshape(S, 2)
         a, b = span_v[member, 0], span_v[member, 1]

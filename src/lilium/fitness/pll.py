@@ -33,7 +33,9 @@ member's result does not depend on the population it is evaluated in. Skull-to-f
 a lookup in the face curve's nearest-point table (brute force where the table's answer was
 trimmed away or the point lies off the table or off the pixel grid); face-to-skull pairing a
 brute-force search over each member's curve (0.06-0.3 ms per member in populations of 30,
-``benchmarks/bench_terms.py``; 2-6x faster than the oracle's per-member loop).
+``benchmarks/bench_terms.py``; 2-6x faster than the oracle's per-member loop). The three steps
+are compiled (:mod:`lilium.fitness._pll_kernels`, one loop over the members, the same numbers);
+the numpy code here is their reference and the fallback (:mod:`lilium.jit`).
 
 When a curve is empty (a region projected off the image, say) no pair exists:
 :data:`PLL_NO_CURVE` is the total and the parts are NaN.
@@ -43,8 +45,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import jit
 from ..constants import C_INF
 from ..imaging.raster import mesh_edge_topology
+from ._curve_kernels import edge_face_table
+from ._pll_kernels import SIDE_CODES, pair_kernel, terms_kernel, trim_kernel
 from .curves import CurveBatch, check_view, detect_curves_batch, refine_curve
 
 #: Fraction of a curve's length whose mean tangent defines its end normal (SPEC: 20 %).
@@ -259,11 +264,15 @@ def trim_curves_batch(curves, face_index):
     face_lo, face_hi : ndarray of shape (S,) of int64
         Member ``m``'s trimmed facial curve is ``face_index.curve[face_lo[m] : face_hi[m]]``.
     """
-    P = curves.points
-    offset = np.asarray(curves.offset, np.int64)
+    P = np.ascontiguousarray(curves.points, dtype=float)
+    offset = np.ascontiguousarray(curves.offset, np.int64)
+    face = np.ascontiguousarray(face_index.curve, dtype=float)
+    if jit.compiled():
+        ends = np.zeros((4, 2)) if face_index.ends is None else np.array(face_index.ends, float)
+        points, kept, lo, hi = trim_kernel(P, offset, face, ends, face_index.ends is not None)
+        return CurveBatch(points, kept), lo, hi
     S = len(offset) - 1
     n = np.diff(offset)
-    face = face_index.curve
     M = len(face)
     head_s, tail_s = np.zeros(S, np.int64), np.zeros(S, np.int64)
     face_lo, face_hi = np.zeros(S, np.int64), np.full(S, M, np.int64)
@@ -334,14 +343,19 @@ def pair_curves_batch(skull, face_index, face_lo=None, face_hi=None):
     -------
     PairBatch
     """
-    P = skull.points
-    offset = np.asarray(skull.offset, np.int64)
+    P = np.ascontiguousarray(skull.points, dtype=float)
+    offset = np.ascontiguousarray(skull.offset, np.int64)
     S = len(offset) - 1
     n = np.diff(offset)
-    face = face_index.curve
+    face = np.ascontiguousarray(face_index.curve, dtype=float)
     M = len(face)
     face_lo = np.zeros(S, np.int64) if face_lo is None else np.asarray(face_lo, np.int64)
     face_hi = np.full(S, M, np.int64) if face_hi is None else np.asarray(face_hi, np.int64)
+    if jit.compiled():
+        u0, v0 = face_index.origin
+        table = np.ascontiguousarray(face_index.table, np.int64)
+        lo, hi = np.ascontiguousarray(face_lo), np.ascontiguousarray(face_hi)
+        return PairBatch(*pair_kernel(P, offset, face, lo, hi, table, int(u0), int(v0)))
     if M == 0 or not n.any():
         return PairBatch(np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(S + 1, np.int64))
     member = np.repeat(np.arange(S), n)
@@ -447,7 +461,12 @@ def wrong_side(skull, face, view):
 
 def terms_from_pairs(pairs, view):
     """:class:`PllTerms` of every member, fields of shape (S,), from its pairs (step 3)."""
-    offset = np.asarray(pairs.offset, np.int64)
+    offset = np.ascontiguousarray(pairs.offset, np.int64)
+    if jit.compiled():
+        skull, face = (np.ascontiguousarray(x, dtype=float) for x in (pairs.skull, pairs.face))
+        distance = np.ascontiguousarray(pairs.distance, dtype=float)
+        side = SIDE_CODES[check_view(view)]
+        return PllTerms(*terms_kernel(skull, face, distance, offset, side, PLL_NO_CURVE))
     S = len(offset) - 1
     terms = _failed(S)
     count = np.diff(offset)
@@ -536,6 +555,9 @@ class PllContext:
     image_shape : (int, int) or None
     face_index : FaceCurveIndex or None
         Built from ``face_curve`` when None.
+    edge_faces : tuple or None
+        The faces of every edge of ``topology`` (``edge_face_table``, for the compiled curve
+        detection); computed at each call when None.
     """
 
     faces: np.ndarray
@@ -544,19 +566,22 @@ class PllContext:
     view: str
     image_shape: tuple | None = None
     face_index: FaceCurveIndex | None = None
+    edge_faces: tuple | None = None
 
     @classmethod
     def build(cls, region_faces, face_curve, view, image_shape=None, ordered=True):
         """From a region's faces ``(G, 3)`` and a facial curve ``(M, 2)`` (refined here)."""
         check_view(view)
         curve = refine_curve(face_curve, view, ordered=ordered)
+        topology = mesh_edge_topology(region_faces)
         return cls(
             np.asarray(region_faces),
-            mesh_edge_topology(region_faces),
+            topology,
             curve,
             view,
             None if image_shape is None else tuple(image_shape),
             face_curve_index(curve),
+            edge_face_table(topology),
         )
 
     def skull_curves(self, region_uv, span_v=None):
@@ -567,6 +592,7 @@ class PllContext:
             topology=self.topology,
             span_v=span_v,
             image_shape=self.image_shape,
+            edge_faces=self.edge_faces,
         )
 
     def skull_curve(self, region_uv, span_v=None):

@@ -39,7 +39,13 @@ from ..imaging.raster import (
     skull_raster,  # noqa: F401 - the raster S itself, re-exported next to the count
     winding_intervals,
 )
-from ._skof_kernels import FaceClusters, face_clusters, outside_pixels_kernel, project_vertices
+from ._skof_kernels import (
+    FaceClusters,
+    face_clusters,
+    outside_pixels_kernel,
+    project_vertices,
+    squared_distance_to_background,
+)
 
 #: Weight of the outside-pixel count in P_skof (SPEC section 5).
 SKOF_WEIGHT = 100.0
@@ -100,7 +106,10 @@ def face_mask_index(face_mask):
     if mask.all():
         clearance = np.full(mask.shape, np.inf)
     else:
-        distance = ndimage.distance_transform_edt(mask)
+        if jit.compiled():
+            distance = np.sqrt(squared_distance_to_background(mask))
+        else:
+            distance = ndimage.distance_transform_edt(mask)
         clearance = np.maximum(distance - np.sqrt(0.5) - 1e-6, 0.0) ** 2
     return FaceMaskIndex(
         shape=(height, width), outside_prefix=prefix, clearance2=np.pad(clearance, 1).reshape(-1)

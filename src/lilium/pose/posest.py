@@ -202,12 +202,17 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0,
         if len(todo) == 0:
             break
     score = cost if not on_inliers else np.minimum(sq, tau_sq).sum(axis=1)
-    why = [check_camera(R[k], t[k], f[k], sq[k], options.focal_max_px) for k in range(len(f))]
-    if camera_check is not None:
-        accepted = np.asarray(camera_check(R, t), dtype=bool)
-        why = [w or ("" if accepted[k] else REJECTED_MESSAGE) for k, w in enumerate(why)]
-    valid = np.array([not w for w in why])
+    # check_camera's rules, vectorised; its messages are needed only when every camera fails.
+    with np.errstate(invalid="ignore"):
+        fine = np.isfinite(f) & (f >= FOCAL_MIN_PX) & (f <= options.focal_max_px)
+    fine &= np.all(np.isfinite(sq), axis=1)
+    accepted = (
+        np.ones(len(f), bool) if camera_check is None else np.asarray(camera_check(R, t), bool)
+    )
+    valid = fine & accepted
     if not valid.any():
+        why = [check_camera(R[k], t[k], f[k], sq[k], options.focal_max_px) for k in range(len(f))]
+        why = [w or ("" if accepted[k] else REJECTED_MESSAGE) for k, w in enumerate(why)]
         k = int(np.argmin(score))
         if any(w == REJECTED_MESSAGE for w in why):  # would have fitted, but refused
             k = min((j for j, w in enumerate(why) if w == REJECTED_MESSAGE), key=score.__getitem__)

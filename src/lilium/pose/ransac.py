@@ -103,8 +103,10 @@ def msac(uv_centred_px, points_mm, options=RansacOptions(), rng=None):
         Rs, ts, fs = [], [], []
         # A chunk of 4-point samples without repetition, drawn in one call.
         samples = np.argsort(rng.random((options.chunk, n)), axis=1)[:, :4]
-        for idx in samples:
-            R, t, f = p4pf(uv_centred_px[idx], points_mm[idx])
+        # Gathered once per chunk: each sample is then a contiguous (4, 2) / (4, 3) view.
+        uv_samples, X_samples = uv_centred_px[samples], points_mm[samples]
+        for k in range(len(samples)):
+            R, t, f = p4pf(uv_samples[k], X_samples[k])
             Rs.append(R)
             ts.append(t)
             fs.append(f)

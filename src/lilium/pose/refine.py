@@ -273,10 +273,11 @@ def _refine_compiled(uv_c, P, Pm, m, w_sqrt, R, c, log_f, options):
     R = np.ascontiguousarray(R)
     c = np.ascontiguousarray(c)
     log_f = np.ascontiguousarray(log_f)
+    # Writeable C arrays (a broadcast view is read-only): one compiled signature, not two.
     cost, iterations = lm_kernel(
-        np.ascontiguousarray(uv_c),
-        np.ascontiguousarray(Pm),
-        np.ascontiguousarray(w_sqrt),
+        np.require(uv_c, float, ["C", "W"]),
+        np.require(Pm, float, ["C", "W"]),
+        np.require(w_sqrt, float, ["C", "W"]),
         R,
         c,
         log_f,
