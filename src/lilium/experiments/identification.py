@@ -38,6 +38,41 @@ def _score(row):
     return math.inf
 
 
+def complete_photo_runs(rows, score):
+    """The photo-runs whose SFOs against every skull of their experiment are stored.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Database rows (``experiment, method, variant, axes_set, repetition, photo, view,
+        subject, true_subject, success, score``).
+    score : callable
+        ``score(row) -> float``: the ranking score of one SFO (failures mapped as the caller
+        ranks them).
+
+    Yields
+    ------
+    key : tuple
+        ``(experiment, method, variant, axes_set, repetition, photo)``, in sorted order.
+    view, true_subject : str
+    scores : dict of str -> float
+        Per tested skull; includes the true skull.
+    """
+    skulls = defaultdict(set)
+    groups = defaultdict(dict)
+    meta = {}
+    for r in rows:
+        skulls[r["experiment"]].add(r["subject"])
+        key = (r["experiment"], r["method"], r["variant"], r["axes_set"], r["repetition"])
+        key = key + (r["photo"],)
+        groups[key][r["subject"]] = score(r)
+        meta[key] = (r["view"], r["true_subject"])
+    for key, scores in sorted(groups.items()):
+        view, true = meta[key]
+        if set(scores) == skulls[key[0]] and true in scores:
+            yield key, view, true, scores
+
+
 def photo_matches(rows):
     """Counts of negatives better than / tied with the true skull, per photo-run.
 
@@ -54,20 +89,8 @@ def photo_matches(rows):
         negatives`` (ints), for every photo-run whose SFOs against every skull of the
         experiment are stored and include the true skull.
     """
-    skulls = defaultdict(set)
-    groups = defaultdict(dict)
-    meta = {}
-    for r in rows:
-        skulls[r["experiment"]].add(r["subject"])
-        key = (r["experiment"], r["method"], r["variant"], r["axes_set"], r["repetition"])
-        key = key + (r["photo"],)
-        groups[key][r["subject"]] = _score(r)
-        meta[key] = (r["view"], r["true_subject"])
     out = []
-    for key, scores in sorted(groups.items()):
-        view, true = meta[key]
-        if set(scores) != skulls[key[0]] or true not in scores:
-            continue
+    for key, view, true, scores in complete_photo_runs(rows, _score):
         target = scores[true]
         negatives = [s for name, s in scores.items() if name != true]
         exp, method, variant, axes_set, rep, photo = key

@@ -94,28 +94,13 @@ def photo_ranks(rows):
         ``experiment, method, variant, axes_set, repetition, photo, view, rank, n_skulls``.
     """
     from ..evaluation.metrics import rank_of_true
+    from .identification import complete_photo_runs
 
-    skulls = defaultdict(set)
-    groups = defaultdict(dict)
-    meta = {}
-    for r in rows:
-        skulls[r["experiment"]].add(r["subject"])
-        key = (
-            r["experiment"],
-            r["method"],
-            r["variant"],
-            r["axes_set"],
-            r["repetition"],
-            r["photo"],
-        )
-        score = r["score"] if r["success"] and r["score"] is not None else math.nan
-        groups[key][r["subject"]] = score
-        meta[key] = (r["view"], r["true_subject"])
+    def score(r):
+        return r["score"] if r["success"] and r["score"] is not None else math.nan
+
     out = []
-    for key, scores in sorted(groups.items()):
-        view, true = meta[key]
-        if set(scores) != skulls[key[0]] or true not in scores:
-            continue
+    for key, view, true, scores in complete_photo_runs(rows, score):
         names = sorted(scores)
         rank = rank_of_true([scores[n] for n in names], names.index(true))
         exp, method, variant, axes_set, rep, photo = key
