@@ -159,15 +159,8 @@ def run_case(
             if (folder / "overlay.png").is_file():
                 outputs["overlay.png"] = f"{rel.as_posix()}/overlay.png"
             name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
-            status = (
-                f"focal {result.camera.focal_px:.0f} px, score {result.fitness:.4g}"
-                if result
-                else f"FAILED ({result.error})"
-            )
-            off = f", off: {', '.join(result.terms_off)}" if result.terms_off else ""
-            log(f"{photo.id}: {name}: {status}{off}, {result.seconds:.2f} s -> {folder}")
-            for warning in result.warnings:
-                log(f"  warning {warning.code}: {warning.message}")
+            log(f"{photo.id}: {name}: {status_text(result)}, {result.seconds:.2f} s -> {folder}")
+            log_warnings(result, log)
             entries.append(
                 ReportEntry(
                     skull,
@@ -182,3 +175,17 @@ def run_case(
     report = write_report(out / "report.html", entries, title=title, command=command)
     log(f"report: {report}")
     return entries
+
+
+def status_text(result):
+    """One SFO's outcome for the console: camera and score (and terms off), or the failure."""
+    if not result:
+        return f"FAILED ({result.error})"
+    off = f", off: {', '.join(result.terms_off)}" if result.terms_off else ""
+    return f"focal {result.camera.focal_px:.0f} px, score {result.fitness:.4g}{off}"
+
+
+def log_warnings(result, log):
+    """One console line per SPEC section 10 warning of an SFO."""
+    for warning in result.warnings:
+        log(f"  warning {warning.code}: {warning.message}")

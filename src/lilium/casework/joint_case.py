@@ -9,6 +9,7 @@ Methods without a joint form (POSEST-SFO) run per photo as without ``--joint``.
 from pathlib import Path
 
 from ..methods.registry import METHODS, method_tag, run_joint_sfo
+from .case import log_warnings, status_text
 from .folders import check_distinct_photos, joint_overlay_name, write_joint_result
 
 #: Folder of the joint SFOs in a case's output folder.
@@ -82,15 +83,8 @@ def run_joint_methods(skull, records, methods, options, seed, out, log=print):
             f"{result.seconds:.2f} s -> {folder}"
         )
         for single in result.photos:
-            status = (
-                f"focal {single.camera.focal_px:.0f} px, score {single.fitness:.4g}"
-                if single
-                else f"FAILED ({single.error})"
-            )
-            off = f", off: {', '.join(single.terms_off)}" if single.terms_off else ""
-            log(f"  {single.photo_id}: {status}{off}")
-            for warning in single.warnings:
-                log(f"  warning {warning.code}: {warning.message}")
+            log(f"  {single.photo_id}: {status_text(single)}")
+            log_warnings(single, log)
         done[method] = (result, folder)
     return done
 
