@@ -25,6 +25,7 @@ from ..io.case import (
     read_prepared,
     read_skull,
     skull_from_files,
+    subject_files,
 )
 from ..io.curves import read_face_curve
 from ..io.formats import find_landmark_file
@@ -69,17 +70,9 @@ def load_skull(skull_path, landmarks=None, axes=None, log=None):
     if axes is not None:
         check_axes_file(axes)
     if skull_path.is_dir():
-        mesh = _first_file(skull_path, [f"skull{s}" for s in MESH_SUFFIXES])
-        if landmarks is None:
-            skull = read_skull(skull_path, axes_path=axes)
-            landmarks = _first_file(skull_path, ["cranial_landmarks.json"]) or find_landmark_file(
-                skull_path, ["cranial_landmarks", "skull"]
-            )
-        else:
-            if mesh is None:
-                read_skull(skull_path)  # raises its "no skull mesh" message
-            axes = axes or skull_path / "soft_tissue_axes.json"
-            skull = skull_from_files(mesh, landmarks, axes, skull_id=skull_path.name)
+        mesh, found = subject_files(skull_path)
+        landmarks = Path(landmarks) if landmarks is not None else found
+        skull = read_skull(skull_path, axes_path=axes, landmarks_path=landmarks)
         axes = Path(axes) if axes else skull_path / "soft_tissue_axes.json"
     elif skull_path.is_file():
         mesh = skull_path

@@ -68,7 +68,36 @@ def _field(path, data, key):
     return data[key]
 
 
-def read_skull(folder, axes_path=None):
+def subject_files(folder):
+    """The skull mesh and the cranial landmark file of a subject folder.
+
+    The landmarks are ``cranial_landmarks.json`` or, failing that, a Slicer / MeshLab / CSV file
+    (``cranial_landmarks.csv``, ``skull.mrk.json``, ...); when neither is there, the path of the
+    missing ``cranial_landmarks.json`` (reading it then names it).
+
+    Returns
+    -------
+    mesh_path, landmarks_path : Path
+
+    Raises
+    ------
+    ValueError
+        No ``skull.ply`` / ``.obj`` / ``.stl`` in the folder.
+    """
+    folder = Path(folder)
+    mesh_path = _find(
+        folder,
+        [f"skull{s}" for s in MESH_SUFFIXES],
+        "skull mesh",
+        "put the skull mesh (millimetres) there",
+    )
+    lm_path = folder / "cranial_landmarks.json"
+    if not lm_path.is_file():
+        lm_path = find_landmark_file(folder, ["cranial_landmarks", "skull"]) or lm_path
+    return mesh_path, lm_path
+
+
+def read_skull(folder, axes_path=None, landmarks_path=None):
     """Read a subject (skull) folder.
 
     Parameters
@@ -79,6 +108,8 @@ def read_skull(folder, axes_path=None):
     axes_path : str or Path, optional
         Soft-tissue axes file to use instead of the folder's own (e.g. a perturbed set); it
         must exist (a missing file is an error, never a silent fall-back to the normals).
+    landmarks_path : str or Path, optional
+        Cranial landmark file to use instead of the folder's own (any supported format).
 
     Returns
     -------
@@ -87,16 +118,9 @@ def read_skull(folder, axes_path=None):
         folder's name (:func:`lilium.io.paths.path_id`).
     """
     folder = _check_folder(folder, "subject")
-    mesh_path = _find(
-        folder,
-        [f"skull{s}" for s in MESH_SUFFIXES],
-        "skull mesh",
-        "put the skull mesh (millimetres) there",
-    )
-    lm_path = folder / "cranial_landmarks.json"
-    if not lm_path.is_file():
-        # A Slicer / MeshLab / CSV file instead (cranial_landmarks.csv, skull.mrk.json, ...).
-        lm_path = find_landmark_file(folder, ["cranial_landmarks", "skull"]) or lm_path
+    mesh_path, lm_path = subject_files(folder)
+    if landmarks_path is not None:
+        lm_path = Path(landmarks_path)
     if axes_path is not None:
         check_axes_file(axes_path)
     else:
