@@ -68,6 +68,13 @@ IMAGE_SIZES = (
 #: How far (mm) the jaw-line cut is lowered below the jaw border / the gonia (the face outline).
 NECK_CUT_MARGIN_MM = 4.0
 
+#: The jaw-line cut in front of the gonia follows the bone: a skin point is neck when it lies
+#: below its nearest bone vertex (within this angle of straight down) and farther from it than
+#: this depth plus the cut's margin.
+JAW_SKIN_DEPTH_MM = 8.0
+JAW_BELOW_ANGLE_DEG = 60.0
+JAW_BELOW_MOUTH_MM = 10.0
+
 #: How far (mm) below the skull the face mask's neck cut lies: with pitch, the skin under the
 #: jaw covers the mandible's lower border in the image, so a cut just under the bone would drop
 #: pixels the true skull projects onto.
@@ -245,6 +252,7 @@ def head_faces_of(
     facial_landmarks,
     margin_mm=NECK_CUT_MARGIN_MM,
     skull_vertices_mm=None,
+    jaw_bone_mm=None,
 ):
     """Which skin triangles belong to the head (above the neck cut, see the module notes).
 
@@ -280,7 +288,23 @@ def head_faces_of(
             margin_gonia = max(margin_mm, margin_mm - gonia[~anterior].min())
     anterior, jaw, gonia = heights(centroids)
     neck = np.where(anterior, jaw < -margin_jaw, gonia < -margin_gonia)
+    if jaw_bone_mm is not None and {"cheilion_l", "cheilion_r"} <= set(facial_landmarks):
+        mouth_y = min(facial_landmarks["cheilion_l"][1], facial_landmarks["cheilion_r"][1])
+        chin = anterior & (centroids[:, 1] < mouth_y - JAW_BELOW_MOUTH_MM)
+        neck = np.where(chin, _below_jaw_bone(centroids, jaw_bone_mm, margin_mm), neck)
     return ~neck
+
+
+def _below_jaw_bone(points_mm, bone_vertices_mm, margin_mm):
+    """Whether each point ``(N, 3)`` hangs below the bone, farther than ``JAW_SKIN_DEPTH_MM +
+    margin_mm`` from its nearest bone vertex, and more below it than beside it."""
+    from scipy.spatial import cKDTree
+
+    bone = np.asarray(bone_vertices_mm, dtype=float)
+    distance, index = cKDTree(bone).query(points_mm)
+    offset = points_mm - bone[index]
+    below = -offset[:, 1] > np.cos(np.radians(JAW_BELOW_ANGLE_DEG)) * distance
+    return below & (distance > JAW_SKIN_DEPTH_MM + margin_mm)
 
 
 def prepare_head(subject):
@@ -301,7 +325,7 @@ def prepare_head(subject):
         raise ValueError("the subject has no facial landmarks; a photo needs them")
     skull = getattr(subject, "head_skull_vertices_mm", None)  # the complete skull, if not given
     skull = getattr(subject, "skull_vertices_mm", None) if skull is None else skull
-    jaw = head_faces_of(vertices, faces, facial)
+    jaw = head_faces_of(vertices, faces, facial, jaw_bone_mm=skull)
     head = jaw
     if skull is not None:
         head = head_faces_of(vertices, faces, facial, NECK_SKULL_CLEARANCE_MM, skull)

@@ -1,0 +1,175 @@
+"""Identification on generated Exp. C photos: every method and Lilium variant, per view.
+
+Run: ``.venv/bin/python benchmarks/bench_identification.py [--out DIR] [--subjects 8]
+[--workers 2] [--generations 750]``. It generates (or reuses) a dataset of ``--subjects``
+subjects with one frontal and one lateral photo each (dataset seed ``--dataset-seed``), runs
+Exp. C (one axis set, one run, Lilium seed ``--seed``) for POSEST-SFO and the four Lilium
+variants against every skull with :func:`lilium.experiments.runner.run_experiment` (resumable:
+the same command again continues, or only prints when all is stored), and prints:
+
+1. per method, variant and view: mean rank of the true skull, rank-1 rate, ROC AUC per photo
+   (:mod:`lilium.experiments.identification`), mean BPE of the positive pairs and the number of
+   photos;
+2. per Lilium variant and view, the fitness terms of the true skull against the best-scoring
+   wrong skull of the same photo: medians over the photos of ``mse_pix``, ``p_pll``, ``p_skof``
+   and the score, and on how many photos the true skull wins.
+
+At the full budget (DE 30 x 750, 8 subjects: 128 SFOs per method) it takes about 45 minutes on
+2 cores; ``--generations 20`` checks the pipeline in a few minutes.
+"""
+
+import argparse
+import math
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from lilium.experiments.config import (
+    ALL_METHODS,
+    DatasetConfig,
+    ExperimentConfig,
+    method_label,
+    parse_methods,
+)
+from lilium.experiments.identification import complete_photo_runs, identification_table
+from lilium.experiments.report import load_rows, view_group
+from lilium.experiments.runner import run_experiment
+from lilium.optimisation.de import DEOptions
+
+TERMS = ("mse_pix", "p_pll", "p_skof", "score")
+
+
+def config(args):
+    out = Path(args.out)
+    return ExperimentConfig(
+        name="bench-identification",
+        dataset=DatasetConfig(out / "dataset", True, args.subjects, 1, args.dataset_seed),
+        experiments=("C",),
+        methods=parse_methods(args.methods.split(",")) if args.methods else ALL_METHODS,
+        repetitions=1,
+        axes_sets=1,
+        runs_per_axes_set=1,
+        seed=args.seed,
+        de=DEOptions(population_size=30, max_generations=args.generations, max_seconds=500.0),
+        workers=args.workers,
+        db=out / "results.sqlite",
+    )
+
+
+def _score(row):
+    ok = row["success"] and row["score"] is not None and np.isfinite(row["score"])
+    return float(row["score"]) if ok else math.inf
+
+
+def bpe_means(rows):
+    """Mean BPE (mm) of the positive pairs with a camera, per (method label, view group)."""
+    values = defaultdict(list)
+    for r in rows:
+        if r["positive"] and r["bpe_mm"] is not None:
+            values[(method_label(r["method"], r["variant"]), view_group(r["view"]))].append(
+                r["bpe_mm"]
+            )
+    return {k: float(np.mean(v)) for k, v in values.items()}
+
+
+def term_contrast(rows):
+    """Per (method label, view group): the terms of the true skull and of the best wrong one.
+
+    Returns
+    -------
+    dict
+        ``{(label, view): {"true": {term: [...]}, "wrong": {term: [...]}, "wins": int,
+        "photos": int}}``, one list entry per complete photo-run.
+    """
+    by_key = {
+        (
+            r["experiment"],
+            r["method"],
+            r["variant"],
+            r["axes_set"],
+            r["repetition"],
+            r["photo"],
+            r["subject"],
+        ): r
+        for r in rows
+    }
+    out = {}
+    for key, view, true_subject, scores in complete_photo_runs(rows, _score):
+        exp, method, variant, axes, rep, photo = key
+        label, group = method_label(method, variant), view_group(view)
+        entry = out.setdefault(
+            (label, group),
+            {"true": defaultdict(list), "wrong": defaultdict(list), "wins": 0, "photos": 0},
+        )
+        wrong = min((s for s in scores if s != true_subject), key=lambda s: scores[s])
+        entry["photos"] += 1
+        entry["wins"] += scores[true_subject] < scores[wrong]
+        for side, subject in (("true", true_subject), ("wrong", wrong)):
+            row = by_key[(exp, method, variant, axes, rep, photo, subject)]
+            for term in TERMS:
+                value = row[term]
+                entry[side][term].append(np.nan if value is None else float(value))
+    return out
+
+
+def _f(value, digits=2):
+    return "-" if value is None or not np.isfinite(value) else f"{value:.{digits}f}"
+
+
+def print_tables(rows, file=sys.stdout):
+    ident = identification_table(rows)
+    bpe = bpe_means(rows)
+    print("| method | view | mean rank | rank-1 | AUC | BPE mm | photos |", file=file)
+    print("|---|---|---|---|---|---|---|", file=file)
+    for t in ident:
+        b = bpe.get((t["method"], t["view"]))
+        print(
+            f"| {t['method']} | {t['view']} | {_f(t['mean_rank'])} | {_f(t['rank1_rate'])} | "
+            f"{_f(t['auc'])} | {_f(b)} | {t['photo_runs']} (of {t['skulls']} skulls) |",
+            file=file,
+        )
+    print(file=file)
+    print(
+        "| method | view | true wins | "
+        + " | ".join(f"{t} true / best wrong" for t in TERMS)
+        + " |",
+        file=file,
+    )
+    print("|---|---|---|" + "---|" * len(TERMS), file=file)
+    for (label, view), e in sorted(term_contrast(rows).items(), key=lambda kv: kv[0][::-1]):
+        cells = [
+            f"{_f(np.nanmedian(e['true'][t]), 1)} / {_f(np.nanmedian(e['wrong'][t]), 1)}"
+            if np.isfinite(e["true"][t]).any()
+            else "-"
+            for t in TERMS
+        ]
+        print(
+            f"| {label} | {view} | {e['wins']}/{e['photos']} | " + " | ".join(cells) + " |",
+            file=file,
+        )
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default="bench-identification")
+    parser.add_argument("--subjects", type=int, default=8)
+    parser.add_argument("--dataset-seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--generations", type=int, default=750)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument(
+        "--methods", default="", help="comma-separated, e.g. posest-sfo,lilium:skof (default all)"
+    )
+    parser.add_argument("--print-only", action="store_true", help="only print the stored rows")
+    args = parser.parse_args(argv)
+    cfg = config(args)
+    if not args.print_only:
+        run_experiment(cfg, progress=False)
+    print_tables(load_rows(cfg.db))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
