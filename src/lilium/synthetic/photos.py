@@ -32,12 +32,20 @@ away from the camera hide the midline ones) is drawn again, camera and all.
 
 Two cuts of the skin (see :func:`head_faces_of`): in front of the gonia a plane through the
 facial gnathion and both facial gonia (the lower border of the jaw), behind them the horizontal
-plane through the gonia. The *jaw-line cut* lowers them by :data:`NECK_CUT_MARGIN_MM`: the skin
-above it is the face's own outline, from which the chin-jaw curve of ``face_curve.json`` is taken
-(SPEC 5's mask rule applied to that outline). The *face mask* keeps the upper neck too: its cut
-lies :data:`NECK_SKULL_CLEARANCE_MM` below the whole skull, so that, as in a real photo of a head,
-the true skull projects inside the mask from every camera of the ranges (P_skof 0 at the truth).
-Both cuts are properties of the subject, the same in every photo.
+plane through the gonia. The *jaw-line cut* lowers them by :data:`NECK_CUT_MARGIN_MM`, and under
+the chin (in front of the gonia, more than :data:`JAW_BELOW_MOUTH_MM` below the mouth corners) it
+follows the mandible instead of the plane: skin hanging below the bone farther than
+the subject's chin depth is neck (:data:`JAW_BELOW_ANGLE_DEG`). The skin above it is the face's own outline, from
+which the chin-jaw curve of ``face_curve.json`` is taken (SPEC 5's mask rule applied to that
+outline). A plane there would be seen nearly edge-on from the front, so the facial chin-jaw
+curve would be a flat line whatever the jaw's shape, while the bony chin's outline is a U: the
+true skull's own P_pll was then large (issue 20, measured in docs/method.md); following the bone
+keeps the skin's chin outline as curved as the real one (``benchmarks/chin_profile.py``).
+
+The *face mask* keeps the upper neck too: its cut lies :data:`NECK_SKULL_CLEARANCE_MM` below the
+whole skull, so that, as in a real photo of a head, the true skull projects inside the mask from
+every camera of the ranges (P_skof 0 at the truth). Both cuts are properties of the subject, the
+same in every photo.
 """
 
 from dataclasses import dataclass, field
@@ -68,12 +76,17 @@ IMAGE_SIZES = (
 #: How far (mm) the jaw-line cut is lowered below the jaw border / the gonia (the face outline).
 NECK_CUT_MARGIN_MM = 4.0
 
-#: The jaw-line cut in front of the gonia follows the bone: a skin point is neck when it lies
-#: below its nearest bone vertex (within this angle of straight down) and farther from it than
-#: this depth plus the cut's margin.
-JAW_SKIN_DEPTH_MM = 8.0
+#: Under the chin the jaw-line cut follows the mandible: a skin point more than
+#: ``JAW_BELOW_MOUTH_MM`` below the mouth corners is neck when it lies below its nearest bone
+#: vertex (within ``JAW_BELOW_ANGLE_DEG`` of straight down) and farther from it than the
+#: subject's own chin depth (facial gnathion to the nearest bone vertex, ``JAW_DEPTH_FALLBACK_MM``
+#: without a facial gnathion) plus ``JAW_CUT_MARGIN_MM``: the outline then lies about one chin
+#: depth below the bone all along the jaw, as in a real head (``benchmarks/chin_profile.py``).
 JAW_BELOW_ANGLE_DEG = 60.0
 JAW_BELOW_MOUTH_MM = 10.0
+JAW_BEYOND_MOUTH_MM = 5.0
+JAW_CUT_MARGIN_MM = 4.0
+JAW_DEPTH_FALLBACK_MM = 8.5
 
 #: How far (mm) below the skull the face mask's neck cut lies: with pitch, the skin under the
 #: jaw covers the mandible's lower border in the image, so a cut just under the bone would drop
@@ -268,6 +281,9 @@ def head_faces_of(
     skull_vertices_mm : array_like of shape (K, 3), optional
         When given, each plane is lowered further where needed so that the whole skull lies
         at least ``margin_mm`` above it.
+    jaw_bone_mm : array_like of shape (K, 3), optional
+        The complete skull's vertices: under the chin the cut follows this bone (the jaw-line
+        cut, see the module notes; needs both cheilions).
 
     Returns
     -------
@@ -289,22 +305,31 @@ def head_faces_of(
     anterior, jaw, gonia = heights(centroids)
     neck = np.where(anterior, jaw < -margin_jaw, gonia < -margin_gonia)
     if jaw_bone_mm is not None and {"cheilion_l", "cheilion_r"} <= set(facial_landmarks):
-        mouth_y = min(facial_landmarks["cheilion_l"][1], facial_landmarks["cheilion_r"][1])
-        chin = anterior & (centroids[:, 1] < mouth_y - JAW_BELOW_MOUTH_MM)
-        neck = np.where(chin, _below_jaw_bone(centroids, jaw_bone_mm, margin_mm), neck)
+        left, right = (np.asarray(facial_landmarks[n], float) for n in ("cheilion_l", "cheilion_r"))
+        half_width = 0.5 * abs(left[0] - right[0]) + JAW_BEYOND_MOUTH_MM
+        chin = (
+            anterior
+            & (centroids[:, 1] < min(left[1], right[1]) - JAW_BELOW_MOUTH_MM)
+            & (np.abs(centroids[:, 0] - 0.5 * (left[0] + right[0])) < half_width)
+        )
+        neck = np.where(chin, _below_jaw_bone(centroids, jaw_bone_mm, facial_landmarks), neck)
     return ~neck
 
 
-def _below_jaw_bone(points_mm, bone_vertices_mm, margin_mm):
-    """Whether each point ``(N, 3)`` hangs below the bone, farther than ``JAW_SKIN_DEPTH_MM +
-    margin_mm`` from its nearest bone vertex, and more below it than beside it."""
+def _below_jaw_bone(points_mm, bone_vertices_mm, facial_landmarks):
+    """Whether each point ``(N, 3)`` hangs below the bone deeper than the chin's soft tissue
+    (the jaw-line cut under the chin, see :data:`JAW_BELOW_ANGLE_DEG`)."""
     from scipy.spatial import cKDTree
 
     bone = np.asarray(bone_vertices_mm, dtype=float)
-    distance, index = cKDTree(bone).query(points_mm)
+    tree = cKDTree(bone)
+    depth_mm = JAW_DEPTH_FALLBACK_MM
+    if "gnathion" in facial_landmarks:
+        depth_mm = float(tree.query(np.asarray(facial_landmarks["gnathion"], dtype=float))[0])
+    distance, index = tree.query(points_mm)
     offset = points_mm - bone[index]
     below = -offset[:, 1] > np.cos(np.radians(JAW_BELOW_ANGLE_DEG)) * distance
-    return below & (distance > JAW_SKIN_DEPTH_MM + margin_mm)
+    return below & (distance > depth_mm + JAW_CUT_MARGIN_MM)
 
 
 def prepare_head(subject):
