@@ -54,6 +54,24 @@ def superellipsoid(p, centre, radii, exponents, rotation=None):
     return (s ** (1.0 / np.mean(exponents)) - 1.0) * r.min()
 
 
+def elliptic_cylinder(p, centre, radii, z_lo, z_hi):
+    """Rough signed distance to an elliptic cylinder along z, cut by the planes ``z_lo``, ``z_hi``.
+
+    Parameters
+    ----------
+    p : tuple of 3 broadcastable arrays (x, y, z), mm
+    centre : array_like
+        ``(x, y)`` of the axis, mm (a third value is ignored).
+    radii : array_like
+        Semi-axes along x and y, mm.
+    z_lo, z_hi : float
+        The two ends, mm.
+    """
+    a, b = float(radii[0]), float(radii[1])
+    k = np.sqrt(((p[0] - centre[0]) / a) ** 2 + ((p[1] - centre[1]) / b) ** 2)
+    return np.maximum((k - 1.0) * min(a, b), np.maximum(z_lo - p[2], p[2] - z_hi))
+
+
 def capsule(p, a, b, ra, rb=None):
     """Signed distance to a segment ``a``-``b`` thickened by a radius from ``ra`` to ``rb``."""
     a = np.asarray(a, float)

@@ -3,15 +3,23 @@
 Each function adds one part to the bone field (negative inside, skull frame, mm) of
 :func:`lilium.synthetic.anatomy.bone.build_bone`, in this order: cranial vault with its
 low-frequency bumps, temporal fossae, upper face block and maxilla, zygomatic bodies and
-arches with the temporal roots and mastoids, brow ridges and glabella, orbits and their
-margins, nasal bones, nasal aperture and cavity with the anterior nasal spine, and (last, after
-the jaws) the external ear canals. The numbers of every part are the tables below; a centre of
-a bilateral part is the left one (``x > 0``), mirrored with ``sx = -1``.
+arches with the temporal roots and mastoids, brow ridges and glabella, orbits with their
+entrances and margins, nasal bones, nasal aperture and cavity with the anterior nasal spine,
+and (last, after the jaws) the external ear canals. The numbers of every part are the tables
+below; a centre of a bilateral part is the left one (``x > 0``), mirrored with ``sx = -1``.
 """
 
 import numpy as np
 
-from ..volume_fields import capsule, ellipsoid, plane, rotation_xyz, slab, superellipsoid
+from ..volume_fields import (
+    capsule,
+    ellipsoid,
+    elliptic_cylinder,
+    plane,
+    rotation_xyz,
+    slab,
+    superellipsoid,
+)
 from .parts import Blob, add_capsule, add_ellipsoid
 
 # --------------------------------------------------------------------------------------------
@@ -88,11 +96,13 @@ GLABELLA = {
 }
 #: Orbit cavity (subtracted): the design ellipsoid turned by ``(x, y)`` degrees (y mirrored).
 ORBIT_CAVITY = {"tilt_deg": (-8.0, 14.0), "margin_mm": 6, "blend_mm": 2.5}
-#: Orbital margin: a ring of capsules just outside the opening; the lateral side is set back,
-#: the lower half a little too; thickness grows towards the lateral side.
+#: Orbital margin: a ring of capsules around the opening, ``offset_mm`` (x, y) outside the
+#: design ellipse (the transverse offset makes the orbital breadth M51a, dacryon to
+#: ectoconchion, about 40 mm); the lateral side is set back, the lower half a little too;
+#: thickness grows towards the lateral side.
 ORBITAL_MARGIN = {
     "points": 19,
-    "offset_mm": 1.5,
+    "offset_mm": (3.5, 1.5),
     "front_z_mm": 81.0,
     "lateral_setback_mm": 11.0,
     "lower_setback_mm": 2.0,
@@ -100,6 +110,12 @@ ORBITAL_MARGIN = {
     "box_margin_mm": 8,
     "blend_mm": 2.0,
 }
+#: Orbital entrance (subtracted): an elliptic cylinder along z, from ``back_z_mm`` to
+#: ``front_z_mm``, whose edge is the inner edge of the margin's medial side (semi-axes: the
+#: design ones plus the margin's offset less its medial thickness). It clears the face block
+#: and the brow in front of the cavity, which otherwise closed the medial third of the opening
+#: (dacryon about 23 mm off the midline instead of about 13).
+ORBITAL_ENTRANCE = {"back_z_mm": 66.0, "front_z_mm": 110.0, "box_margin_mm": 6, "blend_mm": 4.0}
 #: Nasal bones: a slab from below the brow (y = brow y + dy) to ``(0, y * fh, z + 0.3 * pr)``.
 NASAL_BONES = {
     "top_dy_mm": -10.0,
@@ -114,7 +130,9 @@ NASAL_BONES = {
     "blend_mm": 3,
 }
 #: Nasal aperture (the design ellipsoid, subtracted) and the cavity behind it (centre y
-#: scaled by ``fh``).
+#: scaled by ``fh``, x radius by the nasal width factor like the aperture's: unscaled, the
+#: cavity's side walls made the aperture's lateral margins, and alare-alare grew about 17 mm
+#: per unit of the factor instead of about 21).
 NASAL_APERTURE = {"margin_mm": 6, "blend_mm": 2}
 NASAL_CAVITY = Blob((0.0, -6.0, 62.0), (13.0, 22.0, 26.0), 6, 3)
 #: Anterior nasal spine: a capsule ``length_mm`` long ending at the design ANS point.
@@ -257,26 +275,41 @@ def add_brow(bone, s, d):
 
 
 def add_orbits(bone, d):
-    """Orbit cavities and their margins (in place)."""
+    """Orbit cavities, their entrances and their margins (in place)."""
     oc = ORBIT_CAVITY
     for sx in (1, -1):
         c, r = d["orbit"] * (sx, 1, 1), d["orbit_radii"]
         rot = rotation_xyz(oc["tilt_deg"][0], sx * oc["tilt_deg"][1], 0.0)
         add_ellipsoid(bone, c, r, oc["margin_mm"], "subtract", oc["blend_mm"], rot)
+        _add_orbital_entrance(bone, c, r)
     for sx in (1, -1):
         _add_orbital_margin(bone, d["orbit"] * (sx, 1, 1), d["orbit_radii"], sx)
+
+
+def _add_orbital_entrance(bone, o, r):
+    """Clear the bone in front of one orbit cavity, inside its margin (in place)."""
+    oe, (off_x, off_y) = ORBITAL_ENTRANCE, ORBITAL_MARGIN["offset_mm"]
+    t = ORBITAL_MARGIN["thickness_mm"][0]
+    radii = (r[0] + off_x - t, r[1] + off_y - t)
+    z0, z1, m = oe["back_z_mm"], oe["front_z_mm"], oe["box_margin_mm"]
+    lo = (o[0] - radii[0] - m, o[1] - radii[1] - m, z0 - m)
+    hi = (o[0] + radii[0] + m, o[1] + radii[1] + m, z1 + m)
+    bone.combine(
+        lambda p: elliptic_cylinder(p, o, radii, z0, z1), lo, hi, "subtract", oe["blend_mm"]
+    )
 
 
 def _add_orbital_margin(bone, o, r, sx):
     """A ring of bars around one orbital opening, the lateral side set back (in place)."""
     om = ORBITAL_MARGIN
+    off_x, off_y = om["offset_mm"]
     phi = np.linspace(0, 2 * np.pi, om["points"])
     lateral = 0.5 * (1 + np.cos(phi))  # 1 at the lateral margin, 0 at the medial one
     lower = (np.sin(phi) < 0) * np.abs(np.sin(phi))
     ring = np.column_stack(
         [
-            o[0] + sx * (r[0] + om["offset_mm"]) * np.cos(phi),
-            o[1] + (r[1] + om["offset_mm"]) * np.sin(phi),
+            o[0] + sx * (r[0] + off_x) * np.cos(phi),
+            o[1] + (r[1] + off_y) * np.sin(phi),
             om["front_z_mm"] - om["lateral_setback_mm"] * lateral - om["lower_setback_mm"] * lower,
         ]
     )
@@ -308,7 +341,8 @@ def add_nose(bone, s, d):
     c, r = d["nasal_aperture"], d["nasal_aperture_radii"]
     add_ellipsoid(bone, c, r, na["margin_mm"], "subtract", na["blend_mm"])
     c2 = (cav.centre_mm[0], cav.centre_mm[1] * fh, cav.centre_mm[2])
-    add_ellipsoid(bone, c2, cav.radii_mm, cav.margin_mm, "subtract", cav.blend_mm)
+    r2 = (cav.radii_mm[0] * s.nasal_width, *cav.radii_mm[1:])
+    add_ellipsoid(bone, c2, r2, cav.margin_mm, "subtract", cav.blend_mm)
     sp = NASAL_SPINE
     a, b = d["ans"] - (0, 0, sp["length_mm"]), d["ans"]
     add_capsule(bone, a, b, *sp["radius_mm"], sp["box_margin_mm"], "union", sp["blend_mm"])

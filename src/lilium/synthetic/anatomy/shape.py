@@ -30,10 +30,11 @@ class TruncatedNormal:
 SHAPE_PRIORS = {
     # Tuned so that the craniometric spread matches the pooled-sex adult values of
     # :data:`~.craniometry.PUBLISHED` (docs/population.md). Bounds about +-2 SD: wider ones
-    # let the skin lose a landmark (nasal_width 1.36, face_height 1.2 fail). The means differ
-    # from the measured values by the offset of each measurement's landmarks from the design
-    # position (e.g. glabella-opisthocranion = cranial_length - 4 mm, gonion-gonion =
-    # jaw_width + 8 mm).
+    # let the skin lose a landmark (face_height 1.2 failed). The means differ from the
+    # measured values by the offset of each measurement's landmarks from the design position
+    # (e.g. glabella-opisthocranion = cranial_length - 4 mm, gonion-gonion = jaw_width + 8 mm;
+    # alare-alare grows about 21 mm per unit of nasal_width: 20.3 to 29.7 mm from 0.85 to 1.3
+    # on one skull).
     "cranial_length": TruncatedNormal(184.0, 7.6, 169.0, 199.0),
     "cranial_breadth": TruncatedNormal(139.7, 6.0, 128.0, 151.0),
     "vault_height": TruncatedNormal(1.0, 0.04, 0.92, 1.08),
@@ -46,7 +47,7 @@ SHAPE_PRIORS = {
     "brow": TruncatedNormal(0.8, 0.3, 0.25, 1.4),
     "prognathism_mm": TruncatedNormal(0.0, 2.0, -3.5, 3.5),
     "orbit": TruncatedNormal(1.0, 0.05, 0.9, 1.1),
-    "nasal_width": TruncatedNormal(1.04, 0.07, 0.88, 1.15),
+    "nasal_width": TruncatedNormal(1.07, 0.11, 0.85, 1.29),
     "nose_projection_mm": TruncatedNormal(18.0, 2.2, 14.0, 23.0),
     "ear": TruncatedNormal(1.0, 0.07, 0.88, 1.12),
 }
