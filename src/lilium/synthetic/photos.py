@@ -30,17 +30,18 @@ e.g. the far-side zygion and gonion in a lateral view are dropped. A photo with 
 :data:`MIN_VISIBLE_LANDMARKS` visible landmarks usable for pose estimation (lateral views turned
 away from the camera hide the midline ones) is drawn again, camera and all.
 
-Two cuts of the skin (see :func:`head_faces_of`): in front of the gonia a plane through the
-facial gnathion and both facial gonia (the lower border of the jaw), behind them the horizontal
-plane through the gonia. The *jaw-line cut* lowers them by :data:`NECK_CUT_MARGIN_MM`, and under
-the chin (in front of the gonia, more than :data:`JAW_BELOW_MOUTH_MM` below the mouth corners) it
-follows the mandible instead of the plane: skin hanging below the bone farther than
-the subject's chin depth is neck (:data:`JAW_BELOW_ANGLE_DEG`). The skin above it is the face's own outline, from
-which the chin-jaw curve of ``face_curve.json`` is taken (SPEC 5's mask rule applied to that
-outline). A plane there would be seen nearly edge-on from the front, so the facial chin-jaw
-curve would be a flat line whatever the jaw's shape, while the bony chin's outline is a U: the
-true skull's own P_pll was then large (issue 20, measured in docs/method.md); following the bone
-keeps the skin's chin outline as curved as the real one (``benchmarks/chin_profile.py``).
+Two cuts of the skin (see :func:`head_faces_of`): in front of the gonia a plane through the facial
+gnathion and both facial gonia (the lower border of the jaw), behind them the horizontal plane
+through the gonia. The *jaw-line cut* lowers them by :data:`NECK_CUT_MARGIN_MM`, and under the chin
+(in front of the gonia, more than :data:`JAW_BELOW_MOUTH_MM` below the mouth corners, at most
+:data:`JAW_BEYOND_MOUTH_MM` beyond them sideways) it follows the mandible instead of the plane: skin
+hanging below the bone farther than the subject's chin depth is neck (:data:`JAW_BELOW_ANGLE_DEG`).
+The skin above it is the face's own outline, from which the chin-jaw curve of ``face_curve.json`` is
+taken (SPEC 5's mask rule applied to that outline). A plane there would be seen nearly edge-on from
+the front, so the facial chin-jaw curve would be a flat line whatever the jaw's shape, while the
+bony chin's outline is a U: the true skull's own P_pll was then large (issue 20, measured in
+docs/method.md); following the bone keeps the skin's chin outline as curved as the real one
+(``benchmarks/chin_profile.py``).
 
 The *face mask* keeps the upper neck too: its cut lies :data:`NECK_SKULL_CLEARANCE_MM` below the
 whole skull, so that, as in a real photo of a head, the true skull projects inside the mask from
@@ -77,11 +78,13 @@ IMAGE_SIZES = (
 NECK_CUT_MARGIN_MM = 4.0
 
 #: Under the chin the jaw-line cut follows the mandible: a skin point more than
-#: ``JAW_BELOW_MOUTH_MM`` below the mouth corners is neck when it lies below its nearest bone
+#: ``JAW_BELOW_MOUTH_MM`` below the mouth corners and at most ``JAW_BEYOND_MOUTH_MM`` beyond them
+#: sideways (the chin, where the facial curve is taken) is neck when it lies below its nearest bone
 #: vertex (within ``JAW_BELOW_ANGLE_DEG`` of straight down) and farther from it than the
 #: subject's own chin depth (facial gnathion to the nearest bone vertex, ``JAW_DEPTH_FALLBACK_MM``
-#: without a facial gnathion) plus ``JAW_CUT_MARGIN_MM``: the outline then lies about one chin
-#: depth below the bone all along the jaw, as in a real head (``benchmarks/chin_profile.py``).
+#: without a facial gnathion) plus ``JAW_CUT_MARGIN_MM``: the outline then follows the bone, as
+#: in a real head (``benchmarks/chin_profile.py``), one chin depth below it under the midline and
+#: up to the margin deeper at the sides.
 #: The 4 mm margin: closer, the cut runs through the chin's own skin and its triangles leave a
 #: ragged outline (at 2 mm the true skull had P_int > 0 at its true camera on 3 of 8 frontal
 #: photos of seed 0, at 1 mm on 2; none at 4 mm).
