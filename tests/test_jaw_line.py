@@ -5,7 +5,7 @@ cut. A cut by a plane through gnathion and the gonia is seen nearly edge-on from
 the facial curve came out flat whatever the jaw's shape while the bony chin's outline is a U:
 P_pll then penalised the true skull at its true camera. Measured on the 8 frontal photos of a
 generated Exp. C set (seed 0): the facial curve's rise (lowest point to the mean of its end
-tenths, pixels) was a median 0.45 of the trimmed skull curve's with the plane and 0.88 with the
+tenths, pixels) was a median 0.46 of the trimmed skull curve's with the plane and 0.88 with the
 cut that follows the bone.
 """
 
