@@ -90,3 +90,19 @@ def test_full_method_recovers_the_camera_on_a_generated_noise_free_photo(tmp_pat
         assert abs(result.camera.focal_px - f_true) / f_true < 0.05
         assert geodesic_angle_deg(result.camera.R, truth.camera.R) < 5.0
         assert score(result, truth).bpe_mm < 3.0
+
+
+def test_run_off_focal_is_written_in_scientific_notation():
+    # A run-off fit (focal 1e129 px, seen in an experiment) must give a one-line message, not
+    # a 130-digit number.
+    from types import SimpleNamespace
+
+    from lilium.inputs import CameraPriors
+    from lilium.methods.lilium import _failure_message
+
+    photo = SimpleNamespace(priors=CameraPriors())
+    problem = SimpleNamespace(facing=None, focal_cap_px=10000.0, photo=photo, skull=None)
+    best = {"R": np.eye(3), "t": np.zeros(3), "focal_px": 3.16e129}
+    message = _failure_message(problem, best)
+    assert "3.16e+129 px" in message and len(message) < 400
+    assert "runs off towards an infinite focal length" in message

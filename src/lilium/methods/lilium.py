@@ -410,7 +410,7 @@ def _failure_message(problem, best):
         return facing_failure(problem.skull, problem.photo)
     if finite and f > problem.focal_cap_px:
         return (
-            f"no camera found: the best soft-tissue estimate needs a focal length of {f:.0f} px; "
+            f"no camera found: the best soft-tissue estimate needs a focal length of {f:.4g} px; "
             + focal_cap_message(problem.photo, f)
         )
     return "no camera found for the best soft-tissue estimate"
