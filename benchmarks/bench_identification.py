@@ -19,8 +19,9 @@ the same command again continues, or only prints when all is stored), and prints
    the cameras are good but the fitness ranks poorly, the fitness's freedom (three soft-tissue
    genes per landmark fit the landmarks of any skull) is what limits identification.
 
-At the full budget (DE 30 x 750, 8 subjects: 128 SFOs per method) it takes about 45 minutes on
-2 cores; ``--generations 20`` checks the pipeline in a few minutes.
+At the full budget (DE 30 x 750, 8 subjects: 128 SFOs per method, 640 in all) it took 438 s on
+2 workers and 936 s on one (measured); ``--generations 3 --subjects 3`` checks the pipeline in
+under a minute. Results and their discussion: docs/method.md, "Identification on frontal photos".
 """
 
 import argparse
@@ -183,7 +184,7 @@ def print_identification(rows, file=sys.stdout):
         )
 
 
-def print_tables(rows, root, file=sys.stdout):
+def print_tables(rows, file=sys.stdout):
     print_identification(rows, file)
     print(file=file)
     print(
@@ -193,7 +194,6 @@ def print_tables(rows, root, file=sys.stdout):
         file=file,
     )
     print("|---|---|---|" + "---|" * len(TERMS), file=file)
-    del root
     for (label, view), e in sorted(term_contrast(rows).items(), key=lambda kv: kv[0][::-1]):
         cells = [
             f"{_f(np.nanmedian(e['true'][t]), 1)} / {_f(np.nanmedian(e['wrong'][t]), 1)}"
@@ -223,7 +223,7 @@ def main(argv=None):
     cfg = config(args)
     if not args.print_only:
         run_experiment(cfg, progress=False)
-    print_tables(load_rows(cfg.db), cfg.dataset.path)
+    print_tables(load_rows(cfg.db))
     with ResultStore(cfg.db, read_only=True) as store:
         rescored = mean_depth_scores(store.rows(list(COLUMNS)), cfg.dataset.path)
     print("\nLilium ranked by the mean-depth landmarks' pixel error under its camera:")
