@@ -1,12 +1,15 @@
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from lilium.evaluation import score
 from lilium.geometry import geodesic_angle_deg
+from lilium.inputs import CameraPriors
 from lilium.io.case import read_photo, read_skull
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions
-from lilium.methods.lilium import LiliumProblem, lilium_sfo
+from lilium.methods.lilium import LiliumProblem, _failure_message, lilium_sfo
 from lilium.optimisation import DEOptions
 
 
@@ -92,17 +95,15 @@ def test_full_method_recovers_the_camera_on_a_generated_noise_free_photo(tmp_pat
         assert score(result, truth).bpe_mm < 3.0
 
 
-def test_run_off_focal_is_written_in_scientific_notation():
-    # A run-off fit (focal 1e129 px, seen in an experiment) must give a one-line message, not
-    # a 130-digit number.
-    from types import SimpleNamespace
-
-    from lilium.inputs import CameraPriors
-    from lilium.methods.lilium import _failure_message
-
+def test_refused_focal_lengths_read_well_in_the_message():
+    # Over the cap: whole pixels; a run-off fit (1e129 px, seen in an experiment): 3 digits,
+    # not a 130-digit number.
     photo = SimpleNamespace(priors=CameraPriors())
     problem = SimpleNamespace(facing=None, focal_cap_px=10000.0, photo=photo, skull=None)
-    best = {"R": np.eye(3), "t": np.zeros(3), "focal_px": 3.16e129}
+    best = {"R": np.eye(3), "t": np.zeros(3), "focal_px": 12345.4}
+    message = _failure_message(problem, best)
+    assert "needs a focal length of 12345 px" in message and "capped at 10000 px" in message
+    best["focal_px"] = 3.16e129
     message = _failure_message(problem, best)
     assert "3.16e+129 px" in message and len(message) < 400
     assert "runs off towards an infinite focal length" in message

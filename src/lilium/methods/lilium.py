@@ -402,6 +402,11 @@ def photo_outcome(problem, best, seed):
     return camera, terms, error, warnings
 
 
+def _px(focal_px):
+    """A focal length for a message: whole pixels, or 3 significant digits for a run-off fit."""
+    return f"{focal_px:.0f}" if focal_px < 1e6 else f"{focal_px:.3g}"
+
+
 def _failure_message(problem, best):
     """Why the best member has no camera: behind the skull, over the focal cap, or neither."""
     R, t, f = np.asarray(best["R"]), np.asarray(best["t"]), float(best["focal_px"])
@@ -410,7 +415,7 @@ def _failure_message(problem, best):
         return facing_failure(problem.skull, problem.photo)
     if finite and f > problem.focal_cap_px:
         return (
-            f"no camera found: the best soft-tissue estimate needs a focal length of {f:.4g} px; "
+            f"no camera found: the best soft-tissue estimate needs a focal length of {_px(f)} px; "
             + focal_cap_message(problem.photo, f)
         )
     return "no camera found for the best soft-tissue estimate"

@@ -35,7 +35,8 @@ gnathion and both facial gonia (the lower border of the jaw), behind them the ho
 through the gonia. The *jaw-line cut* lowers them by :data:`NECK_CUT_MARGIN_MM`, and under the chin
 (in front of the gonia, more than :data:`JAW_BELOW_MOUTH_MM` below the mouth corners, at most
 :data:`JAW_BEYOND_MOUTH_MM` beyond them sideways) it follows the mandible instead of the plane: skin
-hanging below the bone farther than the subject's chin depth is neck (:data:`JAW_BELOW_ANGLE_DEG`).
+hanging below the bone farther than the subject's chin depth + :data:`JAW_CUT_MARGIN_MM` is neck
+(:data:`JAW_BELOW_ANGLE_DEG`).
 The skin above it is the face's own outline, from which the chin-jaw curve of ``face_curve.json`` is
 taken (SPEC 5's mask rule applied to that outline). A plane there would be seen nearly edge-on from
 the front, so the facial chin-jaw curve would be a flat line whatever the jaw's shape, while the
@@ -58,6 +59,7 @@ from ..fitness import curves as _curves
 from ..fitness.curves import check_view
 from ..geometry.camera import Camera, principal_point_of
 from ..geometry.rotations import rotvec_to_matrix
+from ..softtissue.depths import BUILTIN_DEPTHS
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
 from . import render as _render
 
@@ -92,7 +94,7 @@ JAW_BELOW_ANGLE_DEG = 60.0
 JAW_BELOW_MOUTH_MM = 10.0
 JAW_BEYOND_MOUTH_MM = 5.0
 JAW_CUT_MARGIN_MM = 4.0
-JAW_DEPTH_FALLBACK_MM = 8.5
+JAW_DEPTH_FALLBACK_MM = BUILTIN_DEPTHS["gnathion"].mean_mm
 
 #: How far (mm) below the skull the face mask's neck cut lies: with pitch, the skin under the
 #: jaw covers the mandible's lower border in the image, so a cut just under the bone would drop
@@ -310,21 +312,34 @@ def head_faces_of(
             margin_gonia = max(margin_mm, margin_mm - gonia[~anterior].min())
     anterior, jaw, gonia = heights(centroids)
     neck = np.where(anterior, jaw < -margin_jaw, gonia < -margin_gonia)
-    if jaw_bone_mm is not None and {"cheilion_l", "cheilion_r"} <= set(facial_landmarks):
+    has_bone = jaw_bone_mm is not None and len(jaw_bone_mm) > 0
+    if has_bone and {"cheilion_l", "cheilion_r"} <= set(facial_landmarks):
         left, right = (np.asarray(facial_landmarks[n], float) for n in ("cheilion_l", "cheilion_r"))
-        half_width = 0.5 * abs(left[0] - right[0]) + JAW_BEYOND_MOUTH_MM
+        half_width_mm = 0.5 * abs(left[0] - right[0]) + JAW_BEYOND_MOUTH_MM
         chin = (
             anterior
             & (centroids[:, 1] < min(left[1], right[1]) - JAW_BELOW_MOUTH_MM)
-            & (np.abs(centroids[:, 0] - 0.5 * (left[0] + right[0])) < half_width)
+            & (np.abs(centroids[:, 0] - 0.5 * (left[0] + right[0])) < half_width_mm)
         )
         neck = np.where(chin, _below_jaw_bone(centroids, jaw_bone_mm, facial_landmarks), neck)
     return ~neck
 
 
 def _below_jaw_bone(points_mm, bone_vertices_mm, facial_landmarks):
-    """Whether each point ``(N, 3)`` hangs below the bone deeper than the chin's soft tissue
-    (the jaw-line cut under the chin, see :data:`JAW_BELOW_ANGLE_DEG`)."""
+    """Which points hang below the bone deeper than the chin's soft tissue (the jaw-line cut
+    under the chin, see :data:`JAW_BELOW_ANGLE_DEG`).
+
+    Parameters
+    ----------
+    points_mm : ndarray of shape (N, 3)
+    bone_vertices_mm : array_like of shape (K, 3), K >= 1
+    facial_landmarks : dict
+        Its ``gnathion`` sets the chin depth (distance to the nearest bone vertex).
+
+    Returns
+    -------
+    ndarray of shape (N,), bool
+    """
     from scipy.spatial import cKDTree
 
     bone = np.asarray(bone_vertices_mm, dtype=float)
@@ -332,10 +347,10 @@ def _below_jaw_bone(points_mm, bone_vertices_mm, facial_landmarks):
     depth_mm = JAW_DEPTH_FALLBACK_MM
     if "gnathion" in facial_landmarks:
         depth_mm = float(tree.query(np.asarray(facial_landmarks["gnathion"], dtype=float))[0])
-    distance, index = tree.query(points_mm)
-    offset = points_mm - bone[index]
-    below = -offset[:, 1] > np.cos(np.radians(JAW_BELOW_ANGLE_DEG)) * distance
-    return below & (distance > depth_mm + JAW_CUT_MARGIN_MM)
+    distance_mm, index = tree.query(points_mm)
+    offset_mm = points_mm - bone[index]
+    below = -offset_mm[:, 1] > np.cos(np.radians(JAW_BELOW_ANGLE_DEG)) * distance_mm
+    return below & (distance_mm > depth_mm + JAW_CUT_MARGIN_MM)
 
 
 def prepare_head(subject):
@@ -360,6 +375,7 @@ def prepare_head(subject):
     head = jaw
     if skull is not None:
         head = head_faces_of(vertices, faces, facial, NECK_SKULL_CLEARANCE_MM, skull)
+        jaw = jaw & head  # the facial curve's skin lies inside the face mask
     head_points = vertices[np.unique(faces[head])]
     hull = head_points[ConvexHull(head_points).vertices]
     names = tuple(facial)
