@@ -26,7 +26,6 @@ under a minute. Results and their discussion: docs/method.md, "Identification on
 
 import argparse
 import json
-import math
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -40,7 +39,11 @@ from lilium.experiments.config import (
     method_label,
     parse_methods,
 )
-from lilium.experiments.identification import complete_photo_runs, identification_table
+from lilium.experiments.identification import (
+    complete_photo_runs,
+    identification_table,
+    ranking_score,
+)
 from lilium.experiments.report import load_rows, view_group
 from lilium.experiments.runner import run_experiment
 from lilium.experiments.store import COLUMNS, ResultStore
@@ -53,42 +56,71 @@ from lilium.optimisation.de import DEOptions
 TERMS = ("mse_pix", "p_pll", "p_skof", "score")
 
 
-def mean_depth_scores(rows, root):
-    """Lilium rows rescored: mean pixel error of the mean-depth landmarks under their camera.
+def mean_depth_error_px(camera, skull, photo):
+    """Mean pixel error of the mean-depth facial landmarks (POSEST-SFO's 3D points) of
+    ``skull`` under ``camera`` (:class:`Camera`), over the landmarks ``photo`` marks."""
+    corr = correspondences(skull, photo)
+    uv = camera.project(mean_depth_landmarks(corr))
+    return float(np.linalg.norm(uv - corr.uv_px, axis=1).mean())
+
+
+class DatasetInputs:
+    """Skulls (with a task's axes set) and photos of a generated dataset, read once each, by
+    the paths ``dataset.json`` gives (as the experiment runner reads them)."""
+
+    def __init__(self, root):
+        self.root = Path(root)
+        index = json.loads((self.root / "dataset.json").read_text())
+        self.subjects = {s["id"]: s for s in index["subjects"]}
+        self.photo_paths = {p["id"]: p["paths"] for p in index["photos"]}
+        self._skulls, self._photos = {}, {}
+
+    def skull(self, subject, experiment, axes_set):
+        key = (subject, experiment, axes_set)
+        if key not in self._skulls:
+            entry, axes = self.subjects[subject], None
+            if experiment == "C":
+                names = entry.get("axes_C", [])
+                if not 1 <= axes_set <= len(names):
+                    raise ValueError(f"subject {subject}: no perturbed axes set {axes_set}")
+                axes = str(self.root / entry["path"] / names[axes_set - 1])
+            self._skulls[key] = read_skull(self.root / entry["path"], axes_path=axes)
+        return self._skulls[key]
+
+    def photo(self, photo, experiment):
+        key = (photo, experiment)
+        if key not in self._photos:
+            folder = self.root / self.photo_paths[photo][experiment]
+            self._photos[key] = read_photo(folder, load_image=False)
+        return self._photos[key]
+
+
+def mean_depth_scores(rows, inputs):
+    """Lilium rows rescored by :func:`mean_depth_error_px` under their own camera.
 
     Parameters
     ----------
     rows : list of dict
-        Database rows with their ``result`` JSON (:meth:`ResultStore.rows`).
-    root : Path
-        The dataset folder.
+        Database rows with their ``result`` JSON (``ResultStore.rows(COLUMNS)``).
+    inputs : DatasetInputs
 
     Returns
     -------
     list of dict
-        Copies of the Lilium rows with ``score`` replaced (failed SFOs keep ``None``).
+        Copies of the Lilium rows with ``score`` replaced; a failed SFO's score is None (it
+        ranks last, as in the tables).
     """
-    index = json.loads((root / "dataset.json").read_text())
-    subjects = {s["id"]: s for s in index["subjects"]}
-    skulls, photos, out = {}, {}, []
+    out = []
     for row in rows:
         if row["method"] != "lilium":
             continue
-        row = dict(row)
-        key = (row["subject"], row["axes_set"])
-        if key not in skulls:
-            entry = subjects[row["subject"]]
-            names = entry.get("axes_C", [])
-            axes = str(root / entry["path"] / names[row["axes_set"] - 1]) if names else None
-            skulls[key] = read_skull(root / entry["path"], axes_path=axes)
-        if row["photo"] not in photos:
-            folder = root / "photos" / row["experiment"] / row["photo"]
-            photos[row["photo"]] = read_photo(folder, load_image=False)
-        if row["success"] and row.get("result"):
+        row = dict(row, score=None)
+        if row["success"] and row["result"]:
             camera = Camera.from_dict(json.loads(row["result"])["camera"])
-            corr = correspondences(skulls[key], photos[row["photo"]])
-            uv = camera.project(mean_depth_landmarks(corr))
-            row["score"] = float(np.linalg.norm(uv - corr.uv_px, axis=1).mean())
+            skull = inputs.skull(row["subject"], row["experiment"], row["axes_set"])
+            row["score"] = mean_depth_error_px(
+                camera, skull, inputs.photo(row["photo"], row["experiment"])
+            )
         out.append(row)
     return out
 
@@ -108,11 +140,6 @@ def config(args):
         workers=args.workers,
         db=out / "results.sqlite",
     )
-
-
-def _score(row):
-    ok = row["success"] and row["score"] is not None and np.isfinite(row["score"])
-    return float(row["score"]) if ok else math.inf
 
 
 def bpe_means(rows):
@@ -148,7 +175,7 @@ def term_contrast(rows):
         for r in rows
     }
     out = {}
-    for key, view, true_subject, scores in complete_photo_runs(rows, _score):
+    for key, view, true_subject, scores in complete_photo_runs(rows, ranking_score):
         exp, method, variant, axes, rep, photo = key
         label, group = method_label(method, variant), view_group(view)
         entry = out.setdefault(
@@ -225,7 +252,7 @@ def main(argv=None):
         run_experiment(cfg, progress=False)
     print_tables(load_rows(cfg.db))
     with ResultStore(cfg.db, read_only=True) as store:
-        rescored = mean_depth_scores(store.rows(list(COLUMNS)), cfg.dataset.path)
+        rescored = mean_depth_scores(store.rows(list(COLUMNS)), DatasetInputs(cfg.dataset.path))
     print("\nLilium ranked by the mean-depth landmarks' pixel error under its camera:")
     print_identification(rescored)
     return 0

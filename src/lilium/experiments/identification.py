@@ -32,7 +32,8 @@ from .config import ALL_METHODS, EXPERIMENTS, method_label
 IDENTIFICATION_VIEWS = ("frontal", "lateral")
 
 
-def _score(row):
+def ranking_score(row):
+    """The score a stored SFO ranks by: its ``score``, or +inf when it failed (ranks last)."""
     if row["success"] and row["score"] is not None and np.isfinite(row["score"]):
         return float(row["score"])
     return math.inf
@@ -90,7 +91,7 @@ def photo_matches(rows):
         experiment are stored and include the true skull.
     """
     out = []
-    for key, view, true, scores in complete_photo_runs(rows, _score):
+    for key, view, true, scores in complete_photo_runs(rows, ranking_score):
         target = scores[true]
         negatives = [s for name, s in scores.items() if name != true]
         exp, method, variant, axes_set, rep, photo = key
