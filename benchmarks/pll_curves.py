@@ -1,11 +1,12 @@
 """Pictures of P_pll's curves: a photo's true skull against its best-scoring wrong skull.
 
 Run: ``.venv/bin/python benchmarks/pll_curves.py DB PHOTO [--variant skof+pll] [--out PNG]``
-on a database of :mod:`benchmarks.bench_identification` (or any ``lilium experiment`` run of
-generated photos). For the photo, three panels on the photo's chin-jaw (frontal) or forehead
-(lateral) region: the true skull at the ground-truth camera, the true skull at the camera
-Lilium found, and the wrong skull Lilium scored best at its camera. Each shows the skull curve
-as detected (orange) and trimmed (red), the facial curve (cyan), every fourth pair (yellow),
+on a database of :mod:`benchmarks.bench_identification` (or of any ``lilium experiment`` whose
+generated dataset lies in ``dataset/`` beside the database; ``--axes-set`` and ``--repetition`` pick
+the run, default the first of Exp. C). For the photo, three panels on the photo's chin-jaw (frontal)
+or forehead (lateral) region: the true skull at the ground-truth camera, the true skull at the
+camera Lilium found, and the wrong skull Lilium scored best at its camera. Each shows the skull
+curve as detected (orange) and trimmed (red), the facial curve (cyan), every fourth pair (yellow),
 and the terms Delta_d, P_conv, P_int with the end and mean distances in pixels.
 """
 
@@ -18,14 +19,14 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
+from lilium.fitness.pll import pair_curves_batch, terms_from_pairs, trim_curves_batch
+from lilium.geometry.camera import Camera, principal_point_of
+from lilium.io.case import read_photo, read_skull
+from lilium.io.truth import read_ground_truth
+from lilium.methods.lilium_terms import PllTerm, TermOff
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-from lilium.fitness.pll import pair_curves_batch, terms_from_pairs, trim_curves_batch  # noqa: E402
-from lilium.geometry.camera import Camera, principal_point_of  # noqa: E402
-from lilium.io.case import read_photo, read_skull  # noqa: E402
-from lilium.io.truth import read_ground_truth  # noqa: E402
-from lilium.methods.lilium_terms import PllTerm  # noqa: E402
 
 
 def curves_and_pairs(term, camera):
@@ -71,34 +72,63 @@ def main(argv=None):
     parser.add_argument("photo")
     parser.add_argument("--variant", default="skof+pll")
     parser.add_argument("--experiment", default="C")
+    parser.add_argument("--axes-set", type=int, default=1, help="Exp. C axis set (A, B: 0)")
+    parser.add_argument("--repetition", type=int, default=0)
     parser.add_argument("--out", default=None, help="PNG (default PHOTO-VARIANT-curves.png)")
     args = parser.parse_args(argv)
     db = Path(args.db)
     root = db.parent / "dataset"
     folder = root / "photos" / args.experiment / args.photo
-    rows = sqlite3.connect(f"file:{db}?mode=ro", uri=True).execute(
-        "SELECT subject, score, result FROM sfo WHERE method = 'lilium' AND variant = ? "
-        "AND photo = ? AND experiment = ? AND success = 1",
-        (args.variant, args.photo, args.experiment),
-    )
-    results = {subject: (score, json.loads(result)) for subject, score, result in rows}
-    truth = read_ground_truth(folder)
-    if truth.subject not in results:
-        print(f"{db}: no Lilium {args.variant} result of {args.photo} on its true skull")
+    if not db.is_file() or not folder.is_dir():
+        print(f"{db}: no database, or no photo folder {folder}")
         return 1
-    wrong = min((s for s in results if s != truth.subject), key=lambda s: results[s][0])
+    rows = sqlite3.connect(f"file:{db}?mode=ro", uri=True).execute(
+        "SELECT subject, axes_set, score, result FROM sfo WHERE method = 'lilium' AND "
+        "variant = ? AND photo = ? AND experiment = ? AND axes_set = ? AND repetition = ? "
+        "AND success = 1",
+        (args.variant, args.photo, args.experiment, args.axes_set, args.repetition),
+    )
+    results = {
+        subject: (axes_set, score, json.loads(result)) for subject, axes_set, score, result in rows
+    }
+    truth = read_ground_truth(folder)
+    wrong = sorted((s for s in results if s != truth.subject), key=lambda s: results[s][1])
+    if truth.subject not in results or not wrong:
+        print(
+            f"{db}: Lilium {args.variant} has no result of {args.photo} on its true skull "
+            "and on a wrong one in that run"
+        )
+        return 1
     photo = read_photo(folder)
     centre = principal_point_of(photo.image_size_wh)
     fig, axes = plt.subplots(1, 3, figsize=(15, 5))
+    true_result, wrong_result = results[truth.subject], results[wrong[0]]
     panels = (
-        (truth.subject, truth.camera, "true skull, true camera"),
-        (truth.subject, Camera.from_dict(results[truth.subject][1]["camera"]), "true skull"),
-        (wrong, Camera.from_dict(results[wrong][1]["camera"]), f"best wrong skull {wrong}"),
+        (truth.subject, truth.camera, "true skull, true camera", true_result[0]),
+        (
+            truth.subject,
+            Camera.from_dict(true_result[2]["camera"]),
+            f"true skull (score {true_result[1]:.1f})",
+            true_result[0],
+        ),
+        (
+            wrong[0],
+            Camera.from_dict(wrong_result[2]["camera"]),
+            f"best wrong skull {wrong[0]} (score {wrong_result[1]:.1f})",
+            wrong_result[0],
+        ),
     )
-    for ax, (subject, camera, label) in zip(axes, panels, strict=True):
-        skull = read_skull(root / "subjects" / subject)
-        score = results[subject][0]
-        draw(ax, photo.image, PllTerm(skull, photo, centre), camera, f"{label} (score {score:.1f})")
+    for ax, (subject, camera, label, axes_set) in zip(axes, panels, strict=True):
+        axes_file = root / "subjects" / subject / f"axes_{args.experiment}{axes_set}.json"
+        skull = read_skull(
+            root / "subjects" / subject, axes_path=axes_file if axes_file.is_file() else None
+        )
+        try:
+            term = PllTerm(skull, photo, centre)
+        except TermOff as exc:
+            print(f"P_pll cannot apply to {args.photo} with skull {subject}: {exc}")
+            return 1
+        draw(ax, photo.image, term, camera, label)
     out = Path(args.out or f"{args.photo}-{args.variant}-curves.png")
     fig.savefig(out, dpi=110, bbox_inches="tight")
     print(f"wrote {out}")
