@@ -30,7 +30,6 @@ Definitions (decisions the paper leaves open are marked *):
 """
 
 import csv
-import math
 import sqlite3
 from collections import defaultdict
 from pathlib import Path
@@ -38,7 +37,12 @@ from pathlib import Path
 import numpy as np
 
 from .config import ALL_METHODS, EXPERIMENTS, method_label
-from .identification import identification_markdown, identification_table, write_identification
+from .identification import (
+    identification_markdown,
+    identification_table,
+    photo_matches,
+    write_identification,
+)
 from .store import ResultStore, database_error
 from .terms_off import terms_off_markdown, terms_off_rows, terms_off_table
 
@@ -88,35 +92,18 @@ def load_rows(db):
 def photo_ranks(rows):
     """Rank of the true skull for every (experiment, method, run, photo) with all skulls stored.
 
+    From :func:`identification.photo_matches`: ``rank = 1 + better + tied / 2`` (failed SFOs
+    rank last, ties share the mean rank).
+
     Returns
     -------
     list of dict
         ``experiment, method, variant, axes_set, repetition, photo, view, rank, n_skulls``.
     """
-    from ..evaluation.metrics import rank_of_true
-    from .identification import complete_photo_runs
-
-    def score(r):
-        return r["score"] if r["success"] and r["score"] is not None else math.nan
-
     out = []
-    for key, view, true, scores in complete_photo_runs(rows, score):
-        names = sorted(scores)
-        rank = rank_of_true([scores[n] for n in names], names.index(true))
-        exp, method, variant, axes_set, rep, photo = key
-        out.append(
-            dict(
-                experiment=exp,
-                method=method,
-                variant=variant,
-                axes_set=axes_set,
-                repetition=rep,
-                photo=photo,
-                view=view,
-                rank=float(rank),
-                n_skulls=len(names),
-            )
-        )
+    for m in photo_matches(rows):
+        better, tied, negatives = m.pop("better"), m.pop("tied"), m.pop("negatives")
+        out.append(dict(m, rank=1.0 + better + tied / 2.0, n_skulls=negatives + 1))
     return out
 
 
