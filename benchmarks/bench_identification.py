@@ -38,13 +38,14 @@ from lilium.experiments.config import (
     ExperimentConfig,
     method_label,
     parse_methods,
+    view_group,
 )
 from lilium.experiments.identification import (
     complete_photo_runs,
     identification_table,
     ranking_score,
 )
-from lilium.experiments.report import load_rows, view_group
+from lilium.experiments.report import load_rows
 from lilium.experiments.runner import run_experiment
 from lilium.experiments.store import COLUMNS, ResultStore
 from lilium.geometry.camera import Camera

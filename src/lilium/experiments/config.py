@@ -271,6 +271,21 @@ def parse_methods(entries, where="methods"):
     return tuple(out)
 
 
+#: View groups of the report's tables: frontal photos, and lateral ones (left and right together).
+VIEW_GROUPS = ("frontal", "lateral")
+
+
+def view_group(view):
+    """The view group of a photo's view (:data:`VIEW_GROUPS`)."""
+    return "frontal" if view == "frontal" else "lateral"
+
+
+def method_order(pairs):
+    """``(method, variant)`` pairs in the protocol's order (:data:`ALL_METHODS`), others after."""
+    known = [m for m in ALL_METHODS if m in pairs]
+    return known + sorted(p for p in pairs if p not in known)
+
+
 def method_label(method, variant):
     """Display name: ``POSEST-SFO``, ``Lilium``, ``Lilium+P_pll``, ``Lilium+P_skof+P_pll``."""
     if method == "posest-sfo":

@@ -26,10 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .config import ALL_METHODS, EXPERIMENTS, method_label
-
-#: View groups of the identification table (lateral = left and right).
-IDENTIFICATION_VIEWS = ("frontal", "lateral")
+from .config import EXPERIMENTS, VIEW_GROUPS, method_label, method_order, view_group
 
 
 def ranking_score(row):
@@ -134,14 +131,10 @@ def cmc_values(better, tied, max_rank):
     return np.clip((r - better) / (tied + 1.0), 0.0, 1.0)
 
 
-def _view_group(view):
-    return "frontal" if view == "frontal" else "lateral"
-
-
 def _grouped(matches):
     groups = defaultdict(list)
     for m in matches:
-        groups[(m["experiment"], m["method"], m["variant"], _view_group(m["view"]))].append(m)
+        groups[(m["experiment"], m["method"], m["variant"], view_group(m["view"]))].append(m)
     return groups
 
 
@@ -150,11 +143,10 @@ def _order(keys):
     out = []
     for exp in EXPERIMENTS:
         present = {(m, v) for (e, m, v, _) in keys if e == exp}
-        pairs = [p for p in ALL_METHODS if p in present] + sorted(present - set(ALL_METHODS))
-        for method, variant in pairs:
+        for method, variant in method_order(present):
             out += [
                 (exp, method, variant, view)
-                for view in IDENTIFICATION_VIEWS
+                for view in VIEW_GROUPS
                 if (exp, method, variant, view) in keys
             ]
     return out

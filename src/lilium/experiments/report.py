@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .config import ALL_METHODS, EXPERIMENTS, method_label
+from .config import EXPERIMENTS, VIEW_GROUPS, method_label, method_order, view_group
 from .identification import (
     identification_markdown,
     identification_table,
@@ -45,18 +45,6 @@ from .identification import (
 )
 from .store import ResultStore, database_error
 from .terms_off import terms_off_markdown, terms_off_rows, terms_off_table
-
-#: Views of the tables: frontal photos and lateral ones (left and right together).
-VIEW_GROUPS = ("frontal", "lateral")
-
-
-def view_group(view):
-    return "frontal" if view == "frontal" else "lateral"
-
-
-def _method_order(pairs):
-    known = [m for m in ALL_METHODS if m in pairs]
-    return known + sorted(p for p in pairs if p not in known)
 
 
 def _mean_sd(values):
@@ -141,7 +129,7 @@ def summary_table(rows, ranks):
     table = []
     for exp in EXPERIMENTS:
         pairs = {(m, v) for (e, m, v) in by_method if e == exp}
-        for method, variant in _method_order(pairs):
+        for method, variant in method_order(pairs):
             key = (exp, method, variant)
             group = by_method[key]
             row = {
@@ -204,7 +192,7 @@ def wilcoxon_table(rows, ranks):
             families[(exp, view)].append((method, variant))
         for exp in EXPERIMENTS:
             for view in VIEW_GROUPS:
-                methods = _method_order(set(families.get((exp, view), [])))
+                methods = method_order(set(families.get((exp, view), [])))
                 tests = []
                 for i, a in enumerate(methods):
                     for b in methods[i + 1 :]:
@@ -247,7 +235,7 @@ def implausible_table(rows):
     out = []
     for exp in EXPERIMENTS:
         pairs = {(m, v) for (e, m, v) in runs if e == exp}
-        for method, variant in _method_order(pairs):
+        for method, variant in method_order(pairs):
             per_run = runs[(exp, method, variant)]
             stats = []
             for run, group in sorted(per_run.items()):
@@ -330,7 +318,7 @@ def plot_rank_distribution(ranks, path):
     fig, axes = plt.subplots(1, len(exps), figsize=(4.5 * len(exps), 3.8), squeeze=False)
     for ax, exp in zip(axes[0], exps, strict=True):
         items = [r for r in ranks if r["experiment"] == exp]
-        pairs = _method_order({(r["method"], r["variant"]) for r in items})
+        pairs = method_order({(r["method"], r["variant"]) for r in items})
         k = max((r["n_skulls"] for r in items), default=1)
         grid = np.arange(1, k + 1)
         for method, variant in pairs:
@@ -364,7 +352,7 @@ def plot_bpe(rows, path):
     fig, axes = plt.subplots(1, len(exps), figsize=(4.5 * len(exps), 4.2), squeeze=False)
     for ax, exp in zip(axes[0], exps, strict=True):
         items = [r for r in pos if r["experiment"] == exp]
-        pairs = _method_order({(r["method"], r["variant"]) for r in items})
+        pairs = method_order({(r["method"], r["variant"]) for r in items})
         data = [
             [max(r["bpe_mm"], 1e-3) for r in items if (r["method"], r["variant"]) == p]
             for p in pairs

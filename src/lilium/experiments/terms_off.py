@@ -12,20 +12,8 @@ import sqlite3
 from collections import defaultdict
 from pathlib import Path
 
-from .config import ALL_METHODS, EXPERIMENTS, method_label
+from .config import EXPERIMENTS, VIEW_GROUPS, method_label, method_order, view_group
 from .store import ResultStore, database_error
-
-#: Views of the table: frontal photos and lateral ones (left and right together).
-VIEW_GROUPS = ("frontal", "lateral")
-
-
-def _view_group(view):
-    return "frontal" if view == "frontal" else "lateral"
-
-
-def _method_order(pairs):
-    known = [m for m in ALL_METHODS if m in pairs]
-    return known + sorted(p for p in pairs if p not in known)
 
 
 def terms_off_rows(db):
@@ -62,11 +50,11 @@ def terms_off_table(rows):
     terms = sorted({t for r in rows for t in r["terms_off"]})
     groups = defaultdict(list)
     for r in rows:
-        groups[(r["experiment"], r["method"], r["variant"], _view_group(r["view"]))].append(r)
+        groups[(r["experiment"], r["method"], r["variant"], view_group(r["view"]))].append(r)
     out = []
     for exp in EXPERIMENTS:
         pairs = {(m, v) for (e, m, v, _) in groups if e == exp}
-        for method, variant in _method_order(pairs):
+        for method, variant in method_order(pairs):
             if not any(
                 r["terms_off"]
                 for g in VIEW_GROUPS
