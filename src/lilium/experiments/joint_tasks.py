@@ -19,7 +19,6 @@ The task's key is its frontal row's; the rows are stored lateral first, so a run
 the two writes reruns the task (``INSERT OR IGNORE`` keeps the row already there).
 """
 
-import json
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -71,15 +70,7 @@ def run_joint_task(task):
     import socket
 
     from ..methods import SfoOptions, run_joint_sfo
-    from .runner import (
-        _DROPPED_RESULT_KEYS,
-        _facial_truth,
-        _finite,
-        _photo,
-        _skull,
-        _topology,
-        score_result,
-    )
+    from .runner import _facial_truth, _photo, _skull, _topology, result_columns, score_result
     from .store import KEY_COLUMNS
 
     start = time.perf_counter()
@@ -113,22 +104,6 @@ def run_joint_task(task):
         if row["positive"]:
             truth = replace(truth, facial_landmarks_mm=_facial_truth(task.subject_dir))
         row.update(score_result(single, skull, photo, truth, topology))
-        data = single.to_dict()
-        for key in _DROPPED_RESULT_KEYS:
-            data.pop(key, None)
-        row.update(
-            success=int(bool(single)),
-            score=_finite(result.fitness) if result else None,
-            mse_pix=_finite(single.terms.get("mse_pix")),
-            p_cam=_finite(single.terms.get("p_cam")),
-            p_skof=_finite(single.terms.get("p_skof")),
-            p_pll=_finite(single.terms.get("p_pll")),
-            focal_px=_finite(single.camera.focal_px) if single else None,
-            seconds=float(result.seconds),
-            generations=result.extra.get("generations"),
-            error=single.error or result.error or None,
-            result=json.dumps(data),
-            task_seconds=time.perf_counter() - start,
-            finished_at=time.time(),
-        )
+        row.update(result_columns(single, result.fitness if result else None, result))
+        row.update(task_seconds=time.perf_counter() - start, finished_at=time.time())
     return rows[::-1]

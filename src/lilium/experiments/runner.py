@@ -345,25 +345,39 @@ def run_task(task):
     if row["positive"]:
         truth = replace(truth, facial_landmarks_mm=_facial_truth(task.subject_dir))
     row.update(score_result(result, skull, photo, truth, _topology(task.subject_dir, skull)))
-    data = result.to_dict()
+    row.update(result_columns(result, result.fitness, result))
+    row.update(task_seconds=time.perf_counter() - start, finished_at=time.time())
+    return row
+
+
+def result_columns(single, score, run):
+    """The stored columns of one photo's SFO result.
+
+    Parameters
+    ----------
+    single : SfoResult
+        The photo's result (terms, camera, ``result.json``).
+    score : float or None
+        Its ranking score (a joint SFO's: the joint fitness).
+    run : SfoResult or JointSfoResult
+        The run that produced it (its time, generations and error).
+    """
+    data = single.to_dict()
     for key in _DROPPED_RESULT_KEYS:
         data.pop(key, None)
-    row.update(
-        success=int(bool(result)),
-        score=_finite(result.fitness),
-        mse_pix=_finite(result.terms.get("mse_pix")),
-        p_cam=_finite(result.terms.get("p_cam")),
-        p_skof=_finite(result.terms.get("p_skof")),
-        p_pll=_finite(result.terms.get("p_pll")),
-        focal_px=_finite(result.camera.focal_px) if result else None,
-        seconds=float(result.seconds),
-        generations=result.extra.get("generations"),
-        error=result.error or None,
+    return dict(
+        success=int(bool(single)),
+        score=_finite(score),
+        mse_pix=_finite(single.terms.get("mse_pix")),
+        p_cam=_finite(single.terms.get("p_cam")),
+        p_skof=_finite(single.terms.get("p_skof")),
+        p_pll=_finite(single.terms.get("p_pll")),
+        focal_px=_finite(single.camera.focal_px) if single else None,
+        seconds=float(run.seconds),
+        generations=run.extra.get("generations"),
+        error=single.error or run.error or None,
         result=json.dumps(data),
-        task_seconds=time.perf_counter() - start,
-        finished_at=time.time(),
     )
-    return row
 
 
 def _init_worker(parent_pid=None):
