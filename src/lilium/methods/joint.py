@@ -40,7 +40,7 @@ import numpy as np
 from ..optimisation.de import DifferentialEvolution
 from ..softtissue.cones import decode
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from .lilium import LiliumProblem, build_cones, photo_outcome
+from .lilium import LiliumProblem, build_cones, de_extra, photo_outcome
 from .options import SfoOptions
 from .result import SfoResult, finite_or_none
 
@@ -378,13 +378,6 @@ def joint_lilium_sfo(
         facial_landmarks_mm=dict(zip(problem.facial_names, shared, strict=True)),
         seconds=seconds,
         weights=tuple(float(w) for w in problem.weights),
-        extra={
-            "history": de.history.tolist(),
-            "generations": de.nit,
-            "evaluations": de.nfev,
-            "stop": de.message,
-            "genes": de.x.tolist(),
-            "fallbacks": sum(pr.n_fallbacks for pr in problem.problems),
-            "weighting": weighting,
-        },
+        extra=de_extra(de, sum(pr.n_fallbacks for pr in problem.problems))
+        | {"weighting": weighting},
     )

@@ -350,15 +350,21 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         error=error,
         warnings=warnings,
         terms_off=dict(problem.terms_off),
-        extra={
-            "history": de.history.tolist(),
-            "generations": de.nit,
-            "evaluations": de.nfev,
-            "stop": de.message,
-            "genes": de.x.tolist(),
-            "fallbacks": problem.n_fallbacks,
-        },
+        extra=de_extra(de, problem.n_fallbacks),
     )
+
+
+def de_extra(de, fallbacks):
+    """The ``extra`` of an SFO result from its finished :class:`DifferentialEvolution` run:
+    ``history``, ``generations``, ``evaluations``, ``stop``, ``genes``, ``fallbacks``."""
+    return {
+        "history": de.history.tolist(),
+        "generations": de.nit,
+        "evaluations": de.nfev,
+        "stop": de.message,
+        "genes": de.x.tolist(),
+        "fallbacks": fallbacks,
+    }
 
 
 def photo_outcome(problem, best, seed):
