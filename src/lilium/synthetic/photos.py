@@ -321,7 +321,7 @@ def head_faces_of(
             & (centroids[:, 1] < min(left[1], right[1]) - JAW_BELOW_MOUTH_MM)
             & (np.abs(centroids[:, 0] - 0.5 * (left[0] + right[0])) < half_width_mm)
         )
-        neck = np.where(chin, _below_jaw_bone(centroids, jaw_bone_mm, facial_landmarks), neck)
+        neck[chin] = _below_jaw_bone(centroids[chin], jaw_bone_mm, facial_landmarks)
     return ~neck
 
 
