@@ -21,6 +21,7 @@ LAYERS = {
     "inputs": 4,
     "methods": 5,
     "evaluation": 5,
+    "identification": 5,
     "io": 6,
     "synthetic": 7,
     "ct": 7,

@@ -93,6 +93,11 @@ class Photo:
     warnings : tuple of CaseWarning
         Found while reading the photo (e.g. ``exif_focal_unusable``); every result of the photo
         carries them.
+    landmark_sources : dict of str -> str
+        Who placed each facial landmark: ``manual`` (by hand, or an automatic point the user
+        reviewed), ``tracked`` or ``template`` (automatic, unreviewed; SPEC section 11). A
+        landmark not listed is ``manual``. Sets its 2D uncertainty in the identification
+        (:mod:`lilium.identification`).
     """
 
     id: str
@@ -106,6 +111,7 @@ class Photo:
     landmarks_file: str | None = None
     prior_sources: dict = field(default_factory=dict)
     warnings: tuple = ()
+    landmark_sources: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
 from .folders import labelled_skull
+from .identify import Calibrations, conclusion_line, identify, with_identification
 from .inputs import check_runnable, load_photos, load_skull
 from .prepared import check_photo_extra
 
@@ -57,6 +58,7 @@ def run_case(
     log=print,
     auto_landmarks=False,
     joint=False,
+    calibration=None,
     **photo_options,
 ):
     """Read and check every input, run every SFO, write each result and the report.
@@ -95,6 +97,11 @@ def run_case(
         ``overlay_<photo id>.png`` per photo); the other methods run per photo as usual. The
         report shows every photo's overlay and terms from the shared soft tissue, and its 3D
         facial landmarks. Needs two or more distinct photos.
+    calibration : path, optional
+        Identification calibration file (default: the shipped one). Every result gets its
+        ``"identification"`` (SPEC section 12); with several photos, each method's separate
+        SFOs are also taken together as one decision (shared soft tissue), shown first in the
+        report and logged.
 
     Returns
     -------
@@ -125,6 +132,7 @@ def run_case(
     )
     if depth_table:
         options = replace(options, depth_table=read_depth_table(depth_table))
+    calibrations = Calibrations(calibration)
     planned = {}
     for photo, inputs, _, _ in records:  # every problem before any long run
         planned[photo.id] = check_runnable(
@@ -142,7 +150,10 @@ def run_case(
     if joint:
         from .joint_case import joint_entry, run_joint_methods
 
-        joints = run_joint_methods(skull, records, methods, options, seed, out, log)
+        joints = run_joint_methods(
+            skull, records, methods, options, seed, out, log, calibrations
+        )
+    separate = {}  # method -> [(photo, result)], for the decision over several photos
     for k, (photo, inputs, notes, origin) in enumerate(records):
         landmark_info = _landmark_info(origin, out)
         for method in methods:
@@ -151,6 +162,8 @@ def run_case(
                 entries.append(joint_entry(joints[method], k, skull, photo, labelled, notes, out))
                 continue
             result = run_sfo(method, skull, photo, options, seed)
+            result = with_identification(result, skull, [photo], calibrations)
+            separate.setdefault(method, []).append((photo, result))
             tag = method_tag(method, options.variant)
             folder = out / safe_id(photo.id) / tag  # ids read from files are safe already
             write_result(folder, result, result_overlay(result, skull, photo))
@@ -161,6 +174,7 @@ def run_case(
             name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
             log(f"{photo.id}: {name}: {status_text(result)}, {result.seconds:.2f} s -> {folder}")
             log_warnings(result, log)
+            log(f"  {conclusion_line(result.extra['identification'])}")
             entries.append(
                 ReportEntry(
                     skull,
@@ -172,7 +186,19 @@ def run_case(
                     **landmark_info,
                 )
             )
-    report = write_report(out / "report.html", entries, title=title, command=command)
+    decisions = []
+    for method, done in separate.items():
+        if len(done) < 2:
+            continue
+        photos_m, results_m = zip(*done, strict=True)
+        record = identify(skull, list(photos_m), list(results_m), calibrations)
+        tag = method_tag(method, options.variant)
+        label = f"photos {', '.join(p.id for p in photos_m)} together, {tag}"
+        log(f"{label}: {conclusion_line(record)}")
+        decisions.append((label, record))
+    report = write_report(
+        out / "report.html", entries, title=title, command=command, decisions=decisions
+    )
     log(f"report: {report}")
     return entries
 

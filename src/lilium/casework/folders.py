@@ -11,6 +11,7 @@ from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import check_joint_method, check_method, run_joint_sfo, run_sfo
+from .identify import Calibrations, with_identification
 from .inputs import load_photos, load_skull
 
 
@@ -30,6 +31,7 @@ def sfo_on_folders(
     axes=None,
     depth_table=None,
     overlay=True,
+    calibration=None,
 ):
     """Read a subject and a photo folder, check them, run the method, write ``out_dir``.
 
@@ -52,11 +54,14 @@ def sfo_on_folders(
         CSV depth table (replaces ``options.depth_table``).
     overlay : bool
         Write ``overlay.png`` too.
+    calibration : path, optional
+        Identification calibration file (default: the shipped one;
+        :mod:`lilium.casework.identify`).
 
     Returns
     -------
     SfoResult
-        With its ``warnings`` (print them).
+        With its ``warnings`` (print them) and ``extra["identification"]``.
 
     Raises
     ------
@@ -75,7 +80,9 @@ def sfo_on_folders(
     check_inputs(skull, photo)
     if depth_table is not None:
         options = replace(options, depth_table=read_depth_table(depth_table))
+    calibrations = Calibrations(calibration)
     result = run_sfo(method, skull, photo, options, seed)
+    result = with_identification(result, skull, [photo], calibrations)
     write_result(out_dir, result, result_overlay(result, skull, photo) if overlay else None)
     return result
 
@@ -139,6 +146,7 @@ def joint_sfo_on_folders(
     axes=None,
     depth_table=None,
     overlay=True,
+    calibration=None,
 ):
     """One joint SFO (SPEC section 9) of a subject folder and two or more photo folders of the
     same person: read, check, run, write ``out_dir``.
@@ -171,6 +179,8 @@ def joint_sfo_on_folders(
         check_inputs(skull, photo)
     if depth_table is not None:
         options = replace(options, depth_table=read_depth_table(depth_table))
+    calibrations = Calibrations(calibration)
     result = run_joint_sfo(method, skull, photos, options, seed)
+    result = with_identification(result, skull, photos, calibrations)
     write_joint_result(out_dir, result, skull, photos, overlay=overlay)
     return result

@@ -11,6 +11,7 @@ from pathlib import Path
 from ..methods.registry import METHODS, method_tag, run_joint_sfo
 from .case import log_warnings, status_text
 from .folders import check_distinct_photos, joint_overlay_name, write_joint_result
+from .identify import Calibrations, conclusion_line, with_identification
 
 #: Folder of the joint SFOs in a case's output folder.
 JOINT_FOLDER = "joint"
@@ -39,7 +40,7 @@ def check_joint_case(photos, methods):
         )
 
 
-def run_joint_methods(skull, records, methods, options, seed, out, log=print):
+def run_joint_methods(skull, records, methods, options, seed, out, log=print, calibrations=None):
     """Run every joint-capable method of ``methods`` once on all the photos; write each.
 
     Parameters
@@ -53,6 +54,8 @@ def run_joint_methods(skull, records, methods, options, seed, out, log=print):
     out : Path
         The case's output folder.
     log : callable
+    calibrations : Calibrations, optional
+        For the joint SFO's identification (default: the shipped calibration).
 
     Returns
     -------
@@ -75,6 +78,7 @@ def run_joint_methods(skull, records, methods, options, seed, out, log=print):
         if METHODS[method].run_joint is None:
             continue
         result = run_joint_sfo(method, skull, photos, options, seed)
+        result = with_identification(result, skull, photos, calibrations or Calibrations())
         folder = Path(out) / JOINT_FOLDER / method_tag(method, options.variant)
         write_joint_result(folder, result, skull, photos)
         name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
@@ -85,6 +89,7 @@ def run_joint_methods(skull, records, methods, options, seed, out, log=print):
         for single in result.photos:
             log(f"  {single.photo_id}: {status_text(single)}")
             log_warnings(single, log)
+        log(f"  {conclusion_line(result.extra['identification'])}")
         done[method] = (result, folder)
     return done
 

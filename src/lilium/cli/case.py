@@ -33,6 +33,7 @@ from .sfo import (
     MAX_SECONDS,
     POPULATION,
     VARIANTS,
+    add_calibration_option,
     options_from,
 )
 
@@ -190,6 +191,7 @@ def register(subparsers):
             "DIR/joint/lilium-<variant>/ (SPEC section 9)"
         ),
     )
+    add_calibration_option(p)
     p.add_argument("--title", help="report title")
     p.set_defaults(func=run)
 
@@ -197,7 +199,7 @@ def register(subparsers):
 def command_line(args, methods):
     """The ``lilium case`` command line equivalent to ``args`` (for the provenance)."""
     parts = ["lilium", "case", "--skull", str(args.skull)]
-    for option in ("landmarks", "axes", "depth_table"):
+    for option in ("landmarks", "axes", "depth_table", "calibration"):
         if getattr(args, option) is not None:
             parts += [f"--{option.replace('_', '-')}", str(getattr(args, option))]
     for photo in args.photo:
@@ -251,5 +253,6 @@ def run(args):
         sensor_width_mm=args.sensor_width_mm,
         auto_landmarks=args.auto_landmarks,
         joint=args.joint,
+        calibration=args.calibration,
     )
     return 0 if all(e.result for e in entries) else 1

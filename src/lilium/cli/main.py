@@ -27,6 +27,7 @@ COMMANDS = [
     "lilium.cli.import_ct",
     "lilium.cli.experiment",
     "lilium.cli.report",
+    "lilium.cli.calibrate",
     "lilium.cli.photo",
 ]
 

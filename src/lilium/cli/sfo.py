@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from ..casework.folders import joint_sfo_on_folders, sfo_on_folders
+from ..casework.identify import conclusion_line
 from ..methods import METHODS, SfoOptions
 from ..optimisation.de import DEOptions
 from .argtypes import existing_file, int_in, output_folder, positive_float, seed
@@ -21,6 +22,7 @@ POPULATION = int_in(4, why=" (DE/rand/1 draws three other members)")
 MAX_SECONDS = positive_float(allow_inf=True)
 AXES_FILE = existing_file("soft-tissue axes file")
 DEPTH_TABLE_FILE = existing_file("depth table")
+CALIBRATION_FILE = existing_file("calibration file")
 
 
 def register(subparsers):
@@ -80,7 +82,17 @@ def register(subparsers):
         "--depth-table", type=DEPTH_TABLE_FILE, help="CSV: landmark,mean,sd,min,max (mm)"
     )
     p.add_argument("--no-overlay", action="store_true", help="skip overlay.png")
+    add_calibration_option(p)
     p.set_defaults(func=run)
+
+
+def add_calibration_option(parser):
+    """``--calibration FILE`` (shared with ``lilium case`` and ``lilium lineup``)."""
+    parser.add_argument(
+        "--calibration",
+        type=CALIBRATION_FILE,
+        help="identification calibration written by lilium calibrate (default: the shipped one)",
+    )
 
 
 def options_from(args):
@@ -105,6 +117,7 @@ def run(args):
         axes=args.axes,
         depth_table=args.depth_table,
         overlay=not args.no_overlay,
+        calibration=args.calibration,
     )
     for warning in result.warnings:
         print(f"warning {warning.code}: {warning.message}", file=sys.stderr)
@@ -120,6 +133,7 @@ def run(args):
     )
     for term, why in result.terms_off.items():  # inputs missing: ran without it (SPEC 5)
         print(f"  {term} switched off: {why}")
+    print(conclusion_line(result.extra["identification"]))
     return 0
 
 
@@ -140,6 +154,7 @@ def run_joint(args):
         axes=args.axes,
         depth_table=args.depth_table,
         overlay=not args.no_overlay,
+        calibration=args.calibration,
     )
     for single in result.photos:
         for warning in single.warnings:
@@ -162,4 +177,5 @@ def run_joint(args):
             file=sys.stderr,
         )
         return 1
+    print(conclusion_line(result.extra["identification"]))
     return 0

@@ -346,6 +346,9 @@ def run_task(task):
         truth = replace(truth, facial_landmarks_mm=_facial_truth(task.subject_dir))
     row.update(score_result(result, skull, photo, truth, _topology(task.subject_dir, skull)))
     row.update(result_columns(result, result.fitness, result))
+    from .calibrate import with_terms
+
+    with_terms(row, skull, [photo], [result], result.facial_landmarks_mm)
     row.update(task_seconds=time.perf_counter() - start, finished_at=time.time())
     return row
 

@@ -277,8 +277,10 @@ def read_photo(folder, load_image=True):
         raw = _field(meta_path, meta, "landmarks")
         landmarks = points_from_object(meta_path, "landmarks", raw, "facial")
         landmarks = _without_unconfirmed_templates(landmarks, meta.get("landmark_sources"))
+        sources = landmark_qualities(meta.get("landmark_sources"), landmarks)
     else:
         landmarks = read_landmarks(lm_path, "facial")
+        sources = {}
     check_in_image(lm_path, landmarks, size_wh, image_path.name)
     check_landmark_layout(lm_path, landmarks, _min_extent_px(size_wh), "px")
     priors = parse_priors(meta_path, meta.get("priors"))
@@ -295,6 +297,7 @@ def read_photo(folder, load_image=True):
         curve,
         priors,
         image,
+        landmark_sources=sources,
     )
 
 
@@ -315,6 +318,23 @@ def _without_unconfirmed_templates(landmarks, sources):
             and sources[name].get("confirmed") is not True
         )
     }
+
+
+def landmark_qualities(sources, landmarks):
+    """Who placed each landmark (:attr:`lilium.inputs.Photo.landmark_sources`).
+
+    An entry ``{"source": "automatic", "quality": "tracked" | "template"}`` keeps its quality;
+    a reviewed or confirmed point, or one without an entry, is ``manual``.
+    """
+    out = {}
+    for name in landmarks:
+        entry = sources.get(name) if isinstance(sources, dict) else None
+        quality = entry.get("quality") if isinstance(entry, dict) else None
+        automatic = isinstance(entry, dict) and entry.get("source") == "automatic"
+        reviewed = isinstance(entry, dict) and entry.get("confirmed") is True
+        tagged = automatic and not reviewed and quality in ("tracked", "template")
+        out[name] = quality if tagged else "manual"
+    return out
 
 
 @dataclass(frozen=True)

@@ -40,6 +40,7 @@ from string import Template
 
 import numpy as np
 
+from .conclusion_html import conclusion_section
 from .records import ReportEntry, report_record
 from .svg import curve_svg, marks_svg, skull_view_defs, skull_view_svg
 
@@ -69,7 +70,7 @@ SUMMARY_HEADER = (
     "SCD mm",
     "mean error px",
     "mean error mm",
-    "method's own score (not comparable across methods)",
+    "method's own score: the paper's alignment score (not comparable across methods)",
     "skull outside face %",
     "warnings",
     "time s",
@@ -508,7 +509,9 @@ def format_report(page):
         date=_e(page.date),
         count=len(page.sfos),
         skulls=_e(", ".join(page.skull_ids)),
-        summary=_table(SUMMARY_HEADER, [_summary_row(s) for s in page.sfos], "num")
+        summary=conclusion_section(page.decisions)
+        + "<h2 style='border:0;margin-top:12px'>Summary</h2>\n"
+        + _table(SUMMARY_HEADER, [_summary_row(s) for s in page.sfos], "num")
         + _summary_notes(page),
         sections=_skull_view_defs(page)
         + "".join(format_joint(j) for j in page.joints)
@@ -517,7 +520,7 @@ def format_report(page):
     )
 
 
-def build_report(entries, title=None, command=None, date=None):
+def build_report(entries, title=None, command=None, date=None, decisions=()):
     """The report's HTML text.
 
     Parameters
@@ -529,12 +532,16 @@ def build_report(entries, title=None, command=None, date=None):
         The command line that produced the results, for the provenance.
     date : str, optional
         ISO date-time; now (UTC) by default.
+    decisions : sequence of (str, dict), optional
+        Identifications of several photos taken together (:func:`report_record`).
 
     Returns
     -------
     str
     """
-    return format_report(report_record(entries, title=title, command=command, date=date))
+    return format_report(
+        report_record(entries, title=title, command=command, date=date, decisions=decisions)
+    )
 
 
 def write_report(path, entries, **kwargs):

@@ -284,6 +284,10 @@ class ReportRecord:
     sfos : tuple of SfoRecord
     joints : tuple of JointRecord
         The joint SFOs (SPEC section 9) whose photos the page shows; empty without any.
+    decisions : tuple of (str, str, dict)
+        The identifications (SPEC section 12), shown first: a label, the anchor of the section
+        that shows it ("" for none) and the ``"identification"`` record; every photo's SFO, every
+        joint SFO and, with several photos, their separate SFOs taken together.
     """
 
     title: str
@@ -293,6 +297,7 @@ class ReportRecord:
     versions: tuple
     sfos: tuple
     joints: tuple = ()
+    decisions: tuple = ()
 
     @property
     def lilium_version(self):

@@ -317,7 +317,7 @@ def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
     )
 
 
-def report_record(entries, title=None, command=None, date=None):
+def report_record(entries, title=None, command=None, date=None, decisions=()):
     """The plain record of a report page.
 
     Parameters
@@ -330,6 +330,9 @@ def report_record(entries, title=None, command=None, date=None):
         The command line that produced the results, for the provenance.
     date : str, optional
         ISO date-time; now (UTC) by default.
+    decisions : sequence of (str, dict), optional
+        Identifications of several photos' SFOs taken together (label, record), shown first
+        beside each SFO's own.
 
     Returns
     -------
@@ -343,8 +346,22 @@ def report_record(entries, title=None, command=None, date=None):
     cache, views = {}, {}
     sfos = tuple(sfo_record(e, i, cache, views) for i, e in enumerate(entries, start=1))
     versions = tuple(software_versions().items())
-    joints = tuple(joint_record(j) for j in _unique_joints(entries))
-    return ReportRecord(title, date, command, skull_ids, versions, sfos, joints)
+    unique = _unique_joints(entries)
+    joints = tuple(joint_record(j) for j in unique)
+    found = [(label, "", record) for label, record in decisions]
+    found += [
+        (f"joint SFO {method_label(j.photos[0])}, photos {', '.join(r.photo_id for r in j.photos)}",
+         "", j.extra["identification"])
+        for j in unique
+        if "identification" in j.extra
+    ]
+    found += [
+        (f"photo {e.photo.id}, {method_label(e.result)}", f"sfo-{i}",
+         e.result.extra["identification"])
+        for i, e in enumerate(entries, start=1)
+        if e.joint is None and "identification" in e.result.extra
+    ]
+    return ReportRecord(title, date, command, skull_ids, versions, sfos, joints, tuple(found))
 
 
 def _unique_joints(entries):

@@ -1,0 +1,166 @@
+"""The identification of a case's SFO results (SPEC section 12): terms, calibrated log10 LR and
+the conclusion, for one photo, a joint SFO, or a person's photos taken together.
+
+Which calibration model a decision uses (``lilium/data/calibration.json`` unless the user
+gives another): ``<method>/<variant>/frontal`` or ``/lateral`` for one photo,
+``lilium-joint/<variant>/joint`` for a joint SFO, ``<method>/<variant>/pair`` for separate
+SFOs of two or more photos (fitted on a frontal and a lateral photo; used for any two or more
+photos, and the result says so). Without a model for the decision the LR is not given and the
+conclusion is "undetermined", naming the model missing and how to fit it.
+"""
+
+from dataclasses import replace
+
+from ..identification.conclusion import conclude, material_caps
+from ..identification.score import identification_terms, nll_score
+from ..inputs import correspondences
+from ..io.calibration import read_calibration, shipped_path
+
+#: Cranial landmarks on the mandible: a skull with none of them has no mandible.
+MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")
+
+
+class Calibrations:
+    """The calibration models of a file, read once (the shipped file by default)."""
+
+    def __init__(self, path=None):
+        self.path = shipped_path() if path is None else path
+        self.models, self.provenance = read_calibration(path)
+
+    def get(self, key):
+        return self.models.get(key)
+
+
+def decision_key(method, variant, photos, joint=False):
+    """The calibration key of a decision (module docstring)."""
+    if joint:
+        return f"lilium-joint/{variant or ''}/joint"
+    if len(photos) > 1:
+        return f"{method}/{variant or ''}/pair"
+    group = "frontal" if photos[0].view == "frontal" else "lateral"
+    return f"{method}/{variant or ''}/{group}"
+
+
+def _inconsistent(results, terms):
+    out = {}
+    outside = terms.get("outside_fraction")
+    if outside:
+        out["skull_outside_head"] = (
+            f"{100 * outside:.2g} % of the skull's pixels lie outside the head mask"
+        )
+    for result in results:
+        for w in result.warnings:
+            if w.code == "view_mismatch":
+                out["view_mismatch"] = w.message
+    return out
+
+
+def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joint=False):
+    """The ``"identification"`` record of one decision.
+
+    Parameters
+    ----------
+    skull : Skull
+    photos : sequence of Photo
+    results : sequence of SfoResult
+        One per photo (a joint SFO's per-photo results, or separate SFOs).
+    calibrations : Calibrations
+    facial_landmarks_mm : dict, optional
+        The soft tissue (default: the first result's).
+    joint : bool
+        The results are one joint SFO's.
+
+    Returns
+    -------
+    dict
+        ``score``, ``terms``, ``log10_lr``, ``conclusion``, ``conclusion_uncapped``, ``caps``,
+        ``inconsistent``, ``calibration`` (model key, file, provenance), ``note``.
+    """
+    method, variant = results[0].method, results[0].variant
+    key = decision_key(method, variant, photos, joint)
+    pairs = []
+    for photo in photos:
+        try:
+            pairs.append(len(correspondences(skull, photo).cranial_names))
+        except ValueError:
+            pairs.append(0)
+    used = [
+        f for photo in photos for f in photo.landmarks_uv
+        if photo.landmark_sources.get(f, "manual") != "manual"
+    ]
+    caps = material_caps(
+        has_mandible=any(n in skull.landmarks_mm for n in MANDIBLE_LANDMARKS),
+        photos=len(photos),
+        unreviewed_automatic=bool(used),
+        pairs=min(pairs),
+    )
+    record = {"calibration": {"model": key, "file": str(calibrations.path)}}
+    if not all(results):
+        verdict = conclude(None, caps)
+        return record | {
+            "score": None,
+            "terms": None,
+            "log10_lr": None,
+            "conclusion": verdict.label,
+            "conclusion_uncapped": verdict.uncapped,
+            "caps": caps,
+            "inconsistent": {},
+            "note": "no camera: the SFO failed, so nothing can be concluded",
+        }
+    facial = facial_landmarks_mm or results[0].facial_landmarks_mm
+    terms = identification_terms(
+        skull, photos, [r.camera for r in results], facial,
+        depth_table=None,
+    )
+    model = calibrations.get(key)
+    note = ""
+    if model is None:
+        lr = None
+        note = (
+            f"no calibration for {key} in {calibrations.path}: fit one with lilium calibrate "
+            "DB on an experiment that ran this method and variant, and give it with "
+            "--calibration"
+        )
+    else:
+        lr = float(model.log10_lr([terms])[0])
+        record["calibration"]["provenance"] = model.provenance
+        if len(photos) > 1 and not joint and sorted(p.view != "frontal" for p in photos) != [
+            False,
+            True,
+        ]:
+            note = "calibrated on one frontal and one lateral photo; these photos differ"
+    inconsistent = _inconsistent(results, terms)
+    verdict = conclude(lr, caps, inconsistent)
+    return record | {
+        "score": nll_score(terms),
+        "terms": {k: (None if v is None else float(v)) for k, v in terms.items()},
+        "log10_lr": lr,
+        "conclusion": verdict.label,
+        "conclusion_uncapped": verdict.uncapped,
+        "caps": caps,
+        "inconsistent": inconsistent,
+        "note": note,
+    }
+
+
+def conclusion_line(record):
+    """One console line: the conclusion, the LR, and what capped it."""
+    lr = record.get("log10_lr")
+    lr_text = "no LR" if lr is None else f"log10 LR {lr:+.2f} (LR {10**lr:.3g})"
+    why = list(record.get("inconsistent", {}).values())
+    if record["conclusion"] != record["conclusion_uncapped"]:
+        why += list(record["caps"].values())
+    extra = f"; capped: {'; '.join(why)}" if why else ""
+    note = f"; {record['note']}" if record.get("note") else ""
+    return f"identification: {record['conclusion']}, {lr_text}{extra}{note}"
+
+
+def with_identification(result, skull, photos, calibrations):
+    """``result`` (an :class:`SfoResult` or a :class:`JointSfoResult`) with its
+    ``"identification"`` record in ``extra`` (so in ``result.json``)."""
+    joint = hasattr(result, "photos")
+    singles = list(result.photos) if joint else [result]
+    record = identify(
+        skull, photos, singles, calibrations, result.facial_landmarks_mm, joint=joint
+    )
+    return replace(result, extra={**result.extra, "identification": record})

@@ -1,0 +1,36 @@
+"""``lilium calibrate``: fit the identification calibration on experiment databases."""
+
+import time
+from pathlib import Path
+
+from .argtypes import output_folder
+
+
+def register(subparsers):
+    p = subparsers.add_parser(
+        "calibrate",
+        help="fit the identification calibration (log10 LR) on experiment databases",
+        description=(
+            "Computes every stored SFO's identification terms, fits one log10 LR model per "
+            "method, variant and decision (frontal, lateral, frontal+lateral pair, joint), "
+            "cross-validated by subject, and writes OUT/calibration.json (give it to lilium "
+            "sfo/case/lineup with --calibration) and OUT/calibration.csv (Cllr, Cllr_min, "
+            "rates of misleading evidence)."
+        ),
+    )
+    p.add_argument("db", type=Path, nargs="+", help="results databases of lilium experiment")
+    p.add_argument("--out", type=output_folder, required=True, help="output folder")
+    p.add_argument(
+        "--dataset",
+        type=Path,
+        help="the dataset folder, when it moved since the databases were written",
+    )
+    p.set_defaults(func=run)
+
+
+def run(args):
+    from ..experiments.lr_report import calibrate_databases
+
+    paths = calibrate_databases(args.db, args.out, dataset=args.dataset)
+    print(f"calibration: {paths['calibration.json']} ({time.strftime('%Y-%m-%d')})")
+    return 0

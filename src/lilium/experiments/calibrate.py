@@ -1,0 +1,300 @@
+"""Identification over a results database (SPEC section 12): every stored SFO's terms, the
+decisions (one photo; a frontal + lateral pair), their calibration and its validation.
+
+The terms of an SFO are stored by the runner in its ``result`` JSON
+(``"identification_terms"``); for a database written before that, they are computed here
+from the dataset the database was run on (``meta.config.dataset``), reading each skull and
+photo once.
+
+**Decisions** (the keys of a calibration, ``"<method>/<variant>/<decision>"``):
+
+- ``frontal``, ``lateral``: one photo, one SFO;
+- ``pair``: a person's frontal and lateral photo, two separate SFOs against one skull, taken
+  together by one likelihood: the landmark term stacks both photos' residuals of each
+  landmark with **one shared soft tissue** (:func:`lilium.identification.terms.landmark_chi2`),
+  the other terms add up; calibrated as a model of its own;
+- ``pair_sum``: the same two SFOs' cross-validated log10 LRs added, i.e. as if the photos
+  were independent evidence (they are not: they share the soft tissue); measured beside
+  ``pair`` to show which is better, never shipped;
+- ``joint``: a joint SFO (SPEC section 9) of the pair: its shared soft tissue and two cameras.
+"""
+
+import json
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from ..geometry.camera import Camera
+from ..identification.calibration import cross_validated, fit, performance
+from ..identification.score import identification_terms
+from ..identification.terms import eye_corner_px
+from ..inputs import correspondences
+from ..io.case import read_photo, read_skull
+from .config import view_group
+from .store import COLUMNS, ResultStore
+
+#: Key of an SFO's identification terms in its stored ``result`` JSON (the runner writes
+#: them; ``_joint``: a joint SFO's decision over both photos, on its frontal row).
+TERMS_KEY = "identification_terms"
+
+
+def with_terms(row, skull, photos, singles, facial_landmarks_mm, key=TERMS_KEY):
+    """Add the identification terms of one decision to a row's ``result`` JSON (under
+    ``key``; nothing for a failed SFO): ``lilium calibrate`` and ``lilium report`` read them
+    instead of reading the skull and photos again
+    (:func:`lilium.identification.score.identification_terms`).
+    """
+    if not all(singles) or not row.get("result"):
+        return row
+    data = json.loads(row["result"])
+    data[key] = identification_terms(
+        skull, photos, [s.camera for s in singles], facial_landmarks_mm
+    )
+    row["result"] = json.dumps(data)
+    return row
+
+
+
+class DatasetInputs:
+    """Skulls (with a task's axes set) and photos of a generated dataset, read once each, by
+    the paths ``dataset.json`` gives (as the experiment runner reads them)."""
+
+    def __init__(self, root):
+        self.root = Path(root)
+        index = json.loads((self.root / "dataset.json").read_text())
+        self.subjects = {s["id"]: s for s in index["subjects"]}
+        self.photo_paths = {p["id"]: p["paths"] for p in index["photos"]}
+        self._skulls, self._photos = {}, {}
+
+    def skull(self, subject, experiment, axes_set):
+        key = (subject, experiment, axes_set)
+        if key not in self._skulls:
+            entry, axes = self.subjects[subject], None
+            if experiment == "C":
+                names = entry.get("axes_C", [])
+                if not 1 <= axes_set <= len(names):
+                    raise ValueError(f"subject {subject}: no perturbed axes set {axes_set}")
+                axes = str(self.root / entry["path"] / names[axes_set - 1])
+            self._skulls[key] = read_skull(self.root / entry["path"], axes_path=axes)
+        return self._skulls[key]
+
+    def photo(self, photo, experiment):
+        key = (photo, experiment)
+        if key not in self._photos:
+            folder = self.root / self.photo_paths[photo][experiment]
+            self._photos[key] = read_photo(folder, load_image=False)
+        return self._photos[key]
+
+
+def stored_rows(db):
+    """Every row of a results database with its parsed ``result`` (``row["data"]``)."""
+    with ResultStore(db, read_only=True) as store:
+        rows = [dict(r) for r in store.rows(list(COLUMNS))]
+        config = store.get_meta("config")
+    for r in rows:
+        r["data"] = json.loads(r["result"]) if r.get("result") else None
+    return rows, (config or {}).get("dataset")
+
+
+def _camera(row):
+    data = row["data"]
+    return Camera.from_dict(data["camera"]) if data and data.get("camera") else None
+
+
+def _inputs(row, inputs):
+    skull = inputs.skull(row["subject"], row["experiment"], row["axes_set"])
+    return skull, inputs.photo(row["photo"], row["experiment"])
+
+
+def single_terms(rows, inputs=None):
+    """The terms of every row (None for a failed SFO): stored, or computed with ``inputs``."""
+    out = []
+    for r in rows:
+        camera = _camera(r) if r["success"] else None
+        if camera is None:
+            out.append(None)
+        elif TERMS_KEY in r["data"]:
+            out.append(r["data"][TERMS_KEY])
+        elif inputs is None:
+            raise ValueError(
+                "the database has no identification terms stored and its dataset is missing; "
+                "give --dataset DIR"
+            )
+        else:
+            skull, photo = _inputs(r, inputs)
+            image = None
+            if r["skull_px"] is not None and r["p_pll"] is not None:  # stored by the runner
+                pll = r["p_pll"] / eye_corner_px(camera, _cranial(skull, photo))
+                image = [(r["outside_px"] / max(r["skull_px"], 1), pll)]
+            out.append(identification_terms(skull, [photo], [camera], _facial(r), image=image))
+    return out
+
+
+def _cranial(skull, photo):
+    return correspondences(skull, photo).cranial_mm
+
+
+def _facial(row):
+    data = row["data"] or {}
+    return {k: np.asarray(v, float) for k, v in (data.get("facial_landmarks_3d") or {}).items()}
+
+
+def _run_key(r):
+    return (r["experiment"], r["method"], r["variant"], r["axes_set"], r["repetition"])
+
+
+def decisions(rows, terms, inputs=None):
+    """Every decision of the database with its terms (see the module docstring).
+
+    Returns
+    -------
+    dict
+        ``{(method, variant, decision): [pair, ...]}``, each pair a dict ``terms`` (None for a
+        failed SFO), ``same``, ``person`` (the photo's subject), ``skull``, ``photo`` (the
+        frontal photo of a pair), ``run`` (the run key).
+    """
+    out = defaultdict(list)
+    by_person = defaultdict(dict)
+    for r, t in zip(rows, terms, strict=True):
+        group = view_group(r["view"])
+        method = r["method"]
+        entry = dict(
+            terms=t,
+            same=bool(r["positive"]),
+            person=r["true_subject"],
+            skull=r["subject"],
+            photo=r["photo"],
+            run=_run_key(r),
+        )
+        if method != "lilium-joint":
+            out[(method, r["variant"], group)].append(entry)
+        by_person[(_run_key(r), r["true_subject"], r["subject"])].setdefault(group, []).append(
+            (r, t)
+        )
+    for (run, person, skull_id), groups in sorted(by_person.items()):
+        for (fr, ft), (lr, lt) in zip(groups.get("frontal", []), groups.get("lateral", []),
+                                      strict=False):
+            joint = run[1] == "lilium-joint"
+            base = dict(same=person == skull_id, person=person, skull=skull_id,
+                        photo=fr["photo"], run=run)
+            if ft is None or lt is None:
+                out[(run[1], run[2], "joint" if joint else "pair")].append(base | {"terms": None})
+                continue
+            stored = (fr["data"] or {}).get(TERMS_KEY + "_joint") if joint else None
+            if stored is None:
+                if inputs is None:
+                    raise ValueError("pair terms need the dataset; give --dataset DIR")
+                skull, pf = _inputs(fr, inputs)
+                _, pl = _inputs(lr, inputs)
+                image = [(t["outside_fraction"], t["pll_face"]) for t in (ft, lt)]
+                stored = identification_terms(
+                    skull, [pf, pl], [_camera(fr), _camera(lr)], _facial(fr), image=image
+                )
+            out[(run[1], run[2], "joint" if joint else "pair")].append(base | {"terms": stored})
+            if not joint:
+                out[(run[1], run[2], "pair_sum")].append(base | {"parts": (ft, lt)})
+    return dict(out)
+
+
+def validate(decision_pairs, folds=5):
+    """Cross-validated log10 LR of every decision and its performance.
+
+    ``pair_sum`` decisions add their two photos' cross-validated single-photo log10 LRs.
+
+    Returns
+    -------
+    dict
+        ``{key: {"log10_lr": ndarray, "performance": dict}}``.
+    """
+    out = {}
+    for key, pairs in sorted(decision_pairs.items()):
+        if key[2] == "pair_sum":
+            continue
+        lr = cross_validated(pairs, folds)
+        out[key] = {"log10_lr": lr, "performance": performance(lr, [p["same"] for p in pairs])}
+    for key, pairs in decision_pairs.items():
+        if key[2] != "pair_sum":
+            continue
+        lr = _pair_sum(pairs, decision_pairs, out, key)
+        out[key] = {"log10_lr": lr, "performance": performance(lr, [p["same"] for p in pairs])}
+    return out
+
+
+def _pair_sum(pairs, decision_pairs, validated, key):
+    """Per pair: the frontal and the lateral SFO's cross-validated log10 LR, added."""
+    lookup = {}
+    for view in ("frontal", "lateral"):
+        single = decision_pairs.get((key[0], key[1], view), [])
+        lrs = validated.get((key[0], key[1], view), {}).get("log10_lr", [])
+        for p, v in zip(single, lrs, strict=True):
+            lookup[(view, p["run"], p["person"], p["skull"], p["photo"])] = v
+    out = []
+    for p in pairs:
+        f = lookup.get(("frontal", p["run"], p["person"], p["skull"], p["photo"]), np.nan)
+        lat = [v for k, v in lookup.items()
+               if k[0] == "lateral" and k[1:4] == (p["run"], p["person"], p["skull"])]
+        out.append(f + lat[0] if lat else np.nan)
+    return np.array(out, float)
+
+
+def fit_models(decision_pairs, provenance):
+    """One :class:`Calibration` per decision (``pair_sum`` excepted), fitted on every pair."""
+    models = {}
+    for key, pairs in sorted(decision_pairs.items()):
+        if key[2] == "pair_sum":
+            continue
+        train = [p for p in pairs if p["terms"] is not None]
+        same = [p["same"] for p in train]
+        if not train or all(same) or not any(same):
+            continue
+        models["/".join(key)] = fit(
+            [p["terms"] for p in train], same, provenance=dict(provenance, decision=key[2])
+        )
+    return models
+
+
+def database_decisions(dbs, dataset=None, log=print):
+    """The decisions of one or several results databases, pooled.
+
+    Subjects of different databases are different people even when their ids agree (two
+    dataset seeds both have an ``s01``), so each id is prefixed with its database's index.
+
+    Parameters
+    ----------
+    dbs : sequence of path
+    dataset : path, optional
+        The dataset of a database written without stored terms (default: the one its
+        ``meta`` names).
+
+    Returns
+    -------
+    decisions : dict
+        As :func:`decisions`.
+    rows : list of dict
+        Every row, with its ``terms`` and the database index ``db``.
+    """
+    pooled, all_rows = defaultdict(list), []
+    for k, db in enumerate(dbs):
+        rows, root = stored_rows(db)
+        root = dataset or root
+        inputs = DatasetInputs(root) if root and Path(root, "dataset.json").is_file() else None
+        terms = single_terms(rows, inputs)
+        for key, pairs in decisions(rows, terms, inputs).items():
+            for p in pairs:
+                p.update(person=f"{k}:{p['person']}", skull=f"{k}:{p['skull']}",
+                         run=(k,) + tuple(p["run"]))
+            pooled[key] += pairs
+        for r, t in zip(rows, terms, strict=True):
+            r.update(terms=t, db=k)
+        all_rows += rows
+        log(f"{db}: {len(rows)} SFOs")
+    return dict(pooled), all_rows
+
+
+def performance_table(validated):
+    """Rows of ``calibration.csv``: one per decision, its cross-validated performance."""
+    out = []
+    for (method, variant, decision), v in sorted(validated.items()):
+        out.append(dict(method=method, variant=variant, decision=decision, **v["performance"]))
+    return out

@@ -1,0 +1,181 @@
+"""Files of the identification's calibration (SPEC section 12): ``calibration.json``,
+``calibration.csv`` (Cllr, Cllr_min, rates of misleading evidence per decision), the Tippett
+plot, and the ranking of every photo's skulls by the cross-validated log10 LR beside the
+ranking by the methods' own scores (``identification.csv``).
+
+Used by ``lilium calibrate`` (:func:`calibrate_databases`) and ``lilium report``
+(:func:`lr_identification`).
+"""
+
+import csv
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..io.calibration import write_calibration
+from .calibrate import database_decisions, fit_models, performance_table, validate
+from .config import method_label
+
+#: Label of the two rankings in ``identification.csv``.
+SCORE_FITNESS = "method's own score"
+SCORE_LR = "identification log10 LR (cross-validated)"
+
+#: Decision -> the view its ranking is reported under (a pair ranks by its frontal photo).
+DECISION_VIEW = {"frontal": "frontal", "lateral": "lateral", "pair": "frontal+lateral",
+                 "pair_sum": "frontal+lateral", "joint": "frontal+lateral"}
+
+
+def decision_label(method, variant, decision):
+    """Table label of a decision: the method's, with how photos are combined."""
+    label = method_label(method, variant)
+    return {
+        "pair": f"{label}, separate SFOs, shared soft tissue",
+        "pair_sum": f"{label}, separate SFOs, LRs added (independence)",
+    }.get(decision, label)
+
+
+def ranking_rows(decision_pairs, validated):
+    """Rows for :func:`lilium.experiments.identification.identification_table` that rank each
+    photo's skulls by ``-log10 LR`` (a failed SFO ranks last)."""
+    out = []
+    for key, pairs in decision_pairs.items():
+        method, variant, decision = key
+        lr = validated[key]["log10_lr"]
+        for p, v in zip(pairs, lr, strict=True):
+            ok = bool(np.isfinite(v))
+            out.append(
+                dict(
+                    experiment=p["run"][1],
+                    method=method,
+                    variant=f"{variant}|{decision}",
+                    axes_set=p["run"][4],
+                    repetition=(p["run"][0], p["run"][5]),
+                    photo=p["photo"],
+                    view=DECISION_VIEW[decision],
+                    subject=p["skull"],
+                    true_subject=p["person"],
+                    success=ok,
+                    score=-float(v) if ok else None,
+                )
+            )
+    return out
+
+
+def relabel(table):
+    """Identification-table rows of :func:`ranking_rows` labelled by their decision."""
+    for t in table:
+        t["score"] = SCORE_LR
+    return table
+
+
+def plot_tippett(validated, path):
+    """Tippett plot: per decision, the share of same-person pairs with log10 LR >= x (solid)
+    and of different-person pairs with log10 LR >= x (dashed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    keys = [k for k in sorted(validated) if k[2] != "pair_sum"]
+    fig, axes = plt.subplots(
+        1, max(len(keys), 1), figsize=(3.6 * max(len(keys), 1), 3.6), squeeze=False
+    )
+    for ax, key in zip(axes[0], keys, strict=False):
+        lr = validated[key]["log10_lr"]
+        same = validated[key]["same"]
+        ok = np.isfinite(lr)
+        lo, hi = (np.min(lr[ok]) - 0.2, np.max(lr[ok]) + 0.2) if ok.any() else (-3, 3)
+        grid = np.linspace(lo, hi, 400)
+        for mask, style, label in ((same, "-", "same person"), (~same, "--", "different")):
+            values = lr[ok & mask]
+            if len(values):
+                ax.plot(grid, [(values >= g).mean() for g in grid], style, label=label)
+        ax.axvline(0.0, color="grey", lw=0.8)
+        perf = validated[key]["performance"]
+        ax.set_title(
+            f"{decision_label(*key)}\n{key[2]}: Cllr {perf['cllr']:.2f} "
+            f"(min {perf['cllr_min']:.2f})",
+            fontsize=8,
+        )
+        ax.set_xlabel("log10 LR")
+        ax.set_ylim(0, 1.02)
+        ax.grid(alpha=0.3)
+    axes[0][0].set_ylabel("share of pairs with log10 LR >= x")
+    axes[0][0].legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def write_calibration_csv(path, validated):
+    table = performance_table(validated)
+    for t in table:
+        t["label"] = decision_label(t["method"], t["variant"], t["decision"])
+    keys = ["label", "method", "variant", "decision", "cllr", "cllr_min", "misleading_same",
+            "misleading_diff", "n_same", "n_diff", "failed"]
+    with Path(path).open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")
+        writer.writeheader()
+        writer.writerows(table)
+    return Path(path)
+
+
+def validated_with_labels(decision_pairs, folds=5):
+    validated = validate(decision_pairs, folds)
+    for key, v in validated.items():
+        v["same"] = np.array([p["same"] for p in decision_pairs[key]], bool)
+    return validated
+
+
+def lr_identification(dbs, out_dir, dataset=None, log=print):
+    """``calibration.csv``, ``tippett.png`` and the LR ranking rows of databases.
+
+    Returns
+    -------
+    paths : dict of str -> Path
+    rows : list of dict
+        :func:`ranking_rows`.
+    decision_pairs, validated : dict
+    """
+    out_dir = Path(out_dir)
+    decision_pairs, _ = database_decisions(dbs, dataset, log=log)
+    validated = validated_with_labels(decision_pairs)
+    paths = {
+        "calibration_csv": write_calibration_csv(out_dir / "calibration.csv", validated),
+        "tippett": plot_tippett(validated, out_dir / "tippett.png"),
+    }
+    return paths, ranking_rows(decision_pairs, validated), decision_pairs, validated
+
+
+def calibrate_databases(dbs, out_dir, dataset=None, log=print):
+    """``lilium calibrate``: fit every decision's model on all pairs of the databases and
+    write ``calibration.json`` beside the cross-validated ``calibration.csv`` and Tippett plot.
+
+    Returns
+    -------
+    dict of str -> Path
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths, _, decision_pairs, validated = lr_identification(dbs, out_dir, dataset, log)
+    provenance = {
+        "fitted": time.strftime("%Y-%m-%d"),
+        "lilium": __version__,
+        "databases": [str(Path(db).name) for db in dbs],
+        "model": "logistic regression on the identification terms (lilium.identification)",
+    }
+    models = fit_models(decision_pairs, provenance)
+    for key, model in models.items():
+        perf = validated[tuple(key.split("/"))]["performance"]
+        model.provenance.update(
+            pairs_same=model.n_same,
+            pairs_different=model.n_diff,
+            cv_cllr=round(perf["cllr"], 4),
+            cv_cllr_min=round(perf["cllr_min"], 4),
+        )
+    paths["calibration.json"] = out_dir / "calibration.json"
+    write_calibration(paths["calibration.json"], models, provenance)
+    return paths

@@ -1,0 +1,10 @@
+"""Identification (SPEC section 12): from an SFO result to a likelihood ratio and a conclusion.
+
+- :mod:`~lilium.identification.terms`: the model, maths only (marginal landmark likelihood
+  over the soft tissue, soft-tissue typicality, prior excess);
+- :mod:`~lilium.identification.score`: the terms of one SFO result, single or joint;
+- :mod:`~lilium.identification.calibration`: terms -> log10 LR (logistic regression,
+  cross-validated by subject), Cllr, Cllr_min, rates of misleading evidence;
+- :mod:`~lilium.identification.conclusion`: log10 LR -> the verbal scale, capped by the
+  material.
+"""

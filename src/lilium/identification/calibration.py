@@ -1,0 +1,291 @@
+"""From identification terms to a calibrated log10 likelihood ratio (SPEC section 12).
+
+**Model.** Logistic regression on the transformed terms (:func:`features`): with ``x`` the
+standardised features of one SFO, ``logit P(same | x) = w . x + b``, fitted by L2-penalised
+maximum likelihood on same- and different-person SFOs. Its log LR is the posterior log odds
+minus the training prior log odds: ``log10 LR = (w . x + b - ln(n_same / n_diff)) / ln 10``.
+A model is fitted per method, variant and view (``frontal``, ``lateral``, ``joint``).
+
+**Bounds.** An LR is never more extreme than the data it was fitted on can support: it is
+clipped to ``[-log10(n_same), log10(n_diff)]`` (a different-person score rarer than
+``1 / n_diff`` cannot be measured with ``n_diff`` pairs), after the empirical lower and upper
+bound idea of forensic LR validation. Small calibration sets make LRs vary (Ali et al. 2015):
+the shipped models are fitted on hundreds of pairs and cross-validated by subject.
+
+**Validation.** :func:`cross_validated` scores every pair with a model that never saw its
+subject (k folds of subjects; training leaves out every pair whose photo or skull belongs to
+the fold). :func:`performance` gives Cllr, Cllr_min (after the pool-adjacent-violators
+transform, the best any monotone calibration of the same scores could do) and the rates of
+misleading evidence (same-person pairs with LR < 1, different-person pairs with LR > 1).
+
+Maths only: reading and writing a model is :mod:`lilium.io.calibration`'s job.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import isotonic_regression, minimize
+
+from .terms import TERM_NAMES
+
+#: The feature transforms: heavy-tailed terms on a log scale.
+FEATURES = {
+    "landmark_chi2": lambda v: np.log(np.maximum(v, 1e-6)),
+    "soft_tissue_z2": lambda v: np.log1p(np.maximum(v, 0.0)),
+    "outside_fraction": lambda v: np.log1p(100.0 * np.maximum(v, 0.0)),
+    "pll_face": lambda v: np.log1p(10.0 * np.maximum(v, 0.0)),
+    "prior_excess": lambda v: np.log1p(10.0 * np.maximum(v, 0.0)),
+}
+
+#: L2 penalty on the standardised weights.
+RIDGE = 1e-2
+
+#: Default number of subject folds of the cross-validation.
+FOLDS = 5
+
+
+def features(terms_list, names, fill):
+    """Feature matrix ``(P, len(names))`` of several term dictionaries.
+
+    A term that is None (its input missing) or not finite takes ``fill[name]``, the feature's
+    training median; a landmark term of ``inf`` (a landmark behind the camera) takes the
+    largest finite value instead.
+    """
+    X = np.empty((len(terms_list), len(names)))
+    for j, name in enumerate(names):
+        col = np.array(
+            [np.nan if t.get(name) is None else float(t[name]) for t in terms_list], float
+        )
+        with np.errstate(invalid="ignore", divide="ignore"):
+            col = FEATURES[name](col)
+        col[np.isposinf(col)] = np.nanmax(np.where(np.isfinite(col), col, np.nan), initial=0.0)
+        col[~np.isfinite(col)] = fill[name]
+        X[:, j] = col
+    return X
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A fitted terms -> log10 LR model.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The terms used (those that vary in the training data).
+    centre, scale, fill : dict of str -> float
+        Standardisation and the value of a missing term (training median of the feature).
+    weights : dict of str -> float
+        On the standardised features.
+    intercept : float
+    n_same, n_diff : int
+        Training pairs.
+    provenance : dict
+        Where the model comes from (generator, pairs, budget, date...).
+    """
+
+    names: tuple
+    centre: dict
+    scale: dict
+    fill: dict
+    weights: dict
+    intercept: float
+    n_same: int
+    n_diff: int
+    provenance: dict = field(default_factory=dict)
+
+    @property
+    def bounds(self):
+        """``(lo, hi)``: the log10 LR range the training data supports."""
+        return -float(np.log10(max(self.n_same, 1))), float(np.log10(max(self.n_diff, 1)))
+
+    def log10_lr(self, terms_list):
+        """log10 LR ``(P,)`` of term dictionaries; NaN for a None entry (a failed SFO)."""
+        keep = [i for i, t in enumerate(terms_list) if t is not None]
+        out = np.full(len(terms_list), np.nan)
+        if not keep:
+            return out
+        X = features([terms_list[i] for i in keep], self.names, self.fill)
+        z = (X - [self.centre[n] for n in self.names]) / [self.scale[n] for n in self.names]
+        logit = z @ [self.weights[n] for n in self.names] + self.intercept
+        value = (logit - np.log(self.n_same / self.n_diff)) / np.log(10.0)
+        out[keep] = np.clip(value, *self.bounds)
+        return out
+
+    def to_dict(self):
+        return {
+            "names": list(self.names),
+            "centre": self.centre,
+            "scale": self.scale,
+            "fill": self.fill,
+            "weights": self.weights,
+            "intercept": self.intercept,
+            "n_same": self.n_same,
+            "n_diff": self.n_diff,
+            "provenance": self.provenance,
+        }
+
+    @classmethod
+    def from_dict(cls, data):
+        names = tuple(data["names"])
+        unknown = [n for n in names if n not in FEATURES]
+        if unknown:
+            raise ValueError(f"unknown identification terms {unknown}; known: {list(FEATURES)}")
+        return cls(
+            names,
+            {n: float(data["centre"][n]) for n in names},
+            {n: float(data["scale"][n]) for n in names},
+            {n: float(data["fill"][n]) for n in names},
+            {n: float(data["weights"][n]) for n in names},
+            float(data["intercept"]),
+            int(data["n_same"]),
+            int(data["n_diff"]),
+            dict(data.get("provenance", {})),
+        )
+
+
+def fit(terms_list, same, names=TERM_NAMES, provenance=None):
+    """Fit a :class:`Calibration` on term dictionaries and their labels.
+
+    Parameters
+    ----------
+    terms_list : list of dict
+        One per SFO with a camera (no None).
+    same : array_like of bool, shape (P,)
+        True for a same-person pair.
+    names : sequence of str
+        Candidate terms; those missing in every pair or constant are left out.
+    provenance : dict, optional
+    """
+    same = np.asarray(same, bool)
+    if same.all() or not same.any():
+        raise ValueError("a calibration needs both same- and different-person pairs")
+    raw = {}
+    for name in names:
+        col = np.array(
+            [np.nan if t.get(name) is None else float(t[name]) for t in terms_list], float
+        )
+        with np.errstate(invalid="ignore", divide="ignore"):
+            col = FEATURES[name](col)
+        if np.isfinite(col).sum() >= 2 and np.nanstd(np.where(np.isfinite(col), col, np.nan)) > 0:
+            raw[name] = col
+    used = tuple(raw)
+    fill = {n: float(np.nanmedian(np.where(np.isfinite(raw[n]), raw[n], np.nan))) for n in used}
+    X = features(terms_list, used, fill)
+    centre = X.mean(axis=0)
+    scale = X.std(axis=0)
+    scale[scale == 0] = 1.0
+    Z = (X - centre) / scale
+    y = same.astype(float)
+
+    def loss(p):
+        logit = Z @ p[:-1] + p[-1]
+        nll = np.sum(np.logaddexp(0.0, logit) - y * logit)
+        prob = 0.5 * (1.0 + np.tanh(0.5 * logit))
+        grad = np.concatenate([Z.T @ (prob - y), [np.sum(prob - y)]])
+        n = len(y)
+        return nll / n + RIDGE * p[:-1] @ p[:-1], grad / n + np.concatenate(
+            [2 * RIDGE * p[:-1], [0.0]]
+        )
+
+    p = minimize(loss, np.zeros(len(used) + 1), jac=True, method="L-BFGS-B").x
+    return Calibration(
+        used,
+        dict(zip(used, map(float, centre), strict=True)),
+        dict(zip(used, map(float, scale), strict=True)),
+        fill,
+        dict(zip(used, map(float, p[:-1]), strict=True)),
+        float(p[-1]),
+        int(same.sum()),
+        int((~same).sum()),
+        dict(provenance or {}),
+    )
+
+
+def subject_folds(subjects, folds=FOLDS):
+    """``{subject: fold}``: subjects in sorted order dealt to ``folds`` folds in turn."""
+    return {s: i % folds for i, s in enumerate(sorted(set(subjects)))}
+
+
+def cross_validated(pairs, folds=FOLDS, names=TERM_NAMES):
+    """Cross-validated log10 LR of every pair: each scored by a model that never saw its
+    photo's subject (nor any pair with that subject's skull).
+
+    Parameters
+    ----------
+    pairs : list of dict
+        ``terms`` (dict or None for a failed SFO), ``same`` (bool), ``person`` (the photo's
+        subject), ``skull`` (the skull's subject).
+
+    Returns
+    -------
+    ndarray of shape (P,)
+        NaN for a failed SFO.
+    """
+    fold_of = subject_folds([p["person"] for p in pairs] + [p["skull"] for p in pairs], folds)
+    out = np.full(len(pairs), np.nan)
+    for k in sorted(set(fold_of.values())):
+        train = [
+            p
+            for p in pairs
+            if p["terms"] is not None
+            and fold_of[p["person"]] != k
+            and fold_of[p["skull"]] != k
+        ]
+        test = [i for i, p in enumerate(pairs) if fold_of[p["person"]] == k]
+        if not test:
+            continue
+        model = fit([p["terms"] for p in train], [p["same"] for p in train], names)
+        out[test] = model.log10_lr([pairs[i]["terms"] for i in test])
+    return out
+
+
+def cllr(log10_lr, same):
+    """The log-likelihood-ratio cost (bits): 0 perfect, 1 = an uninformative system."""
+    lr = np.asarray(log10_lr, float) * np.log(10.0)
+    same = np.asarray(same, bool)
+    c_same = np.mean(np.logaddexp(0.0, -lr[same])) / np.log(2.0)
+    c_diff = np.mean(np.logaddexp(0.0, lr[~same])) / np.log(2.0)
+    return 0.5 * (c_same + c_diff)
+
+
+def pav_log10_lr(scores, same):
+    """The pool-adjacent-violators log10 LR of ``scores`` (higher = more likely the same):
+    the best monotone calibration of these very scores (for Cllr_min)."""
+    scores = np.asarray(scores, float)
+    same = np.asarray(same, bool)
+    order = np.argsort(scores, kind="stable")
+    post = isotonic_regression(same[order].astype(float)).x
+    n1, n0 = same.sum(), (~same).sum()
+    eps = 1e-12
+    with np.errstate(divide="ignore"):
+        lr = np.log10(np.clip(post, eps, 1 - eps) / np.clip(1 - post, eps, 1)) - np.log10(n1 / n0)
+    out = np.empty_like(scores)
+    out[order] = lr
+    return out
+
+
+def performance(log10_lr, same):
+    """Cllr, Cllr_min and the rates of misleading evidence of calibrated LRs.
+
+    Pairs whose SFO failed (NaN) are left out and counted.
+
+    Returns
+    -------
+    dict
+        ``cllr``, ``cllr_min``, ``misleading_same`` (share of same-person pairs with
+        log10 LR < 0), ``misleading_diff`` (different-person pairs with log10 LR > 0),
+        ``n_same``, ``n_diff``, ``failed``.
+    """
+    log10_lr = np.asarray(log10_lr, float)
+    same = np.asarray(same, bool)
+    ok = np.isfinite(log10_lr)
+    v, s = log10_lr[ok], same[ok]
+    return {
+        "cllr": float(cllr(v, s)),
+        "cllr_min": float(cllr(pav_log10_lr(v, s), s)),
+        "misleading_same": float(np.mean(v[s] < 0)) if s.any() else float("nan"),
+        "misleading_diff": float(np.mean(v[~s] > 0)) if (~s).any() else float("nan"),
+        "n_same": int(s.sum()),
+        "n_diff": int((~s).sum()),
+        "failed": int((~ok).sum()),
+    }

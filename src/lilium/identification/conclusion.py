@@ -1,0 +1,154 @@
+"""From a log10 likelihood ratio to a conclusion an examiner can sign (SPEC section 12).
+
+**The verbal scale** (after MEPROCS' seven levels; the bands are Lilium's own):
+
+=========================  ===============================
+log10 LR                   conclusion
+=========================  ===============================
+>= 2                       strong support
+[1, 2)                     moderate support
+[0.5, 1)                   limited support
+(-0.5, 0.5)                undetermined
+(-1, -0.5]                 limited support for exclusion
+(-2, -1]                   moderate support for exclusion
+<= -2                      strong support for exclusion
+=========================  ===============================
+
+An LR of 3 (log10 0.5) is the least called support: below it the calibration's own spread
+between subject folds is of the same size (docs/method.md, "Identification").
+
+**Caps.** Support is capped by the material: each of these lowers the highest support
+level the case can reach by one step (strong -> moderate -> limited -> undetermined), and each
+is named in the result: the skull has no mandible; a single photo; automatic landmarks that
+nobody reviewed; fewer than 8 landmark pairs. Exclusion is not capped: a poor match is
+evidence against the same person whatever the material.
+
+**Consistency.** A consistency failure (skull pixels outside the head mask: an implausible
+SFO; the camera disagreeing with the declared view) is never support: the conclusion is at
+most "undetermined" and says why. A failed SFO (no camera) is "undetermined".
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: The verbal scale, from strongest exclusion to strongest support: (label, lowest log10 LR).
+SCALE = (
+    ("strong support for exclusion", -np.inf),
+    ("moderate support for exclusion", -2.0),
+    ("limited support for exclusion", -1.0),
+    ("undetermined", -0.5),
+    ("limited support", 0.5),
+    ("moderate support", 1.0),
+    ("strong support", 2.0),
+)
+
+#: Index of "undetermined" in :data:`SCALE`.
+UNDETERMINED = 3
+
+#: Fewest landmark pairs that do not cap the support.
+MIN_PAIRS_UNCAPPED = 8
+
+
+def level(log10_lr):
+    """Index in :data:`SCALE` of a log10 LR (upper band edges belong to the band above, but
+    ``-0.5`` / ``-1`` / ``-2`` themselves count as exclusion)."""
+    if log10_lr <= -2.0:
+        return 0
+    if log10_lr <= -1.0:
+        return 1
+    if log10_lr <= -0.5:
+        return 2
+    if log10_lr < 0.5:
+        return 3
+    if log10_lr < 1.0:
+        return 4
+    if log10_lr < 2.0:
+        return 5
+    return 6
+
+
+def material_caps(has_mandible, photos, unreviewed_automatic, pairs):
+    """The caps of SPEC section 12 that apply, as ``{code: sentence}``.
+
+    Parameters
+    ----------
+    has_mandible : bool
+    photos : int
+        Photos behind the decision.
+    unreviewed_automatic : bool
+        Some landmark used was placed automatically and not reviewed.
+    pairs : int
+        Fewest landmark pairs of any photo behind the decision.
+    """
+    caps = {}
+    if not has_mandible:
+        caps["no_mandible"] = "the skull has no mandible (chin and jaw cannot be compared)"
+    if photos < 2:
+        caps["single_photo"] = "a single photo (one view of the face)"
+    if unreviewed_automatic:
+        caps["unreviewed_landmarks"] = (
+            "automatic landmarks nobody reviewed (review them in review.html)"
+        )
+    if pairs < MIN_PAIRS_UNCAPPED:
+        caps["few_pairs"] = f"only {pairs} landmark pairs (fewer than {MIN_PAIRS_UNCAPPED})"
+    return caps
+
+
+@dataclass(frozen=True)
+class Conclusion:
+    """A conclusion on the verbal scale.
+
+    Attributes
+    ----------
+    label : str
+        One of :data:`SCALE`'s labels.
+    uncapped : str
+        The label the LR alone would give.
+    caps : dict of str -> str
+        The material caps that apply (whether or not they lowered this LR's level).
+    inconsistent : dict of str -> str
+        Consistency failures that keep the conclusion from support.
+    """
+
+    label: str
+    uncapped: str
+    caps: dict
+    inconsistent: dict
+
+    @property
+    def sentence(self):
+        """One line: the label, and why it is lower than the LR alone, if it is."""
+        why = []
+        if self.label != self.uncapped:
+            why += list(self.inconsistent.values()) + list(self.caps.values())
+        return self.label + (f" (capped from {self.uncapped}: " + "; ".join(why) + ")"
+                             if why else "")
+
+
+def conclude(log10_lr, caps=None, inconsistent=None):
+    """The conclusion of a log10 LR under the material caps and consistency failures.
+
+    Parameters
+    ----------
+    log10_lr : float or None
+        None or NaN: no LR (a failed SFO) -> undetermined.
+    caps : dict of str -> str, optional
+        :func:`material_caps`.
+    inconsistent : dict of str -> str, optional
+        ``{warning code: sentence}`` of consistency failures.
+
+    Returns
+    -------
+    Conclusion
+    """
+    caps, inconsistent = dict(caps or {}), dict(inconsistent or {})
+    if log10_lr is None or not np.isfinite(log10_lr):
+        label = SCALE[UNDETERMINED][0]
+        return Conclusion(label, label, caps, inconsistent)
+    raw = level(log10_lr)
+    top = len(SCALE) - 1 - len(caps)
+    if inconsistent:
+        top = UNDETERMINED
+    capped = min(raw, max(top, UNDETERMINED))
+    return Conclusion(SCALE[capped][0], SCALE[raw][0], caps, inconsistent)

@@ -1,0 +1,138 @@
+"""The identification terms and score of one SFO result, single or joint (SPEC section 12).
+
+:func:`identification_terms` turns a skull, the photo(s) and the camera(s) and soft tissue an
+SFO found into the terms of :mod:`lilium.identification.terms`; :func:`nll_score` adds them up
+unweighted (the score before calibration); the calibrated log10 LR is
+:meth:`lilium.identification.calibration.Calibration.log10_lr`.
+"""
+
+import numpy as np
+
+from ..evaluation.metrics import outside_face
+from ..geometry.camera import Camera
+from ..inputs import correspondences
+from ..methods.checks import scd_point_mm
+from ..methods.lilium_terms import PllTerm, TermOff
+from ..softtissue.depths import depth_stats
+from ..softtissue.landmarks import CRANIAL_TO_FACIAL
+from .terms import (
+    TERM_NAMES,
+    eye_corner_px,
+    landmark_chi2,
+    make_view,
+    prior_excess,
+    soft_tissue_z2,
+)
+
+
+def _soft_tissue_term(skull, facial_landmarks_mm, depth_table):
+    names = [
+        c
+        for c, f in CRANIAL_TO_FACIAL.items()
+        if c in skull.landmarks_mm and f in facial_landmarks_mm and c in skull.axes
+    ]
+    if not names:
+        return None
+    stats = [depth_stats(c, depth_table) for c in names]
+    return soft_tissue_z2(
+        np.array([facial_landmarks_mm[CRANIAL_TO_FACIAL[c]] for c in names], float),
+        np.array([skull.landmarks_mm[c] for c in names], float),
+        np.array([skull.axes[c] for c in names], float),
+        np.array([s.mean_mm for s in stats]),
+        np.array([s.sd_mm for s in stats]),
+    )
+
+
+def image_consistency(skull, photo, camera, eye_px):
+    """``outside_fraction`` and ``pll_face`` of one photo under one camera (None when the
+    photo has no mask / P_pll cannot apply)."""
+    outside = pll = None
+    if photo.face_mask is not None:
+        counts = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
+        outside = counts.outside_px / counts.skull_px if counts.skull_px else 1.0
+    try:
+        term = PllTerm(skull, photo, camera.principal_point_px)
+    except TermOff:
+        term = None
+    if term is not None and np.isfinite(eye_px) and eye_px > 0:
+        pll = float(term(camera.as_batch())[0]) / eye_px
+    return outside, pll
+
+
+def identification_terms(
+    skull, photos, cameras, facial_landmarks_mm, depth_table=None, image=None
+):
+    """The identification terms of one SFO result.
+
+    Parameters
+    ----------
+    skull : Skull
+    photos : sequence of Photo
+        One photo (a single SFO) or several (a joint SFO, or separate SFOs of one person
+        combined: their soft tissue is shared in the landmark term).
+    cameras : sequence of Camera
+        The SFO's camera for each photo.
+    facial_landmarks_mm : dict of str -> array_like of shape (3,)
+        The soft tissue the SFO found (facial points, skull frame); for separate SFOs any one
+        of them, or None to leave ``soft_tissue_z2`` out.
+    depth_table : dict, optional
+    image : sequence of (float or None, float or None), optional
+        Per photo, ``(outside_fraction, pll_face)`` already known (e.g. from the photo's own
+        SFO when several are combined); computed when not given.
+
+    Returns
+    -------
+    dict
+        ``{name: float or None}`` for every name of :data:`TERM_NAMES`, plus ``"nll"`` (the
+        landmarks' negative log-likelihood in nats) and ``"landmarks"`` (pairs used).
+    """
+    views, outside, pll, excess = [], [], [], []
+    for k, (photo, camera) in enumerate(zip(photos, cameras, strict=True)):
+        corr = correspondences(skull, photo)
+        view = make_view(camera, corr, photo.landmark_sources, depth_table)
+        views.append(view)
+        if image is not None:
+            o, p = image[k]
+        else:
+            o, p = image_consistency(skull, photo, camera, eye_corner_px(camera, view.cranial_mm))
+        outside.append(o)
+        pll.append(p)
+        point = scd_point_mm(facial_landmarks_mm) if facial_landmarks_mm else corr.cranial_mm[0]
+        excess.append(prior_excess(camera, photo.priors, point))
+    chi2, nll = landmark_chi2(views)
+    st = _soft_tissue_term(skull, facial_landmarks_mm or {}, depth_table)
+
+    def mean(values):
+        values = [v for v in values if v is not None]
+        return float(np.mean(values)) if values else None
+
+    out = dict(
+        landmark_chi2=chi2,
+        soft_tissue_z2=st,
+        outside_fraction=mean(outside),
+        pll_face=mean(pll),
+        prior_excess=(
+            float(np.sum([e for e in excess if e is not None]))
+            if any(e is not None for e in excess)
+            else None
+        ),
+    )
+    assert tuple(out) == TERM_NAMES
+    out["nll"] = nll
+    out["landmarks"] = int(sum(len(v.names) for v in views))
+    return out
+
+
+def nll_score(terms):
+    """The unweighted identification score (lower = more likely the same person): the
+    landmarks' chi^2 per coordinate plus the other terms as they are (a None counts 0)."""
+    return float(sum(terms[k] or 0.0 for k in TERM_NAMES))
+
+
+def cameras_of(result):
+    """The cameras of a ``result.json`` dictionary, single or joint (None for a failed one)."""
+    if result.get("joint"):
+        return [Camera.from_dict(p["camera"]) if p.get("camera") else None
+                for p in result["photos"]]
+    return [Camera.from_dict(result["camera"]) if result.get("camera") else None]
+

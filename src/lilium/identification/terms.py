@@ -1,0 +1,242 @@
+"""The identification terms of an SFO result (SPEC section 12): how likely the observations
+are under "this skull is this person", given the camera(s) the SFO found.
+
+The model (docs/method.md, "Identification"), for every landmark pair ``i`` (cranial point
+``C_i``, soft-tissue axis ``a_i``, population depth mean ``mu_i`` and SD ``s_i``):
+
+- **the soft tissue is a random vector**, not a free parameter: the facial point is
+  ``F_i = C_i + mu_i a_i + delta_i`` with ``delta_i ~ N(0, Sigma_i)``,
+  ``Sigma_i = s_i^2 a a^T + (mu_i tan(tau))^2 (I - a a^T) + sigma_bone^2 I``: the depth's
+  population SD along the axis, an angular spread ``tau`` about it, and the cranial landmark's
+  own placement error;
+- **each 2D landmark is observed with an isotropic error** ``sigma_i`` (pixels per
+  coordinate): a fraction of the eye-corner distance that depends on who placed it (by hand,
+  automatic tracked, automatic template), with a floor;
+- linearising the projection at the mean facial point (Jacobian ``J_i``, 2 x 3), the residual
+  ``r_i = uv_i - P(C_i + mu_i a_i)`` is Gaussian with covariance
+  ``S_i = J_i Sigma_i J_i^T + sigma_i^2 I``: the soft tissue is integrated out in closed form
+  (a marginal likelihood; no freedom left to fit a wrong skull). With several photos of one
+  person the soft tissue is the same in all of them, so the residuals of landmark ``i`` in
+  every photo are stacked and share ``Sigma_i``: their dependence is modelled, not ignored.
+
+The terms (all "lower is better", dimensionless):
+
+- ``landmark_chi2``: ``sum_i r_i^T S_i^{-1} r_i / (2 N)``, the mean squared Mahalanobis
+  residual per observed coordinate (1 expected for the true skull);
+- ``soft_tissue_z2``: the SFO's own soft tissue against the population, the mean over
+  landmarks of ``z_depth^2 + (angle / tau)^2`` (0 for POSEST-SFO, whose soft tissue is the
+  mean one);
+- ``outside_fraction``: the share of the projected skull's pixels outside the head mask;
+- ``pll_face``: P_pll divided by the eye-corner distance in pixels (face-size units);
+- ``prior_excess``: how far the camera lies outside its priors, relative to each prior
+  (focal and distance as a fraction of the bound, the head angle in units of its tolerance),
+  squared and summed.
+
+A term whose input is missing (no mask, no curve, no prior) is None; the calibration
+(:mod:`lilium.identification.calibration`) reads a None as the term's typical value and says so.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.rotations import geodesic_angle_deg
+from ..softtissue.depths import depth_stats
+
+#: Mean adult eye-corner (exocanthion to exocanthion) distance, mm: the face-size unit.
+EYE_CORNER_MM = 90.0
+
+#: 2D landmark error per coordinate, as a fraction of the eye-corner distance, by source:
+#: hand-placed (``manual``, also a reviewed automatic point), automatic on image evidence
+#: (``tracked``) and automatic from the face template (``template``).
+SIGMA_FRACTION = {"manual": 0.02, "tracked": 0.03, "template": 0.08}
+
+#: Floor of the 2D landmark error (pixels per coordinate): a landmark is never placed better
+#: than this, however small the face.
+SIGMA_FLOOR_PX = 1.5
+
+#: Angular spread (degrees) of the soft-tissue direction about its axis.
+DIRECTION_SD_DEG = 15.0
+
+#: Placement error (mm per coordinate) of a cranial landmark on the skull.
+BONE_SD_MM = 1.0
+
+#: Order of the terms (the calibration's features).
+TERM_NAMES = ("landmark_chi2", "soft_tissue_z2", "outside_fraction", "pll_face", "prior_excess")
+
+
+@dataclass(frozen=True)
+class View:
+    """One photo's share of an identification: its correspondences under the SFO's camera.
+
+    Attributes
+    ----------
+    camera : Camera
+    cranial_mm : ndarray of shape (N, 3)
+    axes : ndarray of shape (N, 3)
+        Unit soft-tissue axes.
+    depth_mean_mm, depth_sd_mm : ndarray of shape (N,)
+    uv_px : ndarray of shape (N, 2)
+        The observed facial landmarks.
+    sources : tuple of str, length N
+        Keys of :data:`SIGMA_FRACTION`.
+    names : tuple of str, length N
+        Cranial names (the key that ties a landmark across photos).
+    """
+
+    camera: object
+    cranial_mm: np.ndarray
+    axes: np.ndarray
+    depth_mean_mm: np.ndarray
+    depth_sd_mm: np.ndarray
+    uv_px: np.ndarray
+    sources: tuple
+    names: tuple
+
+
+def make_view(camera, corr, sources=None, depth_table=None):
+    """A :class:`View` from an SFO's camera and its :class:`lilium.inputs.Correspondences`.
+
+    Parameters
+    ----------
+    camera : Camera
+    corr : Correspondences
+    sources : dict of str -> str, optional
+        Facial name -> ``manual`` / ``tracked`` / ``template``; absent = ``manual``.
+    depth_table : dict, optional
+        A user's depth table (:func:`lilium.softtissue.depths.depth_stats`).
+    """
+    sources = sources or {}
+    stats = [depth_stats(c, depth_table) for c in corr.cranial_names]
+    return View(
+        camera,
+        np.asarray(corr.cranial_mm, float),
+        np.asarray(corr.axes, float),
+        np.array([s.mean_mm for s in stats]),
+        np.array([s.sd_mm for s in stats]),
+        np.asarray(corr.uv_px, float),
+        tuple(sources.get(f, "manual") for f in corr.facial_names),
+        tuple(corr.cranial_names),
+    )
+
+
+def soft_tissue_covariance(axes, depth_mean_mm, depth_sd_mm):
+    """``Sigma_i`` of the model, ``(N, 3, 3)`` mm^2, for unit axes ``(N, 3)``."""
+    a = np.asarray(axes, float)
+    along = a[:, :, None] * a[:, None, :]
+    lateral_sd = np.asarray(depth_mean_mm) * np.tan(np.radians(DIRECTION_SD_DEG))
+    eye = np.eye(3)[None]
+    return (
+        np.asarray(depth_sd_mm)[:, None, None] ** 2 * along
+        + lateral_sd[:, None, None] ** 2 * (eye - along)
+        + BONE_SD_MM**2 * eye
+    )
+
+
+def eye_corner_px(camera, points_mm):
+    """The eye-corner distance in pixels at the depth of ``points_mm`` ``(N, 3)`` (their
+    centroid): ``EYE_CORNER_MM * focal / depth``; the face-size unit of a photo."""
+    depth = camera.to_camera_frame(np.mean(points_mm, axis=0, keepdims=True))[0, 2]
+    return EYE_CORNER_MM * camera.focal_px / depth if depth > 0 else np.nan
+
+
+def _mean_points_and_jacobians(view):
+    """Mean facial points' residuals ``(N, 2)`` and projection Jacobians ``(N, 2, 3)``."""
+    mean_mm = view.cranial_mm + view.depth_mean_mm[:, None] * view.axes
+    cam = view.camera
+    X = cam.to_camera_frame(mean_mm)
+    z = X[:, 2]
+    f = cam.focal_px
+    jac_cam = np.zeros((len(X), 2, 3))
+    jac_cam[:, 0, 0] = jac_cam[:, 1, 1] = f / z
+    jac_cam[:, 0, 2] = -f * X[:, 0] / z**2
+    jac_cam[:, 1, 2] = -f * X[:, 1] / z**2
+    residual = view.uv_px - cam.project(mean_mm)
+    return residual, jac_cam @ cam.R, z
+
+
+def landmark_chi2(views):
+    """The marginal landmark term over one or several photos of one person.
+
+    Landmarks with the same cranial name in several views share their soft tissue: their
+    residuals are stacked into one Gaussian whose covariance couples them through
+    ``Sigma_i``.
+
+    Parameters
+    ----------
+    views : sequence of View
+
+    Returns
+    -------
+    chi2 : float
+        ``sum_i r_i^T S_i^{-1} r_i`` over every landmark of every view divided by the number of
+        observed coordinates; ``inf`` when a landmark lies behind a camera.
+    nll : float
+        The negative log-likelihood of the landmarks (nats): ``0.5 sum_i (r^T S^-1 r +
+        log det(2 pi S_i))``.
+    """
+    by_name = {}
+    for view in views:
+        residual, jac, z = _mean_points_and_jacobians(view)
+        if not np.all(z > 0) or not np.all(np.isfinite(residual)):
+            return np.inf, np.inf
+        sigma_px = np.maximum(
+            SIGMA_FLOOR_PX,
+            np.array([SIGMA_FRACTION.get(s, SIGMA_FRACTION["manual"]) for s in view.sources])
+            * eye_corner_px(view.camera, view.cranial_mm),
+        )
+        cov = soft_tissue_covariance(view.axes, view.depth_mean_mm, view.depth_sd_mm)
+        for k, name in enumerate(view.names):
+            by_name.setdefault(name, []).append((residual[k], jac[k], sigma_px[k], cov[k]))
+    quad = logdet = 0.0
+    coords = 0
+    for entries in by_name.values():
+        r = np.concatenate([e[0] for e in entries])
+        J = np.concatenate([e[1] for e in entries])
+        noise = np.repeat([e[2] ** 2 for e in entries], 2)
+        S = J @ entries[0][3] @ J.T + np.diag(noise)
+        quad += float(r @ np.linalg.solve(S, r))
+        logdet += float(np.linalg.slogdet(2 * np.pi * S)[1])
+        coords += len(r)
+    return quad / coords, 0.5 * (quad + logdet)
+
+
+def soft_tissue_z2(facial_mm, cranial_mm, axes, depth_mean_mm, depth_sd_mm):
+    """Mean over landmarks of ``z_depth^2 + (angle / tau)^2`` of an SFO's soft tissue.
+
+    Parameters
+    ----------
+    facial_mm, cranial_mm, axes : ndarray of shape (N, 3)
+    depth_mean_mm, depth_sd_mm : ndarray of shape (N,)
+    """
+    v = np.asarray(facial_mm, float) - np.asarray(cranial_mm, float)
+    depth = np.linalg.norm(v, axis=1)
+    cos = np.einsum("ij,ij->i", v, axes) / np.maximum(depth, 1e-12)
+    angle = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    z = (depth - depth_mean_mm) / depth_sd_mm
+    return float(np.mean(z**2 + (angle / DIRECTION_SD_DEG) ** 2))
+
+
+def prior_excess(camera, priors, nasion_mm):
+    """How far a camera lies outside its priors (0 inside every prior; None without any).
+
+    Parameters
+    ----------
+    camera : Camera
+    priors : lilium.inputs.Priors
+    nasion_mm : ndarray of shape (3,)
+        The point whose distance is the SCD (skull frame).
+    """
+    parts = []
+    if priors.focal_px is not None:
+        lo, hi = priors.focal_px
+        parts.append(max(0.0, lo / camera.focal_px - 1.0, camera.focal_px / hi - 1.0))
+    if priors.scd_mm is not None:
+        lo, hi = priors.scd_mm
+        scd = float(camera.distance_mm(nasion_mm))
+        parts.append(max(0.0, lo / scd - 1.0, scd / hi - 1.0))
+    if priors.uses_head:
+        angle = geodesic_angle_deg(camera.R, priors.head_rotation_skull2cam)
+        tol = max(priors.head_tolerance_deg, 1.0)
+        parts.append(max(0.0, angle - priors.head_tolerance_deg) / tol)
+    return float(np.sum(np.square(parts))) if parts else None

@@ -1,0 +1,74 @@
+"""The report's first section: the identification's conclusions (SPEC section 12).
+
+One row per decision (each SFO, each joint SFO, and a person's photos taken together): the
+conclusion on the verbal scale, the calibrated log10 LR, what capped it (the material, a
+consistency failure) and the calibration model it comes from. The fitness stays in each SFO's
+section as the paper's score.
+"""
+
+from html import escape
+
+from ..identification.conclusion import SCALE
+
+#: CSS class of a conclusion by its side of the scale.
+_SIDE = {label: ("support" if k > 3 else "exclusion" if k < 3 else "undetermined")
+         for k, (label, _) in enumerate(SCALE)}
+
+
+def _lr_text(record):
+    lr = record.get("log10_lr")
+    if lr is None:
+        return "&ndash;"
+    return f"{lr:+.2f} <span class='muted'>(LR {10 ** lr:.3g})</span>"
+
+
+def _why(record):
+    parts = [
+        f"<b>{escape(code)}</b>: {escape(text)}"
+        for code, text in (record.get("inconsistent") or {}).items()
+    ]
+    caps = (record.get("caps") or {}).items()
+    parts += [f"{escape(code)}: {escape(text)}" for code, text in caps]
+    if record.get("note"):
+        parts.append(f"<i>{escape(record['note'])}</i>")
+    return "<br>".join(parts) or "&ndash;"
+
+
+def conclusion_section(decisions):
+    """HTML of the conclusions (empty when the page has none).
+
+    Parameters
+    ----------
+    decisions : sequence of (str, str, dict)
+        ``ReportRecord.decisions``.
+    """
+    if not decisions:
+        return ""
+    rows = []
+    for label, anchor, record in decisions:
+        name = escape(label)
+        if anchor:
+            name = f"<a href='#{escape(anchor)}'>{name}</a>"
+        conclusion = record.get("conclusion", "undetermined")
+        capped = ""
+        if record.get("conclusion_uncapped") not in (None, conclusion):
+            alone = escape(record["conclusion_uncapped"])
+            capped = f"<br><span class='muted'>(LR alone: {alone})</span>"
+        model = escape((record.get("calibration") or {}).get("model", ""))
+        rows.append(
+            f"<tr><td>{name}</td><td class='conclusion {_SIDE.get(conclusion, '')}'>"
+            f"<b>{escape(conclusion)}</b>{capped}</td><td>{_lr_text(record)}</td>"
+            f"<td>{_why(record)}</td><td><code>{model}</code></td></tr>"
+        )
+    head = ("<tr><th>decision</th><th>conclusion</th><th>log10 LR</th>"
+            "<th>caps and consistency</th><th>calibration</th></tr>")
+    return (
+        "<h2 style='border:0;margin-top:12px'>Identification</h2>\n"
+        "<p class='note'>Is this the person? The likelihood ratio compares the observations "
+        "under \"this skull is the person in the photo\" with \"a random other person\", "
+        "calibrated on generated subjects (docs/method.md, Identification). The conclusion "
+        "follows a verbal scale, capped by the material; a skull outside the head or a camera "
+        "that contradicts the declared view is never support. The fitness in each SFO's "
+        "section is the paper's alignment score, not an identification.</p>\n"
+        f"<table class='conclusions'><thead>{head}</thead><tbody>{''.join(rows)}</tbody></table>\n"
+    )

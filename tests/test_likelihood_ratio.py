@@ -1,0 +1,187 @@
+"""Identification as a likelihood ratio (SPEC section 12): the marginal landmark term, the
+calibration, the conclusion and its caps, and the ``"identification"`` record of ``lilium sfo``
+and ``lilium case``."""
+
+import json
+
+import numpy as np
+import pytest
+
+from lilium.cli.main import main
+from lilium.geometry.camera import Camera
+from lilium.identification.calibration import (
+    Calibration,
+    cllr,
+    cross_validated,
+    fit,
+    pav_log10_lr,
+    performance,
+)
+from lilium.identification.conclusion import conclude, level, material_caps
+from lilium.identification.terms import (
+    View,
+    landmark_chi2,
+    prior_excess,
+    soft_tissue_covariance,
+)
+from lilium.inputs import Priors
+
+
+def _view(rng, scale=1.0, n=40, camera=None, noise=True, sigma_px=None):
+    """A view whose observations follow the model (soft tissue and 2D noise drawn from it)
+    for a skull ``scale`` times the one observed (1 = the true skull)."""
+    camera = camera or Camera.from_rt(np.diag([1.0, -1.0, -1.0]), [0, 0, 1500.0], 3000.0,
+                                      [500.0, 400.0])
+    cranial = rng.normal(0, 40, (n, 3))
+    cranial[:, 2] = -np.abs(cranial[:, 2]) - 60  # facing the camera (camera looks down -z)
+    axes = rng.normal(0, 1, (n, 3)) + [0, 0, -3]
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    mean, sd = np.full(n, 8.0), np.full(n, 2.0)
+    cov = soft_tissue_covariance(axes, mean, sd)
+    delta = np.array([rng.multivariate_normal(np.zeros(3), c) for c in cov]) if noise else 0
+    facial = cranial * scale + mean[:, None] * axes + delta
+    uv = camera.project(facial)
+    if noise:
+        eye_px = 90.0 * camera.focal_px / 1500.0
+        uv = uv + rng.normal(0, max(1.5, 0.02 * eye_px) if sigma_px is None else sigma_px, uv.shape)
+    return View(camera, cranial, axes, mean, sd, uv, ("manual",) * n,
+                tuple(f"p{k}" for k in range(n)))
+
+
+def test_marginal_chi2_is_one_for_the_model_and_larger_for_another_skull():
+    rng = np.random.default_rng(0)
+    true = [landmark_chi2([_view(rng)])[0] for _ in range(20)]
+    assert 0.8 < np.mean(true) < 1.2  # the residuals' own covariance: 1 per coordinate
+    wrong = [landmark_chi2([_view(rng, scale=1.08)])[0] for _ in range(20)]
+    assert np.mean(wrong) > 1.5 * np.mean(true)
+
+
+def test_shared_soft_tissue_couples_two_views():
+    """Two photos of the same soft tissue: the coupled likelihood sees one soft-tissue draw;
+    counting each photo alone would count it twice (chi2 per coordinate unchanged). The same
+    view twice is not twice the evidence: the shared part is counted once."""
+    rng = np.random.default_rng(1)
+    view = _view(rng, noise=True, sigma_px=0.01)
+    single, _ = landmark_chi2([view])
+    twice, _ = landmark_chi2([view, view])
+    # With (almost) no 2D noise the residual is the soft tissue's, identical in both photos:
+    # independent photos would keep chi2 per coordinate at `single`; coupled, it drops.
+    assert twice < 0.75 * single
+
+
+def test_landmark_behind_the_camera_is_infinitely_unlikely():
+    rng = np.random.default_rng(2)
+    view = _view(rng)
+    behind = View(view.camera, view.cranial_mm + [0, 0, 3000.0], *list(vars(view).values())[2:])
+    assert landmark_chi2([behind])[0] == np.inf
+
+
+def test_prior_excess_zero_inside_and_grows_outside():
+    camera = Camera.from_rt(np.eye(3), [0, 0, 1000.0], 3000.0, [0, 0])
+    priors = Priors(focal_px=(2900, 3100), scd_mm=(950, 1050))
+    assert prior_excess(camera, priors, np.zeros(3)) == 0.0
+    far = Priors(focal_px=(1400, 1500), scd_mm=(950, 1050))
+    assert prior_excess(camera, far, np.zeros(3)) == pytest.approx(1.0)
+    assert prior_excess(camera, Priors(), np.zeros(3)) is None
+
+
+def _synthetic_pairs(rng, n_subjects=12, shift=2.0):
+    pairs = []
+    for person in range(n_subjects):
+        for skull in range(n_subjects):
+            same = person == skull
+            chi2 = np.exp(rng.normal(0.0 if same else shift, 0.5))
+            pairs.append(dict(terms={"landmark_chi2": chi2, "outside_fraction": 0.0},
+                              same=same, person=f"s{person}", skull=f"s{skull}"))
+    return pairs
+
+
+def test_calibration_separates_bounds_and_round_trips():
+    rng = np.random.default_rng(3)
+    pairs = _synthetic_pairs(rng)
+    model = fit([p["terms"] for p in pairs], [p["same"] for p in pairs])
+    assert model.names == ("landmark_chi2",)  # a constant term is left out
+    lr = model.log10_lr([p["terms"] for p in pairs])
+    same = np.array([p["same"] for p in pairs])
+    assert lr[same].mean() > 0 > lr[~same].mean()
+    lo, hi = model.bounds
+    assert lo == pytest.approx(-np.log10(12)) and hi == pytest.approx(np.log10(132))
+    assert np.all((lr >= lo - 1e-12) & (lr <= hi + 1e-12))
+    again = Calibration.from_dict(json.loads(json.dumps(model.to_dict())))
+    np.testing.assert_allclose(again.log10_lr([p["terms"] for p in pairs]), lr)
+    assert np.isnan(model.log10_lr([None])[0])
+
+
+def test_cross_validation_and_performance():
+    rng = np.random.default_rng(4)
+    pairs = _synthetic_pairs(rng)
+    pairs[0]["terms"] = None  # a failed SFO
+    lr = cross_validated(pairs, folds=4)
+    assert np.isnan(lr[0]) and np.isfinite(lr[1:]).all()
+    perf = performance(lr, [p["same"] for p in pairs])
+    assert perf["failed"] == 1
+    assert perf["cllr_min"] <= perf["cllr"] < 0.6
+    assert perf["misleading_same"] <= 0.2 and perf["misleading_diff"] <= 0.1
+    # An uninformative system costs 1 bit; PAV of random scores cannot do much better.
+    same = np.array([p["same"] for p in pairs])
+    assert cllr(np.zeros(len(same)), same) == pytest.approx(1.0)
+    noise = rng.normal(size=len(same))
+    assert cllr(pav_log10_lr(noise, same), same) > 0.7
+
+
+def test_conclusion_scale_caps_and_consistency():
+    assert [level(x) for x in (-3, -1.5, -0.7, 0.0, 0.7, 1.5, 3)] == list(range(7))
+    assert conclude(2.5).label == "strong support"
+    caps = material_caps(has_mandible=False, photos=1, unreviewed_automatic=False, pairs=12)
+    assert set(caps) == {"no_mandible", "single_photo"}
+    capped = conclude(2.5, caps)
+    assert capped.label == "limited support" and capped.uncapped == "strong support"
+    assert "no mandible" in capped.sentence
+    four = material_caps(False, 1, True, 6)
+    assert conclude(3.0, four).label == "undetermined"
+    assert conclude(-2.5, four).label == "strong support for exclusion"  # exclusion uncapped
+    inconsistent = conclude(2.5, {}, {"view_mismatch": "the camera looks at the side"})
+    assert inconsistent.label == "undetermined"
+    assert conclude(None).label == conclude(float("nan")).label == "undetermined"
+
+
+def test_sfo_writes_the_identification_and_prints_the_conclusion(case, tmp_path, capsys):
+    subject_dir, photo_dir = case
+    out = tmp_path / "out"
+    code = main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
+                 "--photo", str(photo_dir), "--out", str(out)])
+    stdout = capsys.readouterr().out
+    assert code == 0
+    ident = json.loads((out / "result.json").read_text())["identification"]
+    assert set(ident) >= {"score", "terms", "log10_lr", "conclusion", "caps", "calibration"}
+    assert ident["calibration"]["model"] == "posest-sfo//frontal"
+    assert "single_photo" in ident["caps"]
+    assert ident["terms"]["landmark_chi2"] > 0
+    assert f"identification: {ident['conclusion']}" in stdout
+
+
+def test_case_without_a_calibrated_model_says_so(case, tmp_path, capsys):
+    subject_dir, photo_dir = case
+    calibration = tmp_path / "empty.json"
+    calibration.write_text(json.dumps({"format": "lilium-calibration", "models": {}}))
+    out = tmp_path / "out"
+    code = main(["case", "--skull", str(subject_dir), "--photo", str(photo_dir),
+                 "--photo", str(photo_dir), "--method", "posest-sfo",
+                 "--calibration", str(calibration), "--out", str(out)])
+    stdout = capsys.readouterr().out
+    assert code == 0
+    assert "no calibration for posest-sfo//frontal" in stdout
+    assert "together, posest-sfo: identification: undetermined" in stdout
+    text = (out / "report.html").read_text()
+    assert text.index("Identification") < text.index("Summary")
+    assert "the paper&#x27;s alignment score" in text or "the paper's alignment score" in text
+
+
+def test_a_file_that_is_not_a_calibration_is_refused(case, tmp_path, capsys):
+    subject_dir, photo_dir = case
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    code = main(["sfo", "--skull", str(subject_dir), "--photo", str(photo_dir),
+                 "--calibration", str(bad), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and "not a Lilium calibration file" in err and str(bad) in err
