@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lilium.experiments.calibrate import DatasetInputs
 from lilium.experiments.config import (
     ALL_METHODS,
     DatasetConfig,
@@ -45,12 +46,12 @@ from lilium.experiments.identification import (
     identification_table,
     ranking_score,
 )
+from lilium.experiments.lr_report import calibrate_databases
 from lilium.experiments.report import load_rows
 from lilium.experiments.runner import run_experiment
 from lilium.experiments.store import COLUMNS, ResultStore
 from lilium.geometry.camera import Camera
 from lilium.inputs import correspondences
-from lilium.io.case import read_photo, read_skull
 from lilium.methods.posest_sfo import mean_depth_landmarks
 from lilium.optimisation.de import DEOptions
 
@@ -63,37 +64,6 @@ def mean_depth_error_px(camera, skull, photo):
     corr = correspondences(skull, photo)
     uv = camera.project(mean_depth_landmarks(corr))
     return float(np.linalg.norm(uv - corr.uv_px, axis=1).mean())
-
-
-class DatasetInputs:
-    """Skulls (with a task's axes set) and photos of a generated dataset, read once each, by
-    the paths ``dataset.json`` gives (as the experiment runner reads them)."""
-
-    def __init__(self, root):
-        self.root = Path(root)
-        index = json.loads((self.root / "dataset.json").read_text())
-        self.subjects = {s["id"]: s for s in index["subjects"]}
-        self.photo_paths = {p["id"]: p["paths"] for p in index["photos"]}
-        self._skulls, self._photos = {}, {}
-
-    def skull(self, subject, experiment, axes_set):
-        key = (subject, experiment, axes_set)
-        if key not in self._skulls:
-            entry, axes = self.subjects[subject], None
-            if experiment == "C":
-                names = entry.get("axes_C", [])
-                if not 1 <= axes_set <= len(names):
-                    raise ValueError(f"subject {subject}: no perturbed axes set {axes_set}")
-                axes = str(self.root / entry["path"] / names[axes_set - 1])
-            self._skulls[key] = read_skull(self.root / entry["path"], axes_path=axes)
-        return self._skulls[key]
-
-    def photo(self, photo, experiment):
-        key = (photo, experiment)
-        if key not in self._photos:
-            folder = self.root / self.photo_paths[photo][experiment]
-            self._photos[key] = read_photo(folder, load_image=False)
-        return self._photos[key]
 
 
 def mean_depth_scores(rows, inputs):
@@ -126,11 +96,13 @@ def mean_depth_scores(rows, inputs):
     return out
 
 
-def config(args):
+def config(args, dataset_seed):
     out = Path(args.out)
+    if len(args.dataset_seeds) > 1:
+        out = out / f"seed-{dataset_seed}"
     return ExperimentConfig(
         name="bench-identification",
-        dataset=DatasetConfig(out / "dataset", True, args.subjects, 1, args.dataset_seed),
+        dataset=DatasetConfig(out / "dataset", True, args.subjects, 1, dataset_seed),
         experiments=("C",),
         methods=parse_methods(args.methods.split(",")) if args.methods else ALL_METHODS,
         repetitions=1,
@@ -235,11 +207,47 @@ def print_tables(rows, file=sys.stdout):
         )
 
 
+def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
+    """The identification LR over every database pooled (subjects of different databases are
+    different people): cross-validated Cllr and misleading evidence per decision, and every
+    decision's ranking by its log10 LR; writes ``out_dir/calibration.json`` (the models fitted
+    on every pair, what ``lilium calibrate`` writes), ``calibration.csv`` and ``tippett.png``."""
+    _, table, decision_pairs, validated = calibrate_databases(
+        dbs, out_dir, log=lambda line: None
+    )
+    print("| decision | method | pairs same / different | failed | Cllr | Cllr_min | "
+          "misleading same | misleading different |", file=file)
+    print("|---|---|---|---|---|---|---|---|", file=file)
+    for (method, variant, decision), v in sorted(validated.items()):
+        p = v["performance"]
+        print(
+            f"| {decision} | {method_label(method, variant)} | {p['n_same']} / {p['n_diff']} | "
+            f"{p['failed']} | {p['cllr']:.3f} | {p['cllr_min']:.3f} | "
+            f"{100 * p['misleading_same']:.1f} % | {100 * p['misleading_diff']:.1f} % |",
+            file=file,
+        )
+    print(file=file)
+    print("| ranked by identification log10 LR | view | mean rank | rank-1 | AUC | photos |",
+          file=file)
+    print("|---|---|---|---|---|---|", file=file)
+    for t in table:
+        print(
+            f"| {t['method']} | {t['view']} | {_f(t['mean_rank'])} | {_f(t['rank1_rate'])} | "
+            f"{_f(t['auc'], 3)} | {t['photo_runs']} |",
+            file=file,
+        )
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="bench-identification")
     parser.add_argument("--subjects", type=int, default=8)
-    parser.add_argument("--dataset-seed", type=int, default=0)
+    parser.add_argument(
+        "--dataset-seeds",
+        default="0",
+        type=lambda text: [int(x) for x in text.split(",")],
+        help="comma-separated dataset seeds, one dataset each (OUT/seed-K with several)",
+    )
     parser.add_argument("--seed", type=int, default=7)
     parser.add_argument("--generations", type=int, default=750)
     parser.add_argument("--workers", type=int, default=2)
@@ -247,15 +255,27 @@ def main(argv=None):
         "--methods", default="", help="comma-separated, e.g. posest-sfo,lilium:skof (default all)"
     )
     parser.add_argument("--print-only", action="store_true", help="only print the stored rows")
+    parser.add_argument(
+        "--db", action="append", default=[], help="more databases to pool in the LR tables"
+    )
     args = parser.parse_args(argv)
-    cfg = config(args)
-    if not args.print_only:
-        run_experiment(cfg, progress=False)
-    print_tables(load_rows(cfg.db))
-    with ResultStore(cfg.db, read_only=True) as store:
-        rescored = mean_depth_scores(store.rows(list(COLUMNS)), DatasetInputs(cfg.dataset.path))
-    print("\nLilium ranked by the mean-depth landmarks' pixel error under its camera:")
-    print_identification(rescored)
+    dbs = []
+    for dataset_seed in args.dataset_seeds:
+        cfg = config(args, dataset_seed)
+        if not args.print_only:
+            run_experiment(cfg, progress=False)
+        print(f"\n## Dataset seed {dataset_seed} ({cfg.db})\n")
+        print_tables(load_rows(cfg.db))
+        with ResultStore(cfg.db, read_only=True) as store:
+            rescored = mean_depth_scores(
+                store.rows(list(COLUMNS)), DatasetInputs(cfg.dataset.path)
+            )
+        print("\nLilium ranked by the mean-depth landmarks' pixel error under its camera:")
+        print_identification(rescored)
+        dbs.append(cfg.db)
+    dbs += [Path(db) for db in args.db]
+    print(f"\n## Identification log10 LR, {len(dbs)} database(s) pooled, cross-validated\n")
+    print_likelihood_ratios(dbs, Path(args.out) / "calibration")
     return 0
 
 

@@ -1,5 +1,6 @@
 """Experiment runner: config, task enumeration, SQLite store, resume after a kill, Dask."""
 
+import csv
 import json
 import os
 import signal
@@ -209,9 +210,22 @@ def test_run_resume_and_report_cli(dataset, tmp_path):
     assert len(db_keys(db)) == total
     out = tmp_path / "report"
     assert main(["report", str(db), "--out", str(out)]) == 0
-    for name in ("report.md", "summary.csv", "wilcoxon.csv", "implausible.csv", "bpe.png"):
+    for name in ("report.md", "summary.csv", "wilcoxon.csv", "implausible.csv", "bpe.png",
+                 "calibration.csv", "tippett.png"):
         assert (out / name).is_file(), name
     assert "POSEST-SFO" in (out / "report.md").read_text()
+    # Identification (SPEC 12): every SFO's terms stored by the runner; the ranking by each
+    # method's own score beside the ranking by the identification LR.
+    stored = [json.loads(r["result"]) for r in ResultStore(db).rows(["success", "result"])
+              if r["success"]]
+    assert all(s["identification_terms"]["landmark_chi2"] > 0 for s in stored)
+    with (out / "identification.csv").open() as fh:
+        scores = {row["score"] for row in csv.DictReader(fh)}
+    assert scores == {"method's own score", "identification log10 LR (cross-validated)"}
+    # Two subjects are too few to calibrate: lilium calibrate says so and writes no model.
+    cal = tmp_path / "cal"
+    assert main(["calibrate", str(db), "--out", str(cal)]) == 0
+    assert json.loads((cal / "calibration.json").read_text())["models"] == {}
 
 
 def test_kill_and_resume(dataset, tmp_path):

@@ -185,3 +185,37 @@ def test_a_file_that_is_not_a_calibration_is_refused(case, tmp_path, capsys):
                  "--calibration", str(bad), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert code == 2 and "not a Lilium calibration file" in err and str(bad) in err
+
+
+def test_lineup_ranks_candidates_and_resumes(case, tmp_path, capsys, monkeypatch):
+    subject_dir, photo_dir = case
+    out = tmp_path / "lineup"
+    argv = ["lineup", "--skull", str(subject_dir), "--candidate", "anna", str(photo_dir),
+            "--candidate", "bea", str(photo_dir), str(photo_dir), "--method", "posest-sfo",
+            "--no-progress", "--out", str(out)]
+    assert main(argv) == 0
+    stdout = capsys.readouterr().out
+    ranking = json.loads((out / "lineup.json").read_text())["ranking"]
+    assert [e["rank"] for e in ranking] == [1, 2]
+    assert {e["candidate"] for e in ranking} == {"anna", "bea"}
+    lrs = [e["identification"]["log10_lr"] for e in ranking]
+    assert lrs[0] >= lrs[1]
+    assert (out / "anna" / "standin_frontal" / "posest-sfo" / "overlay.png").is_file()
+    assert "1. " in stdout and (out / "report.html").is_file()
+
+    import lilium.casework.lineup as lineup
+
+    def no_rerun(*args, **kwargs):
+        raise AssertionError("a stored SFO ran again")
+
+    monkeypatch.setattr(lineup, "run_sfo", no_rerun)
+    assert main(argv) == 0  # every SFO read back
+    again = json.loads((out / "lineup.json").read_text())["ranking"]
+    assert [e["identification"]["log10_lr"] for e in again] == lrs
+
+
+def test_lineup_refuses_a_name_given_twice(case, tmp_path, capsys):
+    subject_dir, photo_dir = case
+    code = main(["lineup", "--skull", str(subject_dir), "--candidate", "a", str(photo_dir),
+                 "--candidate", "a", str(photo_dir), "--out", str(tmp_path / "o")])
+    assert code == 2 and "given twice" in capsys.readouterr().err

@@ -31,6 +31,6 @@ def register(subparsers):
 def run(args):
     from ..experiments.lr_report import calibrate_databases
 
-    paths = calibrate_databases(args.db, args.out, dataset=args.dataset)
+    paths, *_ = calibrate_databases(args.db, args.out, dataset=args.dataset)
     print(f"calibration: {paths['calibration.json']} ({time.strftime('%Y-%m-%d')})")
     return 0

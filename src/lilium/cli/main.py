@@ -28,6 +28,7 @@ COMMANDS = [
     "lilium.cli.experiment",
     "lilium.cli.report",
     "lilium.cli.calibrate",
+    "lilium.cli.lineup",
     "lilium.cli.photo",
 ]
 

@@ -238,15 +238,22 @@ def _pair_sum(pairs, decision_pairs, validated, key):
     return np.array(out, float)
 
 
-def fit_models(decision_pairs, provenance):
-    """One :class:`Calibration` per decision (``pair_sum`` excepted), fitted on every pair."""
+#: Fewest same-person and different-person pairs a decision needs for a model of its own.
+MIN_PAIRS = 10
+
+
+def fit_models(decision_pairs, provenance, log=print):
+    """One :class:`Calibration` per decision (``pair_sum`` excepted), fitted on every pair;
+    a decision with fewer than :data:`MIN_PAIRS` pairs of either kind gets none (and says so)."""
     models = {}
     for key, pairs in sorted(decision_pairs.items()):
         if key[2] == "pair_sum":
             continue
         train = [p for p in pairs if p["terms"] is not None]
         same = [p["same"] for p in train]
-        if not train or all(same) or not any(same):
+        if min(sum(same), len(same) - sum(same)) < MIN_PAIRS:
+            log(f"{'/'.join(key)}: {sum(same)} same- and {len(same) - sum(same)} "
+                f"different-person pairs, fewer than {MIN_PAIRS}: no model")
             continue
         models["/".join(key)] = fit(
             [p["terms"] for p in train], same, provenance=dict(provenance, decision=key[2])

@@ -276,12 +276,13 @@ def identification_markdown(identification):
         "Rank-1 rate and cumulative match curve with ties broken at random (a tie counts in "
         "part), ROC AUC of the true skull's score against the other skulls' for the same photo "
         "(a tie counts 0.5); means over the photos of a view in every run.\n",
-        "| exp | method | view | rank-1 rate | mean rank | ROC AUC | photo-runs |",
-        "|---|---|---|---|---|---|---|",
+        "| exp | method | ranked by | view | rank-1 rate | mean rank | ROC AUC | photo-runs |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     out += [
-        f"| {i['experiment']} | {i['method']} | {i['view']} | {_fmt(i['rank1_rate'])} | "
-        f"{_fmt(i['mean_rank'])} | {_fmt(i['auc'])} | {i['photo_runs']} |"
+        f"| {i['experiment']} | {i['method']} | {i.get('score', 'score')} | {i['view']} | "
+        f"{_fmt(i['rank1_rate'])} | {_fmt(i['mean_rank'])} | {_fmt(i['auc'])} | "
+        f"{i['photo_runs']} |"
         for i in identification
     ]
     out.append("\n![cumulative match curve](cmc.png)\n")
@@ -308,6 +309,8 @@ def write_identification(rows, identification, out_dir):
     cmc = cmc_table(rows)
     keys = ["method", "experiment", "view", "rank1_rate", "mean_rank", "auc"]
     keys += ["photo_runs", "runs", "skulls"]
+    if any("score" in t for t in identification):
+        keys.insert(1, "score")
     return {
         "identification": _write_csv(out_dir / "identification.csv", identification, keys),
         "cmc": _write_csv(

@@ -17,6 +17,7 @@ from .. import __version__
 from ..io.calibration import write_calibration
 from .calibrate import database_decisions, fit_models, performance_table, validate
 from .config import method_label
+from .identification import identification_table
 
 #: Label of the two rankings in ``identification.csv``.
 SCORE_FITNESS = "method's own score"
@@ -36,37 +37,44 @@ def decision_label(method, variant, decision):
     }.get(decision, label)
 
 
-def ranking_rows(decision_pairs, validated):
+def ranking_rows(pairs, log10_lr, view):
     """Rows for :func:`lilium.experiments.identification.identification_table` that rank each
-    photo's skulls by ``-log10 LR`` (a failed SFO ranks last)."""
+    photo's skulls by ``-log10 LR`` (a failed SFO ranks last); a pair ranks by its frontal
+    photo, so ``view`` is that of the decision's photo."""
     out = []
-    for key, pairs in decision_pairs.items():
-        method, variant, decision = key
-        lr = validated[key]["log10_lr"]
-        for p, v in zip(pairs, lr, strict=True):
-            ok = bool(np.isfinite(v))
-            out.append(
-                dict(
-                    experiment=p["run"][1],
-                    method=method,
-                    variant=f"{variant}|{decision}",
-                    axes_set=p["run"][4],
-                    repetition=(p["run"][0], p["run"][5]),
-                    photo=p["photo"],
-                    view=DECISION_VIEW[decision],
-                    subject=p["skull"],
-                    true_subject=p["person"],
-                    success=ok,
-                    score=-float(v) if ok else None,
-                )
+    for p, v in zip(pairs, log10_lr, strict=True):
+        ok = bool(np.isfinite(v))
+        out.append(
+            dict(
+                experiment=p["run"][1],
+                method="lr",
+                variant="",
+                axes_set=p["run"][4],
+                repetition=(p["run"][0], p["run"][5]),
+                photo=p["photo"],
+                view=view,
+                subject=p["skull"],
+                true_subject=p["person"],
+                success=ok,
+                score=-float(v) if ok else None,
             )
+        )
     return out
 
 
-def relabel(table):
-    """Identification-table rows of :func:`ranking_rows` labelled by their decision."""
-    for t in table:
-        t["score"] = SCORE_LR
+def lr_identification_table(decision_pairs, validated):
+    """Rank-1 rate, mean rank and ROC AUC of every decision ranked by its cross-validated
+    log10 LR: rows like :func:`~lilium.experiments.identification.identification_table`'s,
+    with ``score`` = :data:`SCORE_LR`."""
+    table = []
+    for key in sorted(validated):
+        method, variant, decision = key
+        view = "lateral" if decision == "lateral" else "frontal"
+        rows = ranking_rows(decision_pairs[key], validated[key]["log10_lr"], view)
+        for t in identification_table(rows):
+            t.update(method=decision_label(method, variant, decision),
+                     view=DECISION_VIEW[decision], score=SCORE_LR)
+            table.append(t)
     return table
 
 
@@ -103,7 +111,8 @@ def plot_tippett(validated, path):
         ax.set_ylim(0, 1.02)
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel("share of pairs with log10 LR >= x")
-    axes[0][0].legend(fontsize=7, loc="lower left")
+    if axes[0][0].get_lines()[1:]:  # more than the line at 0
+        axes[0][0].legend(fontsize=7, loc="lower left")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -136,8 +145,8 @@ def lr_identification(dbs, out_dir, dataset=None, log=print):
     Returns
     -------
     paths : dict of str -> Path
-    rows : list of dict
-        :func:`ranking_rows`.
+    table : list of dict
+        :func:`lr_identification_table`.
     decision_pairs, validated : dict
     """
     out_dir = Path(out_dir)
@@ -147,7 +156,7 @@ def lr_identification(dbs, out_dir, dataset=None, log=print):
         "calibration_csv": write_calibration_csv(out_dir / "calibration.csv", validated),
         "tippett": plot_tippett(validated, out_dir / "tippett.png"),
     }
-    return paths, ranking_rows(decision_pairs, validated), decision_pairs, validated
+    return paths, lr_identification_table(decision_pairs, validated), decision_pairs, validated
 
 
 def calibrate_databases(dbs, out_dir, dataset=None, log=print):
@@ -156,18 +165,20 @@ def calibrate_databases(dbs, out_dir, dataset=None, log=print):
 
     Returns
     -------
-    dict of str -> Path
+    paths : dict of str -> Path
+    table, decision_pairs, validated
+        As :func:`lr_identification`.
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    paths, _, decision_pairs, validated = lr_identification(dbs, out_dir, dataset, log)
+    paths, table, decision_pairs, validated = lr_identification(dbs, out_dir, dataset, log)
     provenance = {
         "fitted": time.strftime("%Y-%m-%d"),
         "lilium": __version__,
         "databases": [str(Path(db).name) for db in dbs],
         "model": "logistic regression on the identification terms (lilium.identification)",
     }
-    models = fit_models(decision_pairs, provenance)
+    models = fit_models(decision_pairs, provenance, log)
     for key, model in models.items():
         perf = validated[tuple(key.split("/"))]["performance"]
         model.provenance.update(
@@ -178,4 +189,4 @@ def calibrate_databases(dbs, out_dir, dataset=None, log=print):
         )
     paths["calibration.json"] = out_dir / "calibration.json"
     write_calibration(paths["calibration.json"], models, provenance)
-    return paths
+    return paths, table, decision_pairs, validated

@@ -43,6 +43,7 @@ from .identification import (
     photo_matches,
     write_identification,
 )
+from .lr_report import SCORE_FITNESS, lr_identification
 from .store import ResultStore, database_error
 from .terms_off import terms_off_markdown, terms_off_rows, terms_off_table
 
@@ -527,11 +528,27 @@ def write_report(db, out_dir):
         "bpe_plot": plot_bpe(rows, out_dir / "bpe.png"),
     }
     identification = identification_table(rows)
+    for t in identification:
+        t["score"] = SCORE_FITNESS
+    lr_note = ""
+    try:
+        lr_paths, lr_table, _, _ = lr_identification([db], out_dir, log=lambda line: None)
+        paths.update(lr_paths)
+        identification += lr_table
+        lr_note = (
+            "\n\nRanked by the identification log10 LR (SPEC section 12): each pair scored by "
+            "a calibration that never saw its subject (cross-validated); Cllr, Cllr_min and "
+            "the rates of misleading evidence in calibration.csv, the Tippett plot:\n\n"
+            "![Tippett plot](tippett.png)\n"
+        )
+    except (ValueError, OSError) as exc:
+        lr_note = f"\n\nIdentification LR not computed: {exc}.\n"
     paths.update(write_identification(rows, identification, out_dir))
     md = out_dir / "report.md"
     md.write_text(
         markdown_report(db, summary, tests, implausible, len(rows), terms_off)
         + identification_markdown(identification)
+        + lr_note
         + "\n"
     )
     paths["markdown"] = md

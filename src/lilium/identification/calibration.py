@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import isotonic_regression, minimize
 
-from .terms import TERM_NAMES
+from .terms import CALIBRATED_TERMS
 
 #: The feature transforms: heavy-tailed terms on a log scale.
 FEATURES = {
@@ -143,7 +143,7 @@ class Calibration:
         )
 
 
-def fit(terms_list, same, names=TERM_NAMES, provenance=None):
+def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None):
     """Fit a :class:`Calibration` on term dictionaries and their labels.
 
     Parameters
@@ -206,7 +206,7 @@ def subject_folds(subjects, folds=FOLDS):
     return {s: i % folds for i, s in enumerate(sorted(set(subjects)))}
 
 
-def cross_validated(pairs, folds=FOLDS, names=TERM_NAMES):
+def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS):
     """Cross-validated log10 LR of every pair: each scored by a model that never saw its
     photo's subject (nor any pair with that subject's skull).
 
@@ -219,7 +219,8 @@ def cross_validated(pairs, folds=FOLDS, names=TERM_NAMES):
     Returns
     -------
     ndarray of shape (P,)
-        NaN for a failed SFO.
+        NaN for a failed SFO, and for the pairs of a fold whose training pairs lack one of
+        the two classes (too few pairs to calibrate).
     """
     fold_of = subject_folds([p["person"] for p in pairs] + [p["skull"] for p in pairs], folds)
     out = np.full(len(pairs), np.nan)
@@ -232,8 +233,9 @@ def cross_validated(pairs, folds=FOLDS, names=TERM_NAMES):
             and fold_of[p["skull"]] != k
         ]
         test = [i for i, p in enumerate(pairs) if fold_of[p["person"]] == k]
-        if not test:
-            continue
+        labels = {p["same"] for p in train}
+        if not test or labels != {True, False}:
+            continue  # nothing to score, or too few pairs to fit: left NaN
         model = fit([p["terms"] for p in train], [p["same"] for p in train], names)
         out[test] = model.log10_lr([pairs[i]["terms"] for i in test])
     return out
@@ -280,6 +282,10 @@ def performance(log10_lr, same):
     same = np.asarray(same, bool)
     ok = np.isfinite(log10_lr)
     v, s = log10_lr[ok], same[ok]
+    if not s.any() or s.all():
+        nan = float("nan")
+        return dict(cllr=nan, cllr_min=nan, misleading_same=nan, misleading_diff=nan,
+                    n_same=int(s.sum()), n_diff=int((~s).sum()), failed=int((~ok).sum()))
     return {
         "cllr": float(cllr(v, s)),
         "cllr_min": float(cllr(pav_log10_lr(v, s), s)),

@@ -54,3 +54,49 @@ def read_result_camera(path):
     if data["camera"] is None:
         return None
     return Camera.from_dict(data["camera"], name=f"{path}: camera")
+
+
+def read_result(path):
+    """An :class:`~lilium.methods.result.SfoResult` back from the ``result.json`` of one SFO
+    (what a resumed run keeps instead of running the SFO again).
+
+    Raises
+    ------
+    ValueError
+        A missing or malformed file, naming it.
+    """
+    import numpy as np
+
+    from ..inputs import CaseWarning
+    from ..methods.result import SfoResult
+
+    data = read_json(path)
+    known = {"method", "variant", "seed", "subject", "photo", "camera", "fitness", "terms",
+             "terms_off", "facial_landmarks_3d", "seconds", "landmark_error", "warnings",
+             "priors", "error"}
+    try:
+        camera = read_result_camera(path)
+        return SfoResult(
+            method=str(data["method"]),
+            variant=data.get("variant"),
+            seed=data.get("seed"),
+            skull_id=str(data["subject"]),
+            photo_id=str(data["photo"]),
+            camera=camera,
+            fitness=float("inf") if data.get("fitness") is None else float(data["fitness"]),
+            terms=dict(data.get("terms") or {}),
+            facial_landmarks_mm={
+                k: np.asarray(v, float) for k, v in (data.get("facial_landmarks_3d") or {}).items()
+            },
+            seconds=float(data.get("seconds") or 0.0),
+            error=str(data.get("error") or ""),
+            extra={k: v for k, v in data.items() if k not in known},
+            warnings=tuple(CaseWarning(w["code"], w["message"]) for w in data.get("warnings", [])),
+            priors=data.get("priors"),
+            landmark_error=data.get("landmark_error"),
+            terms_off=dict(data.get("terms_off") or {}),
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ValueError(
+            f"{path}: not a complete result.json ({exc}); delete it to rerun"
+        ) from None

@@ -1,0 +1,189 @@
+"""A lineup (SPEC section 12): one skull against several candidate persons, each with one or
+more photos, ranked by the identification's likelihood ratio in one report.
+
+The usual case of a found skull and a missing-persons list. Every photo of every candidate
+gets one SFO per method (as in ``lilium case``); a candidate's decision is its photo's
+identification, or with several photos their separate SFOs taken together (one shared soft
+tissue, :mod:`lilium.casework.identify`). Candidates are ranked by log10 LR (no LR last).
+
+Outputs: ``OUT/<candidate>/<photo>/<method tag>/result.json`` and ``overlay.png`` per SFO,
+``OUT/lineup.json`` (the ranking) and ``OUT/report.html`` (the ranking first, then every
+SFO with its overlay). **Resumable**: an SFO whose ``result.json`` is already there for the
+same method, variant, seed, skull and photo is read back, not run again, so a lineup killed
+half-way continues where it stopped; a progress bar counts the SFOs.
+"""
+
+from pathlib import Path
+
+from ..io.jsonio import write_json
+from ..io.paths import safe_id
+from ..io.results import read_result, write_result
+from ..methods.checks import check_inputs
+from ..methods.options import SfoOptions
+from ..methods.overlay import result_overlay
+from ..methods.registry import check_method, method_tag, run_sfo
+from .folders import labelled_skull
+from .identify import Calibrations, conclusion_line, identify, with_identification
+from .inputs import load_photos, load_skull
+
+
+def _stored(folder, method, variant, seed, skull_id, photo_id):
+    """The SFO stored in ``folder`` when it is this one, else None."""
+    path = Path(folder) / "result.json"
+    if not path.is_file():
+        return None
+    try:
+        result = read_result(path)
+    except ValueError:
+        return None
+    same = (
+        result.method == method
+        and (result.variant or None) == (variant or None)
+        and (result.seed == seed or method == "posest-sfo")
+        and result.skull_id == skull_id
+        and result.photo_id == photo_id
+        and "identification" in result.extra
+    )
+    return result if same else None
+
+
+def check_candidates(candidates):
+    """Refuse an empty lineup, a candidate without photos and a name given twice.
+
+    Parameters
+    ----------
+    candidates : list of (str, list of path)
+    """
+    if not candidates:
+        raise ValueError("--candidate: give at least one candidate: --candidate NAME PHOTO ...")
+    seen = set()
+    for name, photos in candidates:
+        key = safe_id(name)
+        if not photos:
+            raise ValueError(f"--candidate {name}: give one or more photos after the name")
+        if key in seen:
+            raise ValueError(f"--candidate {name}: the name is given twice; names must differ")
+        seen.add(key)
+
+
+def run_lineup(
+    skull_path,
+    candidates,
+    out,
+    methods=("lilium",),
+    options=SfoOptions(),
+    seed=0,
+    calibration=None,
+    landmarks=None,
+    title=None,
+    command=None,
+    log=print,
+    progress=True,
+):
+    """Run every candidate's SFOs (or read them back), rank the candidates, write the report.
+
+    Parameters
+    ----------
+    skull_path : path
+        Subject folder or skull mesh.
+    candidates : list of (str, list of path)
+        Each candidate's name and photo folders (SPEC section 8) or images.
+    out : path
+    methods : sequence of str
+        The first one ranks the candidates; the others are shown beside it.
+    options : SfoOptions
+    seed : int
+    calibration : path, optional
+    landmarks : path, optional
+        Cranial landmark file (when ``skull_path`` is a mesh).
+    title, command : str, optional
+    log : callable
+    progress : bool
+        Show a progress bar over the SFOs.
+
+    Returns
+    -------
+    list of dict
+        The ranking: ``candidate``, ``photos``, ``method``, ``identification``, best first.
+    """
+    from tqdm import tqdm
+
+    from ..report.html import ReportEntry, write_report
+
+    check_candidates(candidates)
+    methods = list(dict.fromkeys(methods)) or ["lilium"]
+    for method in methods:
+        check_method(method, options.variant)
+    out = Path(out)
+    calibrations = Calibrations(calibration)
+    skull, skull_inputs = load_skull(skull_path, landmarks, log=log)
+    skull = labelled_skull(skull, skull_inputs)
+    loaded = []
+    for name, photos in candidates:  # every input checked before the first SFO
+        records = load_photos(photos, log=log, skull=skull)
+        for record in records:
+            check_inputs(skull, record.photo)
+        loaded.append((name, records))
+    total = sum(len(records) for _, records in loaded) * len(methods)
+    bar = tqdm(total=total, desc="lineup SFOs", unit="SFO", disable=not progress)
+    entries, ranking = [], []
+    for name, records in loaded:
+        done = {m: [] for m in methods}
+        for photo, inputs, notes, _ in records:
+            for method in methods:
+                tag = method_tag(method, options.variant)
+                folder = out / safe_id(name) / safe_id(photo.id) / tag
+                variant = options.variant if method == "lilium" else None
+                result = _stored(folder, method, variant, seed, skull.id, photo.id)
+                if result is None:
+                    result = run_sfo(method, skull, photo, options, seed)
+                    result = with_identification(result, skull, [photo], calibrations)
+                    write_result(folder, result, result_overlay(result, skull, photo))
+                bar.update(1)
+                done[method].append((photo, result))
+                rel = folder.relative_to(out).as_posix()
+                outputs = {"result.json": f"{rel}/result.json"}
+                if (folder / "overlay.png").is_file():
+                    outputs["overlay.png"] = f"{rel}/overlay.png"
+                entries.append(
+                    ReportEntry(skull, photo, result, {**skull_inputs, **inputs}, notes, outputs)
+                )
+        for method in methods:
+            photos_m = [p for p, _ in done[method]]
+            results_m = [r for _, r in done[method]]
+            if len(results_m) == 1:
+                record = results_m[0].extra["identification"]
+            else:
+                record = identify(skull, photos_m, results_m, calibrations)
+            ranking.append(
+                dict(
+                    candidate=name,
+                    photos=[p.id for p in photos_m],
+                    method=method_tag(method, options.variant),
+                    identification=record,
+                )
+            )
+    bar.close()
+    first = method_tag(methods[0], options.variant)
+
+    def order(entry):
+        lr = entry["identification"].get("log10_lr")
+        return (entry["method"] != first, -(lr if lr is not None else float("-inf")))
+
+    ranking.sort(key=order)
+    for k, entry in enumerate(ranking, start=1):
+        entry["rank"] = k
+        log(f"{k}. {entry['candidate']} ({entry['method']}): "
+            f"{conclusion_line(entry['identification'])}")
+    write_json(out / "lineup.json", {"skull": skull.id, "ranking": ranking})
+    decisions = [
+        (f"{e['rank']}. candidate {e['candidate']} ({', '.join(e['photos'])}), {e['method']}",
+         e["identification"])
+        for e in ranking
+    ]
+    title = title or f"Lineup: skull {skull.id} against {len(candidates)} candidates"
+    report = write_report(
+        out / "report.html", entries, title=title, command=command, decisions=decisions
+    )
+    log(f"report: {report}")
+    return ranking
