@@ -668,6 +668,74 @@ def add_headsq_subjects(dataset_dir, n_photos=None, seed=None, variants=("hq",),
     return root
 
 
+def sfo_problems_from_dataset(root, experiment="C", axes_set=1, subjects=None):
+    """POSEST-SFO problems of the positive pairs of a dataset on disk (``bench_posest --sfo``).
+
+    What POSEST-SFO hands POSEST for each photo of ``subjects`` (default all) against its own
+    skull: the photo's marked landmarks of ``experiment`` and the cranial landmarks pushed by the
+    mean depths along the axes set ``axes_set`` (Exp. C; the folder's true axes for A/B), as
+    ``sfo_problems.SfoProblem`` (scored by BPE over every true facial landmark).
+
+    Returns
+    -------
+    list of sfo_problems.SfoProblem
+    """
+    from lilium.geometry.camera import Camera
+    from lilium.inputs import correspondences
+    from lilium.io.case import read_photo, read_skull
+    from lilium.io.jsonio import read_json
+    from lilium.methods.posest_sfo import mean_depth_landmarks
+    from sfo_problems import SfoProblem
+
+    root = Path(root)
+    index = read_json(root / "dataset.json")
+    entries = {s["id"]: s for s in index["subjects"]}
+    problems = []
+    for photo_entry in index["photos"]:
+        sid = photo_entry["subject"]
+        if subjects is not None and sid not in subjects:
+            continue
+        folder = root / entries[sid]["path"]
+        axes = None
+        if experiment == "C":
+            axes = folder / entries[sid]["axes_C"][axes_set - 1]
+        skull = read_skull(folder, axes_path=axes)
+        photo_dir = root / photo_entry["paths"][experiment]
+        photo = read_photo(photo_dir, load_image=False)
+        truth = read_json(photo_dir / "photo.json")["ground_truth"]
+        facial = read_json(folder / "facial_landmarks.json")["landmarks"]
+        names = sorted(set(facial) & set(truth["landmarks_noise_free"]))
+        corr = correspondences(skull, photo)
+        camera = Camera.from_rt(
+            np.asarray(truth["skull2cam"])[:3, :3],
+            np.asarray(truth["skull2cam"])[:3, 3],
+            truth["focal_px"],
+            truth["principal_point_px"],
+        )
+        problems.append(
+            SfoProblem(
+                photo_id=photo_entry["id"],
+                view="frontal" if photo_entry["view"] == "frontal" else "lateral",
+                image_size_wh=tuple(photo.image_size_wh),
+                uv_px=corr.uv_px,
+                points_mm=mean_depth_landmarks(corr),
+                facial_true_mm=np.array([facial[n] for n in names]),
+                uv_true_px=np.array([truth["landmarks_noise_free"][n] for n in names]),
+                camera=camera,
+            )
+        )
+    return problems
+
+
+def ensure_dataset(folder, n_photos=6, seed=0, data=None):
+    """The headsq dataset at ``folder``, built there first if it has no ``dataset.json``
+    (:func:`build_headsq_dataset`); None when the CT is absent."""
+    folder = Path(folder)
+    if (folder / "dataset.json").is_file():
+        return folder
+    return build_headsq_dataset(folder, n_photos=n_photos, seed=seed, data=data)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="headsq-case", help="dataset folder to write")
