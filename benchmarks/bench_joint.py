@@ -16,6 +16,11 @@ SFOs together), with the issue's targets (BPE <= 0.9 x, no more failures, time <
 
     python benchmarks/bench_joint.py --subjects 8 --jobs 2
     python benchmarks/bench_joint.py --dataset DIR --generations 150 --designs sum:1 scale:1
+
+``--headsq DIR`` adds the headsq real-anatomy case (issue 27, ``benchmarks/headsq_case.py``; its
+dataset built in DIR when absent): each frontal photo paired with the lateral one of the same
+index, on its complete skull and on its mandible-less skull (the same photos), summarised apart
+after the generated subjects (``--subjects 0``: headsq alone).
 """
 
 import argparse
@@ -111,6 +116,21 @@ def pairs_of(index, n_subjects):
     return out
 
 
+def headsq_pairs(index, subject):
+    """``(subject, (frontal k, lateral k))`` for every k of a headsq subject."""
+    mine = [p for p in index["photos"] if p["subject"] == subject and "C" in p["paths"]]
+    frontal = [p["id"] for p in mine if p["view"] == "frontal"]
+    lateral = [p["id"] for p in mine if p["view"] != "frontal"]
+    return [(subject, pair) for pair in zip(frontal, lateral, strict=False)]
+
+
+def _run_tasks(tasks, jobs):
+    if jobs > 1:
+        with ProcessPoolExecutor(jobs) as pool:
+            return [r for pair in pool.map(run_pair, tasks) for r in pair]
+    return [r for task in tasks for r in run_pair(task)]
+
+
 def _mean(values):
     values = [v for v in values if np.isfinite(v)]
     return statistics.fmean(values) if values else float("nan")
@@ -183,7 +203,45 @@ def main(argv=None):
     p.add_argument("--population", type=int, default=DEOptions().population_size)
     p.add_argument("--designs", nargs="+", default=["sum:1"], help="WEIGHTING:GENERATIONS_FACTOR")
     p.add_argument("--jobs", type=int, default=1)
+    p.add_argument("--headsq", type=Path, metavar="DIR", help="also the headsq case (see above)")
+    p.add_argument("--headsq-photos", type=int, default=3, help="its photos per view if built")
     args = p.parse_args(argv)
+    de = DEOptions(
+        population_size=args.population, max_generations=args.generations, max_seconds=None
+    )
+    t0 = time.perf_counter()
+    if args.subjects > 0:
+        _generated(args, de)
+    if args.headsq is not None:
+        _headsq(args, de)
+    print(f"\n{time.perf_counter() - t0:.0f} s in all")
+
+
+def _headsq(args, de):
+    import headsq_case
+
+    root = headsq_case.ensure_dataset(args.headsq, n_photos=args.headsq_photos)
+    if root is None:
+        print(f"\nheadsq: no CT at {headsq_case.DEFAULT_DATA}; skipped")
+        return
+    index = read_json(root / "dataset.json")
+    for sid, label in (("hq", "complete skull"), ("hq_nm", "without mandible")):
+        tasks = [
+            (root, subject, ids, args.axes_set, args.variant, de, seed, args.designs)
+            for subject, ids in headsq_pairs(index, sid)
+            for seed in args.seeds
+        ]
+        if not tasks:
+            continue
+        print(
+            f"\nheadsq real anatomy, {label} ({sid}): {len(tasks)} pairs (frontal k + lateral "
+            f"k x {len(args.seeds)} seed(s)), Lilium {args.variant}, DE {args.population} x "
+            f"{args.generations}, axes C{args.axes_set}"
+        )
+        summarise(_run_tasks(tasks, args.jobs), args.designs)
+
+
+def _generated(args, de):
     root = args.dataset
     if root is None:
         from lilium.synthetic.dataset import generate_dataset
@@ -191,9 +249,6 @@ def main(argv=None):
         root = Path(tempfile.mkdtemp(prefix="bench_joint_"))
         generate_dataset(root, args.subjects, 1, seed=0, experiments=("C",), workers=args.jobs)
     index = read_json(root / "dataset.json")
-    de = DEOptions(
-        population_size=args.population, max_generations=args.generations, max_seconds=None
-    )
     tasks = [
         (root, subject, ids, args.axes_set, args.variant, de, seed, args.designs)
         for subject, ids in pairs_of(index, args.subjects)
@@ -204,14 +259,7 @@ def main(argv=None):
         f"{args.variant}, DE {args.population} x {args.generations}, axes C{args.axes_set}, "
         f"{args.jobs} job(s)"
     )
-    t0 = time.perf_counter()
-    if args.jobs > 1:
-        with ProcessPoolExecutor(args.jobs) as pool:
-            rows = [r for pair in pool.map(run_pair, tasks) for r in pair]
-    else:
-        rows = [r for task in tasks for r in run_pair(task)]
-    summarise(rows, args.designs)
-    print(f"\n{time.perf_counter() - t0:.0f} s in all")
+    summarise(_run_tasks(tasks, args.jobs), args.designs)
 
 
 if __name__ == "__main__":

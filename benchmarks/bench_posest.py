@@ -46,6 +46,10 @@ with the settings of :data:`SFO_VARIANTS` (prototypes of decisions, through the 
 package's defaults now are the ``rel0.1f6+cand16+lo1`` row)::
 
     .venv/bin/python benchmarks/bench_posest.py --sfo --subjects 12 --photos 4 --seed 0
+
+``--headsq DIR`` adds the same table for the headsq real-anatomy case (issue 27;
+``benchmarks/headsq_case.py``, its dataset built in DIR when absent): its complete skull and its
+mandible-less skull apart, on the same photos.
 """
 
 import argparse
@@ -305,21 +309,54 @@ def run_pycolmap_sfo(problem, seed):
     return Camera.from_rt(M[:, :3], M[:, 3], f, c)
 
 
-def sfo_benchmark(n_subjects, n_photos, seed):
-    """Print the SFO-problem table (BPE and failures per method and view)."""
+def sfo_benchmark(n_subjects, n_photos, seed, headsq=None):
+    """Print the SFO-problem table (BPE and failures per method and view); with ``headsq`` (a
+    folder, built there by ``headsq_case`` when it holds no dataset yet) the same table for the
+    headsq real-anatomy case after it, its complete and its mandible-less skull apart."""
     from sfo_problems import sfo_problems
 
-    start = time.perf_counter()
-    problems = sfo_problems(n_subjects, n_photos, seed)
+    if n_subjects > 0:
+        start = time.perf_counter()
+        problems = sfo_problems(n_subjects, n_photos, seed)
+        print(
+            f"SFO problems: {n_subjects} subjects x ({n_photos} frontal + {n_photos} lateral), "
+            f"seed {seed}, Exp. C (+-5 px, axes set C1), generated in "
+            f"{time.perf_counter() - start:.0f} s; {_points_range(problems)}"
+        )
+        sfo_table(problems, seed)
+    if headsq is None:
+        return
+    import headsq_case
+
+    root = headsq_case.ensure_dataset(headsq, n_photos=n_photos, seed=seed)
+    if root is None:
+        print(f"\nheadsq: no CT at {headsq_case.DEFAULT_DATA}; skipped")
+        return
+    for sid, label in (("hq", "complete skull"), ("hq_nm", "without mandible")):
+        problems = headsq_case.sfo_problems_from_dataset(root, "C", 1, subjects=[sid])
+        if not problems:
+            continue
+        print(
+            f"\nheadsq real anatomy ({root}), {label} ({sid}): {len(problems)} photos, "
+            f"Exp. C (+-5 px, axes set C1); {_points_range(problems)}"
+        )
+        sfo_table(problems, seed)
+
+
+def _points_range(problems):
     views = np.array([p.view for p in problems])
     n_points = np.array([len(p.uv_px) for p in problems])
-    print(
-        f"SFO problems: {n_subjects} subjects x ({n_photos} frontal + {n_photos} lateral), seed "
-        f"{seed}, Exp. C (+-5 px, axes set C1), generated in {time.perf_counter() - start:.0f} s;"
-        f" points frontal {n_points[views == 'frontal'].min()}-"
-        f"{n_points[views == 'frontal'].max()}, lateral {n_points[views == 'lateral'].min()}-"
-        f"{n_points[views == 'lateral'].max()}"
-    )
+    parts = []
+    for view in ("frontal", "lateral"):
+        n = n_points[views == view]
+        if len(n):
+            parts.append(f"{view} {n.min()}-{n.max()}")
+    return "points " + ", ".join(parts)
+
+
+def sfo_table(problems, seed):
+    """Print BPE and failures per method and view of a list of ``SfoProblem``."""
+    views = np.array([p.view for p in problems])
     methods = {}
     if pycolmap is not None:
         methods["pycolmap"] = run_pycolmap_sfo
@@ -342,6 +379,8 @@ def sfo_benchmark(n_subjects, n_photos, seed):
     for name in methods:
         for view in ("frontal", "lateral"):
             b = bpe[name][views == view]
+            if len(b) == 0:
+                continue
             line = (
                 f"{name:>18} {view:>8} {len(b):3d} {int(np.isnan(b).sum()):4d} "
                 f"{np.nanmean(b):9.2f} {np.nanmedian(b):8.2f}"
@@ -369,9 +408,15 @@ def main(argv=None):
     parser.add_argument("--sfo", action="store_true", help="SFO problems from the generator")
     parser.add_argument("--subjects", type=int, default=12, help="--sfo: generated subjects")
     parser.add_argument("--photos", type=int, default=4, help="--sfo: photos per view per subject")
+    parser.add_argument(
+        "--headsq",
+        metavar="DIR",
+        help="--sfo: also the headsq real-anatomy case (its dataset in DIR, built there if "
+        "absent; benchmarks/headsq_case.py); --subjects 0 for headsq alone",
+    )
     args = parser.parse_args(argv)
     if args.sfo:
-        sfo_benchmark(args.subjects, args.photos, args.seed)
+        sfo_benchmark(args.subjects, args.photos, args.seed, args.headsq)
         return
 
     methods = {"posest": lambda p, i: run_posest(p), "opencv": lambda p, i: run_opencv(p)}
