@@ -238,6 +238,44 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
         )
 
 
+def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):
+    """On the headsq CT (real anatomy, ``benchmarks/headsq_case.py``): its frontal and lateral
+    photo against its own skull and against a generated one, through ``lilium case`` (the full
+    budget, both methods): each photo's and the pair's conclusion. Skipped without the CT."""
+    from headsq_case import build_headsq_dataset
+    from lilium.casework.case import run_case
+    from lilium.casework.identify import Calibrations, identify
+
+    root = build_headsq_dataset(Path(out_dir) / "dataset", 1, 0, variants=("hq",))
+    if root is None:
+        print("headsq CT not found (../shared/data/headsq): skipped", file=file)
+        return
+    photos = [root / "photos" / "C" / "hq_f00", root / "photos" / "C" / "hq_l00"]
+    print("| skull | method | decision | conclusion | log10 LR | capped by |", file=file)
+    print("|---|---|---|---|---|---|", file=file)
+    calibrations = Calibrations(calibration)
+    skulls = (("headsq (true)", root / "subjects" / "hq"), ("generated", other_skull))
+    for name, skull_dir in skulls:
+        entries = run_case(skull_dir, photos, Path(out_dir) / name.split()[0],
+                           methods=("lilium", "posest-sfo"), calibration=calibration,
+                           log=lambda line: None)
+        by_method = defaultdict(list)
+        for e in entries:
+            by_method[e.result.method].append(e)
+        for method, items in by_method.items():
+            decisions = [(e.photo.id, e.result.extra["identification"]) for e in items]
+            pair = identify(items[0].skull, [e.photo for e in items], [e.result for e in items],
+                            calibrations)
+            for what, record in decisions + [("frontal + lateral", pair)]:
+                lr = record["log10_lr"]
+                print(
+                    f"| {name} | {method} | {what} | {record['conclusion']} | "
+                    f"{'-' if lr is None else f'{lr:+.2f}'} | "
+                    f"{', '.join([*record['inconsistent'], *record['caps']]) or '-'} |",
+                    file=file,
+                )
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="bench-identification")
@@ -258,6 +296,9 @@ def main(argv=None):
     parser.add_argument(
         "--db", action="append", default=[], help="more databases to pool in the LR tables"
     )
+    parser.add_argument(
+        "--headsq", action="store_true", help="also the headsq CT's conclusions (real anatomy)"
+    )
     args = parser.parse_args(argv)
     dbs = []
     for dataset_seed in args.dataset_seeds:
@@ -276,6 +317,12 @@ def main(argv=None):
     dbs += [Path(db) for db in args.db]
     print(f"\n## Identification log10 LR, {len(dbs)} database(s) pooled, cross-validated\n")
     print_likelihood_ratios(dbs, Path(args.out) / "calibration")
+    if args.headsq:
+        print("\n## headsq CT: conclusions with the calibration just fitted\n")
+        other = Path(config(args, args.dataset_seeds[0]).dataset.path) / "subjects" / "s01"
+        headsq_conclusions(
+            Path(args.out) / "headsq", Path(args.out) / "calibration" / "calibration.json", other
+        )
     return 0
 
 

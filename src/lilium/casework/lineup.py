@@ -13,6 +13,7 @@ same method, variant, seed, skull and photo is read back, not run again, so a li
 half-way continues where it stopped; a progress bar counts the SFOs.
 """
 
+from dataclasses import replace
 from pathlib import Path
 
 from ..io.jsonio import write_json
@@ -124,15 +125,19 @@ def run_lineup(
         for record in records:
             check_inputs(skull, record.photo)
         loaded.append((name, records))
+
     total = sum(len(records) for _, records in loaded) * len(methods)
     bar = tqdm(total=total, desc="lineup SFOs", unit="SFO", disable=not progress)
     entries, ranking = [], []
     for name, records in loaded:
         done = {m: [] for m in methods}
         for photo, inputs, notes, _ in records:
+            folder_id = safe_id(photo.id)
+            # The report and the results name the candidate with the photo.
+            photo = replace(photo, id=f"{name}: {photo.id}")
             for method in methods:
                 tag = method_tag(method, options.variant)
-                folder = out / safe_id(name) / safe_id(photo.id) / tag
+                folder = out / safe_id(name) / folder_id / tag
                 variant = options.variant if method == "lilium" else None
                 result = _stored(folder, method, variant, seed, skull.id, photo.id)
                 if result is None:
@@ -177,7 +182,7 @@ def run_lineup(
             f"{conclusion_line(entry['identification'])}")
     write_json(out / "lineup.json", {"skull": skull.id, "ranking": ranking})
     decisions = [
-        (f"{e['rank']}. candidate {e['candidate']} ({', '.join(e['photos'])}), {e['method']}",
+        (f"{e['rank']}. candidate {e['candidate']} ({len(e['photos'])} photo(s)), {e['method']}",
          e["identification"])
         for e in ranking
     ]

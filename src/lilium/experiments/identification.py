@@ -310,7 +310,7 @@ def write_identification(rows, identification, out_dir):
     keys = ["method", "experiment", "view", "rank1_rate", "mean_rank", "auc"]
     keys += ["photo_runs", "runs", "skulls"]
     if any("score" in t for t in identification):
-        keys.insert(1, "score")
+        keys.append("score")
     return {
         "identification": _write_csv(out_dir / "identification.csv", identification, keys),
         "cmc": _write_csv(
