@@ -27,7 +27,7 @@ import numpy as np
 
 from ..geometry.camera import Camera
 from ..identification.calibration import cross_validated, fit, performance
-from ..identification.score import identification_terms
+from ..identification.score import identification_terms, pll_face
 from ..identification.terms import eye_corner_px
 from ..inputs import correspondences
 from ..io.case import read_photo, read_skull
@@ -124,9 +124,15 @@ def single_terms(rows, inputs=None):
         else:
             skull, photo = _inputs(r, inputs)
             image = None
-            if r["skull_px"] is not None and r["p_pll"] is not None:  # stored by the runner
-                pll = r["p_pll"] / eye_corner_px(camera, _cranial(skull, photo))
-                image = [(r["outside_px"] / max(r["skull_px"], 1), pll)]
+            if r["skull_px"] is not None:  # the row's own raster and P_pll, when it has them
+                eye_px = eye_corner_px(camera, _cranial(skull, photo))
+                pll = (
+                    r["p_pll"] / eye_px
+                    if r["p_pll"] is not None
+                    else pll_face(skull, photo, camera, eye_px)
+                )
+                outside = r["outside_px"] / r["skull_px"] if r["skull_px"] else 1.0
+                image = [(outside, pll)]
             out.append(identification_terms(skull, [photo], [camera], _facial(r), image=image))
     return out
 

@@ -43,20 +43,25 @@ def _soft_tissue_term(skull, facial_landmarks_mm, depth_table):
     )
 
 
-def image_consistency(skull, photo, camera, eye_px):
-    """``outside_fraction`` and ``pll_face`` of one photo under one camera (None when the
-    photo has no mask / P_pll cannot apply)."""
-    outside = pll = None
-    if photo.face_mask is not None:
-        counts = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
-        outside = counts.outside_px / counts.skull_px if counts.skull_px else 1.0
+def pll_face(skull, photo, camera, eye_px):
+    """P_pll of one photo under one camera in face-size units (None when P_pll cannot apply)."""
     try:
         term = PllTerm(skull, photo, camera.principal_point_px)
     except TermOff:
-        term = None
-    if term is not None and np.isfinite(eye_px) and eye_px > 0:
-        pll = float(term(camera.as_batch())[0]) / eye_px
-    return outside, pll
+        return None
+    if not (np.isfinite(eye_px) and eye_px > 0):
+        return None
+    return float(term(camera.as_batch())[0]) / eye_px
+
+
+def image_consistency(skull, photo, camera, eye_px):
+    """``outside_fraction`` and ``pll_face`` of one photo under one camera (None when the
+    photo has no mask / P_pll cannot apply)."""
+    outside = None
+    if photo.face_mask is not None:
+        counts = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
+        outside = counts.outside_px / counts.skull_px if counts.skull_px else 1.0
+    return outside, pll_face(skull, photo, camera, eye_px)
 
 
 def identification_terms(
