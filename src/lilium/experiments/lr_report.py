@@ -8,6 +8,7 @@ Used by ``lilium calibrate`` (:func:`calibrate_databases`) and ``lilium report``
 """
 
 import csv
+import json
 import time
 from pathlib import Path
 
@@ -65,16 +66,31 @@ def ranking_rows(pairs, log10_lr, view):
 def lr_identification_table(decision_pairs, validated):
     """Rank-1 rate, mean rank and ROC AUC of every decision ranked by its cross-validated
     log10 LR: rows like :func:`~lilium.experiments.identification.identification_table`'s,
-    with ``score`` = :data:`SCORE_LR`."""
+    with ``score`` = :data:`SCORE_LR`. A photo is ranked among the skulls of its own database;
+    the figures of several databases are averaged over their photos."""
     table = []
     for key in sorted(validated):
         method, variant, decision = key
         view = "lateral" if decision == "lateral" else "frontal"
         rows = ranking_rows(decision_pairs[key], validated[key]["log10_lr"], view)
-        for t in identification_table(rows):
-            t.update(method=decision_label(method, variant, decision),
-                     view=DECISION_VIEW[decision], score=SCORE_LR)
-            table.append(t)
+        parts = []
+        for db in sorted({p["run"][0] for p in decision_pairs[key]}):
+            mine = [r for r, p in zip(rows, decision_pairs[key], strict=True) if p["run"][0] == db]
+            parts += identification_table(mine)
+        if not parts:
+            continue
+        weights = np.array([t["photo_runs"] for t in parts], float)
+        merged = dict(parts[0])
+        for name in ("rank1_rate", "mean_rank", "auc"):
+            merged[name] = float(np.average([t[name] for t in parts], weights=weights))
+        merged.update(
+            photo_runs=int(weights.sum()),
+            runs=sum(t["runs"] for t in parts),
+            method=decision_label(method, variant, decision),
+            view=DECISION_VIEW[decision],
+            score=SCORE_LR,
+        )
+        table.append(merged)
     return table
 
 
@@ -159,6 +175,22 @@ def lr_identification(dbs, out_dir, dataset=None, log=print):
     return paths, lr_identification_table(decision_pairs, validated), decision_pairs, validated
 
 
+def database_provenance(db):
+    """What a calibration says of one database it was fitted on: its experiment's name, DE
+    budget and dataset (generator seed and subjects, when ``dataset.json`` is there)."""
+    from .store import ResultStore
+
+    with ResultStore(db, read_only=True) as store:
+        config = store.get_meta("config") or {}
+    out = {"database": Path(db).name, "experiment": config.get("name"), "de": config.get("de")}
+    index = Path(str(config.get("dataset", ""))) / "dataset.json"
+    if index.is_file():
+        data = json.loads(index.read_text())
+        out.update(dataset_seed=data.get("seed"), subjects=len(data.get("subjects", [])),
+                   photos=len(data.get("photos", [])))
+    return out
+
+
 def calibrate_databases(dbs, out_dir, dataset=None, log=print):
     """``lilium calibrate``: fit every decision's model on all pairs of the databases and
     write ``calibration.json`` beside the cross-validated ``calibration.csv`` and Tippett plot.
@@ -175,7 +207,7 @@ def calibrate_databases(dbs, out_dir, dataset=None, log=print):
     provenance = {
         "fitted": time.strftime("%Y-%m-%d"),
         "lilium": __version__,
-        "databases": [str(Path(db).name) for db in dbs],
+        "databases": [database_provenance(db) for db in dbs],
         "model": "logistic regression on the identification terms (lilium.identification)",
     }
     models = fit_models(decision_pairs, provenance, log)
