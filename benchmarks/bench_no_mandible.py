@@ -11,11 +11,13 @@ then prints per method and seed:
 
 - ``fail``: SFOs without a camera (Lilium must have 0 wherever POSEST-SFO has a camera);
 - BPE (mm) mean and median over the SFOs with a camera;
-- ``init ok``: Lilium members of the initial population with a valid camera, median over the
-  photos (of 30), on the code as it runs now: how close the photo came to the trap that
-  issue 25 hit (no valid member at all);
-- ``rescued``: Lilium runs whose initial population had no valid camera and got POSEST-SFO's
-  soft tissue and camera (absent before the fix);
+- ``no cam``: Lilium runs in which some evaluation of the whole population found no valid
+  camera and no member had one to lend (the trap of issue 25: before the fix every later warm
+  start ran off too); each member then takes its own POSEST (absent before the fix);
+- ``rescued``: Lilium runs whose initial population still had no valid camera and got
+  POSEST-SFO's soft tissue and camera (absent before the fix);
+- ``flat``: median RMS distance (mm) of the used cranial landmarks from their best-fitting
+  plane (how little depth the landmarks show);
 - the time per SFO (s).
 
 ``--complete`` runs the same photos against the complete skulls of the same seeds too (the
@@ -37,11 +39,11 @@ from pathlib import Path
 import numpy as np
 
 from lilium.evaluation import score
+from lilium.inputs import correspondences
 from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions, run_sfo
-from lilium.methods.lilium import LiliumProblem
 from lilium.optimisation import DEOptions
 
 #: Dataset kinds: folder name -> share of skulls without the mandible.
@@ -65,13 +67,11 @@ def generate(folder, subjects, photos, seed, share):
         print(f"dataset {folder}: {time.perf_counter() - t0:.0f} s to generate", flush=True)
 
 
-def initial_valid(skull, photo, options, seed):
-    """Members of Lilium's initial population with a valid camera (as :func:`lilium_sfo` draws
-    it: the same generator for the problem and the population)."""
-    rng = np.random.default_rng(seed)
-    problem = LiliumProblem(skull, photo, options, rng=rng)
-    genes = rng.random((options.de.population_size, problem.cones.n_genes))
-    return int(problem.camera_terms(problem.facial_landmarks(genes))["success"].sum())
+def flatness_mm(skull, photo):
+    """RMS distance (mm) of the cranial landmarks paired with the photo from their best plane."""
+    points = correspondences(skull, photo).cranial_mm
+    points = points - points.mean(axis=0)
+    return float(np.linalg.svd(points, compute_uv=False)[2] / np.sqrt(len(points)))
 
 
 def run_photo(folder, entry, options, seed, unmark):
@@ -96,10 +96,9 @@ def run_photo(folder, entry, options, seed, unmark):
             "focal": result.camera.focal_px if result else np.nan,
             "seconds": time.perf_counter() - t0,
             "rescued": bool(result.extra.get("rescued")) if result.extra else False,
-            "init_ok": np.nan,
+            "no_camera": bool(result.extra.get("no_camera_evaluations")) if result.extra else False,
+            "flat": flatness_mm(skull, photo),
         }
-        if method == "lilium":
-            row["init_ok"] = initial_valid(skull, photo, options, seed)
         rows.append(row)
     return rows
 
@@ -107,7 +106,7 @@ def run_photo(folder, entry, options, seed, unmark):
 def table(rows):
     head = (
         f"{'skulls':<12} {'method':<11} {'seed':>4} {'fail':>7} {'BPE mean':>8} {'BPE med':>7} "
-        f"{'init ok':>7} {'rescued':>7} {'s/SFO':>6}"
+        f"{'no cam':>6} {'rescued':>7} {'flat':>5} {'s/SFO':>6}"
     )
     lines = [head]
     keys = dict.fromkeys((r["kind"], r["method"], r["seed"]) for r in rows)
@@ -121,12 +120,13 @@ def table(rows):
         ]
         bpe = [r["bpe"] for r in sel if r["ran"]]
         lilium = method == "lilium"
-        init = f"{statistics.median(r['init_ok'] for r in sel):7.0f}" if lilium else f"{'-':>7}"
+        no_cam = f"{sum(r['no_camera'] for r in sel):6d}" if lilium else f"{'-':>6}"
         rescued = f"{sum(r['rescued'] for r in sel):7d}" if lilium else f"{'-':>7}"
         lines.append(
             f"{kind:<12} {method:<11} {seed!s:>4} {len(sel) - len(bpe):>3}/{len(sel):<3} "
             f"{np.mean(bpe) if bpe else np.nan:8.3f} {np.median(bpe) if bpe else np.nan:7.3f} "
-            f"{init} {rescued} {statistics.median(r['seconds'] for r in sel):6.2f}"
+            f"{no_cam} {rescued} {statistics.median(r['flat'] for r in sel):5.1f} "
+            f"{statistics.median(r['seconds'] for r in sel):6.2f}"
         )
     return "\n".join(lines)
 
@@ -161,7 +161,7 @@ def main(argv=None):
                     status = f"BPE {r['bpe']:6.2f} mm" if r["ran"] else f"FAILED ({r['error']})"
                     print(
                         f"seed {seed} {kind:<11} {r['photo']:>7} {r['method']:<10} {status} "
-                        f"f {r['focal']:7.0f} px  init ok {r['init_ok']!s:>4}  "
+                        f"f {r['focal']:7.0f} px  no cam {r['no_camera']!s:5} "
                         f"rescued {r['rescued']!s:5} {r['seconds']:6.2f} s",
                         flush=True,
                     )

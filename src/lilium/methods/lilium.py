@@ -113,6 +113,8 @@ class LiliumProblem:
         )
         self.terms_off.update(prior_terms_off(photo.priors))
         self.n_fallbacks = 0  # statistics only
+        # Evaluations where no member had a camera to lend and no fit found one (statistics).
+        self.n_no_camera = 0
         # Lowest MSE (px^2) of a camera refused for the focal cap, and its focal length.
         self.capped_mse, self.capped_focal_px = np.inf, None
 
@@ -178,26 +180,35 @@ class LiliumProblem:
         R, t, f = ref.R, ref.t, ref.focal_px
         # Numerical failure (a point behind the camera): fall back to full POSEST.
         broken = ~np.isfinite(ref.cost) | ~np.all(np.isfinite(ref.sq_err_px2), axis=1)
-        # A camera out of range (the least-squares fit over all landmarks ran off towards an
-        # infinite focal length, as near-coplanar landmarks often do) where no member has a
-        # valid camera to lend (the initial population; a population without any): POSEST on
-        # the member's own landmarks (its inliers fix a finite focal length). Warm-starting
-        # from a run-off camera never comes back (docs/method.md, "No camera").
-        retry = broken.copy()
-        if members is None or not np.any(members["success"]):
-            retry |= ~self._valid(R, t, f)
-        for i in np.flatnonzero(retry):
-            self.n_fallbacks += 1
-            camera = self._posest(facial_mm[i])
-            if camera is not None:
-                R[i], t[i], f[i] = camera
-            elif broken[i]:
-                f[i] = np.nan
+        self._own_posest(facial_mm, R, t, f, broken, broken)
+        # A camera out of range is that soft tissue's failure (C_INF) while some member has a
+        # valid camera to lend. When none has (the initial population, or every member failed)
+        # and no fit of this batch found one, the least-squares fits over all landmarks ran off
+        # towards an infinite focal length (near-coplanar landmarks: a skull without the
+        # mandible seen from the front) and every later warm start would start from a run-off
+        # camera and run off again: each member takes its own POSEST, whose inliers fix a
+        # finite focal length (docs/method.md, "No camera on a mandible-less frontal photo").
+        lender = members is not None and np.any(members["success"])
+        invalid = ~self._valid(R, t, f)
+        if not lender and invalid.all():
+            self.n_no_camera += 1
+            self._own_posest(facial_mm, R, t, f, invalid & ~broken, np.zeros_like(broken))
         ok = self._valid(R, t, f)
         sq = reprojection_sq_errors(self.uv_c, facial_mm, R, t, np.where(ok, f, 1.0))
         self._note_capped(facial_mm, R, t, f)
         sq[~ok] = np.inf
         return R, t, f, ok, sq
+
+    def _own_posest(self, facial_mm, R, t, f, which, lost):
+        """Replace the cameras of members ``which`` by their own POSEST (in place, in member
+        order); where POSEST fails too, a member in ``lost`` gets a NaN focal length."""
+        for i in np.flatnonzero(which):
+            self.n_fallbacks += 1
+            camera = self._posest(facial_mm[i])
+            if camera is not None:
+                R[i], t[i], f[i] = camera
+            elif lost[i]:
+                f[i] = np.nan
 
     def _valid(self, R, t, f):
         """``(S,)`` bool: focal length in ``[FOCAL_MIN_PX, cap]`` and the skull's front seen."""
@@ -380,7 +391,9 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         (``fitness`` equals the last value of ``history``); ``terms_off`` names the terms the
         variant asks for that could not apply, and the P_cam parts without a prior. ``extra``
         holds ``history`` (best fitness per generation), ``generations``, ``evaluations``,
-        ``stop``, ``genes`` and ``fallbacks``.
+        ``stop``, ``genes``, ``fallbacks``, ``no_camera_evaluations`` (population evaluations
+        where no member had a camera and each took its own POSEST) and ``rescued`` (the initial
+        population got POSEST-SFO's soft tissue and camera, :func:`rescue_population`).
     """
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
@@ -407,7 +420,11 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         error=error,
         warnings=warnings,
         terms_off=dict(problem.terms_off),
-        extra={**de_extra(de, problem.n_fallbacks), "rescued": rescued},
+        extra={
+            **de_extra(de, problem.n_fallbacks),
+            "no_camera_evaluations": problem.n_no_camera,
+            "rescued": rescued,
+        },
     )
 
 
