@@ -117,3 +117,4 @@ def test_no_camera_at_all_does_not_blame_correct_labels(case, tmp_path, monkeypa
     assert "swapped" not in result["error"]
     assert "infinite focal length (2.28e+267 px)" in result["error"]
     assert "landmark pairs lie nearly in one plane" in result["error"]
+    assert "mean soft tissue has no camera either" in result["error"]

@@ -5,9 +5,13 @@ Its fitness (SPEC section 5) is ``MSE_pix + P_cam [+ P_skof] [+ P_pll]``:
 
 1. decode the genes into soft-tissue vectors, facial 3D landmarks ``F = C + ST``;
 2. fit the camera to ``(F, f)`` by Levenberg-Marquardt, warm-started from the camera of the
-   member the trial competes with (the first population gets full POSEST); when the warm-started
-   refinement fails (a point behind the camera, focal out of range) the individual falls back to
-   full POSEST (RANSAC + LM);
+   member the trial competes with (the first population refines from one full POSEST); when
+   the warm-started refinement breaks (a point behind the camera) the individual falls back to
+   full POSEST (RANSAC + LM), and so does every member when none has a valid camera (the
+   least-squares fits of near-coplanar landmarks run off towards an infinite focal length, and
+   a warm start from such a camera never comes back); an initial population still without a
+   camera gets POSEST-SFO's soft tissue and camera (:func:`rescue_population`), so Lilium finds
+   a camera wherever POSEST-SFO does;
 3. score the camera: mean squared reprojection error over all used landmarks, camera priors,
    skull pixels outside the face mask, chin-jaw/forehead curve parallelism.
 
@@ -539,18 +543,19 @@ def _failure_message(problem, best):
 def _run_off_message(problem, focal_px):
     """The failure of an SFO whose cameras all ran off towards an infinite focal length.
 
-    Reached only when POSEST-SFO's soft tissue has no camera either (else
+    In a single SFO only when POSEST-SFO's soft tissue has no camera either (else
     :func:`rescue_population` gave the population one). The labels passed the left/right checks
     before the SFO (:func:`~lilium.methods.checks.check_inputs`), so the message does not blame
     them: it says how flat the landmarks are, the usual cause.
     """
     points = problem.corr.cranial_mm - problem.corr.cranial_mm.mean(axis=0)
     rms = np.linalg.svd(points, compute_uv=False) / np.sqrt(len(points))
+    mean_tissue = "no camera either" if problem.posest_sfo_member() is None else "one"
     return (
         f"no camera found: the camera of every soft-tissue estimate ran off towards an infinite "
-        f"focal length ({_px(focal_px)} px) and POSEST-SFO's mean soft tissue has no camera "
-        f"either. The {len(points)} landmark pairs lie nearly in one plane ({rms[2]:.1f} mm RMS "
-        f"out of it, {rms[0]:.1f} mm across), so they hardly fix the focal length and the "
-        "distance: mark landmarks away from that plane (zygion, gonion, pogonion, "
-        "frontotemporale), or look for a misplaced landmark"
+        f"focal length ({_px(focal_px)} px); POSEST-SFO's mean soft tissue has {mean_tissue}. "
+        f"The {len(points)} landmark pairs lie nearly in one plane ({rms[2]:.1f} mm RMS out of "
+        f"it, {rms[0]:.1f} mm across), so they hardly fix the focal length and the distance: "
+        "mark landmarks away from that plane (zygion, gonion, pogonion, frontotemporale), or "
+        "look for a misplaced landmark"
     )
