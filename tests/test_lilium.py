@@ -104,6 +104,10 @@ def test_refused_focal_lengths_read_well_in_the_message():
     message = _failure_message(problem, best)
     assert "needs a focal length of 12345 px" in message and "capped at 10000 px" in message
     best["focal_px"] = 3.16e129
+    # A run-off: how flat the landmarks are, not a question about the labels (issue 25).
+    corr = SimpleNamespace(cranial_mm=np.array([[-40, 0, 0], [40, 0, 0], [0, 50, 2], [0, -50, -2]]))
+    problem.corr, problem.posest_sfo_member = corr, lambda: None
     message = _failure_message(problem, best)
-    assert "3.16e+129 px" in message and len(message) < 400
-    assert "runs off towards an infinite focal length" in message
+    assert "3.16e+129 px" in message and len(message) < 500
+    assert "ran off towards an infinite focal length" in message and "swapped" not in message
+    assert "4 landmark pairs lie nearly in one plane (0.0 mm RMS out of it" in message

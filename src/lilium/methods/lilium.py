@@ -5,9 +5,13 @@ Its fitness (SPEC section 5) is ``MSE_pix + P_cam [+ P_skof] [+ P_pll]``:
 
 1. decode the genes into soft-tissue vectors, facial 3D landmarks ``F = C + ST``;
 2. fit the camera to ``(F, f)`` by Levenberg-Marquardt, warm-started from the camera of the
-   member the trial competes with (the first population gets full POSEST); when the warm-started
-   refinement fails (a point behind the camera, focal out of range) the individual falls back to
-   full POSEST (RANSAC + LM);
+   member the trial competes with (the first population refines from one full POSEST); when
+   the warm-started refinement breaks (a point behind the camera) the individual falls back to
+   full POSEST (RANSAC + LM), and so does every member when none has a valid camera (the
+   least-squares fits of near-coplanar landmarks run off towards an infinite focal length, and
+   a warm start from such a camera never comes back); an initial population still without a
+   camera gets POSEST-SFO's soft tissue and camera (:func:`rescue_population`), so Lilium finds
+   a camera wherever POSEST-SFO does;
 3. score the camera: mean squared reprojection error over all used landmarks, camera priors,
    skull pixels outside the face mask, chin-jaw/forehead curve parallelism.
 
@@ -33,7 +37,7 @@ from ..optimisation.de import DifferentialEvolution
 from ..pose.posest import posest
 from ..pose.refine import refine_batch
 from ..pose.residuals import reprojection_sq_errors
-from ..softtissue.cones import decode, make_cones, midsagittal_plane
+from ..softtissue.cones import decode, encode_depth_only, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
 from .checks import facing_check, facing_failure
 from .lilium_terms import image_terms, prior_terms_off
@@ -43,8 +47,12 @@ from .posest_sfo import (
     focal_cap_message,
     focal_cap_warning,
     long_lens_focal_px,
+    mean_depth_landmarks,
 )
 from .result import SfoResult
+
+#: POSEST-SFO's fixed RANSAC seed (:func:`~lilium.methods.posest_sfo.posest_sfo`'s default).
+POSEST_SFO_SEED = 0
 
 #: Variants: which optional penalties are on, (P_skof, P_pll).
 VARIANTS = {
@@ -109,6 +117,8 @@ class LiliumProblem:
         )
         self.terms_off.update(prior_terms_off(photo.priors))
         self.n_fallbacks = 0  # statistics only
+        # Evaluations where no member had a camera to lend and no fit found one (statistics).
+        self.n_no_camera = 0
         # Lowest MSE (px^2) of a camera refused for the focal cap, and its focal length.
         self.capped_mse, self.capped_focal_px = np.inf, None
 
@@ -172,21 +182,45 @@ class LiliumProblem:
                 R0[~ok], t0[~ok], f0[~ok] = R0[j], t0[j], f0[j]
         ref = refine_batch(self.uv_c, facial_mm, R0, t0, f0, options=self.options.refine)
         R, t, f = ref.R, ref.t, ref.focal_px
-        # Numerical failure (a point behind the camera): fall back to full POSEST. A focal length
-        # out of range is a real failure of that soft tissue (the fit runs off towards a weak
-        # perspective): P_cam's C_INF, no fallback.
+        # Numerical failure (a point behind the camera): fall back to full POSEST.
         broken = ~np.isfinite(ref.cost) | ~np.all(np.isfinite(ref.sq_err_px2), axis=1)
-        for i in np.flatnonzero(broken):
-            self.n_fallbacks += 1
-            camera = self._posest(facial_mm[i])
-            R[i], t[i], f[i] = camera if camera is not None else (R[i], t[i], np.nan)
-        ok = (f >= FOCAL_MIN_PX) & (f <= self.focal_cap_px)
-        if self.facing is not None:
-            ok &= self.facing(R, t)
+        self._own_posest(facial_mm, R, t, f, broken, broken)
+        # A camera out of range is that soft tissue's failure (C_INF) while some member has a
+        # valid camera to lend. When none has (the initial population, or every member failed)
+        # and no fit of this batch found one, the least-squares fits over all landmarks ran off
+        # towards an infinite focal length (near-coplanar landmarks: a skull without the
+        # mandible seen from the front) and every later warm start would start from a run-off
+        # camera and run off again: each member takes its own POSEST, whose inliers fix a
+        # finite focal length (docs/method.md, "No camera on a mandible-less frontal photo").
+        lender = members is not None and np.any(members["success"])
+        invalid = ~self._valid(R, t, f)
+        if not lender and invalid.all():
+            self.n_no_camera += 1
+            self._own_posest(facial_mm, R, t, f, invalid & ~broken, np.zeros_like(broken))
+        ok = self._valid(R, t, f)
         sq = reprojection_sq_errors(self.uv_c, facial_mm, R, t, np.where(ok, f, 1.0))
         self._note_capped(facial_mm, R, t, f)
         sq[~ok] = np.inf
         return R, t, f, ok, sq
+
+    def _own_posest(self, facial_mm, R, t, f, which, lost):
+        """Replace the cameras of members ``which`` by their own POSEST (in place, in member
+        order); where POSEST fails too, a member in ``lost`` gets a NaN focal length."""
+        for i in np.flatnonzero(which):
+            self.n_fallbacks += 1
+            camera = self._posest(facial_mm[i])
+            if camera is not None:
+                R[i], t[i], f[i] = camera
+            elif lost[i]:
+                f[i] = np.nan
+
+    def _valid(self, R, t, f):
+        """``(S,)`` bool: focal length in ``[FOCAL_MIN_PX, cap]`` and the skull's front seen."""
+        with np.errstate(invalid="ignore"):
+            ok = (f >= FOCAL_MIN_PX) & (f <= self.focal_cap_px)
+        if self.facing is not None:
+            ok &= self.facing(R, t)
+        return ok
 
     def _note_capped(self, facial_mm, R, t, f):
         """Remember the best fit refused only for its focal length (the cap was hit; a fit
@@ -244,7 +278,10 @@ class LiliumProblem:
         dict of str -> ndarray of shape (S, ...)
             As :meth:`evaluate`, with ``fitness = mse_pix + p_cam`` and the image penalties NaN.
         """
-        R, t, f, ok, sq = self.cameras(facial_mm, members)
+        return self._terms(facial_mm, *self.cameras(facial_mm, members))
+
+    def _terms(self, facial_mm, R, t, f, ok, sq):
+        """:meth:`camera_terms` of given cameras (``ok``: valid; ``sq``: squared errors)."""
         S = len(R)
         mse = np.where(ok, np.mean(sq, axis=1), C_INF)
         mse = np.where(np.isfinite(mse), mse, C_INF)
@@ -264,6 +301,40 @@ class LiliumProblem:
             "focal_px": f,
             "success": ok,
         }
+
+    def posest_sfo_member(self):
+        """POSEST-SFO's soft tissue as a member: its genes and its terms under POSEST-SFO's camera.
+
+        The genes put every facial landmark at the population mean depth along its axis (polar
+        angle 0), POSEST-SFO's facial landmarks; the camera is POSEST on those landmarks with
+        POSEST-SFO's options and fixed RANSAC seed, so exactly POSEST-SFO's camera.
+
+        Returns
+        -------
+        (genes (D,), terms) or None
+            ``terms`` as :meth:`evaluate`'s dictionary for one member (arrays of shape (1, ...));
+            None when POSEST-SFO finds no camera either.
+        """
+        table = self.options.depth_table
+        depth = [depth_stats(c, table).mean_mm for c in self.corr.cranial_names]
+        genes = encode_depth_only(self.cones, depth)
+        pose = posest(
+            self.corr.uv_px,
+            mean_depth_landmarks(self.corr, table),
+            self.centre,
+            self.options.posest,
+            rng=POSEST_SFO_SEED,
+            camera_check=self.facing,
+        )
+        if not pose:
+            return None
+        facial = self.facial_landmarks(genes)
+        R, t = pose.camera.R[None], pose.camera.t[None]
+        f = np.array([pose.camera.focal_px])
+        sq = reprojection_sq_errors(self.uv_c, facial, R, t, f)
+        ok = self._valid(R, t, f) & np.all(np.isfinite(sq), axis=1)
+        sq[~ok] = np.inf
+        return genes, self.add_image_terms(self._terms(facial, R, t, f, ok, sq))
 
     def add_image_terms(self, terms, thresholds=None, offset=0.0, weight=1.0):
         """Add P_skof and P_pll to :meth:`camera_terms`' dictionary (in place; returned).
@@ -324,7 +395,9 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         (``fitness`` equals the last value of ``history``); ``terms_off`` names the terms the
         variant asks for that could not apply, and the P_cam parts without a prior. ``extra``
         holds ``history`` (best fitness per generation), ``generations``, ``evaluations``,
-        ``stop``, ``genes`` and ``fallbacks``.
+        ``stop``, ``genes``, ``fallbacks``, ``no_camera_evaluations`` (population evaluations
+        where no member had a camera and each took its own POSEST) and ``rescued`` (the initial
+        population got POSEST-SFO's soft tissue and camera, :func:`rescue_population`).
     """
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
@@ -332,6 +405,7 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     solver = DifferentialEvolution(
         problem, problem.cones.n_genes, problem.periodic, options.de, rng=rng, callback=callback
     )
+    rescued = rescue_population(problem, solver)
     de = solver.solve()
     best = de.payload
     camera, terms, error, warnings = photo_outcome(problem, best, seed)
@@ -350,8 +424,45 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         error=error,
         warnings=warnings,
         terms_off=dict(problem.terms_off),
-        extra=de_extra(de, problem.n_fallbacks),
+        extra={
+            **de_extra(de, problem.n_fallbacks),
+            "no_camera_evaluations": problem.n_no_camera,
+            "rescued": rescued,
+        },
     )
+
+
+def rescue_population(problem, solver):
+    """Give an initial population without any valid camera POSEST-SFO's soft tissue and camera.
+
+    DE's greedy selection never loses its best member, so once one member has a camera the
+    result has one: Lilium then finds a camera wherever POSEST-SFO does. Replaces the worst
+    member (they all failed) in place.
+
+    Parameters
+    ----------
+    problem : LiliumProblem
+    solver : DifferentialEvolution
+        Just initialised (its population evaluated).
+
+    Returns
+    -------
+    bool
+        Whether a member was replaced.
+    """
+    if np.any(solver.payload["success"]):
+        return False
+    member = problem.posest_sfo_member()
+    if member is None:
+        return False
+    genes, terms = member
+    k = int(np.argmax(solver.fitness))
+    solver.population[k] = genes
+    solver.fitness[k] = terms["fitness"][0]
+    for key, values in solver.payload.items():
+        values[k] = terms[key][0]
+    solver.history[0] = float(solver.fitness.min())
+    return True
 
 
 def de_extra(de, fallbacks):
@@ -419,9 +530,32 @@ def _failure_message(problem, best):
     finite = np.isfinite(f) and np.all(np.isfinite(R)) and np.all(np.isfinite(t))
     if finite and problem.facing is not None and not problem.facing(R[None], t[None])[0]:
         return facing_failure(problem.skull, problem.photo)
+    if finite and f > RUN_OFF_FACTOR * problem.focal_cap_px:
+        return _run_off_message(problem, f)
     if finite and f > problem.focal_cap_px:
         return (
             f"no camera found: the best soft-tissue estimate needs a focal length of {_px(f)} px; "
             + focal_cap_message(problem.photo, f)
         )
     return "no camera found for the best soft-tissue estimate"
+
+
+def _run_off_message(problem, focal_px):
+    """The failure of an SFO whose cameras all ran off towards an infinite focal length.
+
+    In a single SFO only when POSEST-SFO's soft tissue has no camera either (else
+    :func:`rescue_population` gave the population one). The labels passed the left/right checks
+    before the SFO (:func:`~lilium.methods.checks.check_inputs`), so the message does not blame
+    them: it says how flat the landmarks are, the usual cause.
+    """
+    points = problem.corr.cranial_mm - problem.corr.cranial_mm.mean(axis=0)
+    rms = np.linalg.svd(points, compute_uv=False) / np.sqrt(len(points))
+    mean_tissue = "no camera either" if problem.posest_sfo_member() is None else "one"
+    return (
+        f"no camera found: the camera of every soft-tissue estimate ran off towards an infinite "
+        f"focal length ({_px(focal_px)} px); POSEST-SFO's mean soft tissue has {mean_tissue}. "
+        f"The {len(points)} landmark pairs lie nearly in one plane ({rms[2]:.1f} mm RMS out of "
+        f"it, {rms[0]:.1f} mm across), so they hardly fix the focal length and the distance: "
+        "mark landmarks away from that plane (zygion, gonion, pogonion, frontotemporale), or "
+        "look for a misplaced landmark"
+    )
