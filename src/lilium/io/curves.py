@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..validation import is_numeric
 from .jsonio import read_json
 
 #: The curve key of each view.
@@ -59,12 +60,12 @@ def read_face_curve(path, view, image_size_wh=None):
         )
     raw = data[key]
     try:
-        curve = np.asarray(raw, dtype=float)
+        curve = np.asarray(raw, dtype=float) if is_numeric(raw) else np.empty((0,))
     except (TypeError, ValueError):
         curve = np.empty((0,))
     if isinstance(raw, str) or curve.ndim != 2 or curve.shape[1] != 2 or len(curve) < 2:
         raise ValueError(
-            f"{path}: {key} must be a list of at least two [u, v] points (pixels), got "
+            f"{path}: {key} must be a list of at least two [u, v] points (numbers, in pixels), got "
             f"{_short(raw)}"
         )
     if not np.all(np.isfinite(curve)):

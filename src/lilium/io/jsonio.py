@@ -45,6 +45,25 @@ def _unique_keys(pairs):
     return out
 
 
+#: Deepest nesting of arrays and objects a JSON input may have: SPEC files need 4 levels; a
+#: deeper file is hostile or broken, and would exhaust Python's recursion further on.
+MAX_JSON_DEPTH = 64
+
+
+def _depth(value):
+    """Nesting depth of parsed JSON, without recursion."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        item, depth = stack.pop()
+        if isinstance(item, (dict, list)):
+            deepest = max(deepest, depth)
+            if depth > MAX_JSON_DEPTH:
+                break
+            children = item.values() if isinstance(item, dict) else item
+            stack.extend((child, depth + 1) for child in children)
+    return deepest
+
+
 def parse_json(text, source):
     """Parse JSON text; malformed JSON or a key given twice in one object is a ``ValueError``
     naming ``source`` (a file path, for messages).
@@ -52,14 +71,23 @@ def parse_json(text, source):
     Python's ``json`` lets the last of two equal keys win silently; here it is an error, as a
     landmark or prior written twice is a mistake the user must resolve.
     """
+    deep = ValueError(
+        f"{source}: JSON nested deeper than {MAX_JSON_DEPTH} levels of arrays or objects; "
+        "this is not a Lilium file: check that you gave the right file"
+    )
     try:
-        return json.loads(text, object_pairs_hook=_unique_keys)
+        data = json.loads(text, object_pairs_hook=_unique_keys)
+    except RecursionError:
+        raise deep from None
     except _DuplicateKey as exc:
         raise ValueError(
             f"{source}: the key {exc.args[0]!r} appears twice in one JSON object; keep one of them"
         ) from None
     except json.JSONDecodeError as exc:
         raise ValueError(f"{source}: not valid JSON ({exc}); fix the file's syntax") from exc
+    if _depth(data) > MAX_JSON_DEPTH:
+        raise deep
+    return data
 
 
 def read_json(path):
