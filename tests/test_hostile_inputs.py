@@ -206,3 +206,119 @@ def test_focal_cap_message_does_not_contradict_itself(case):
     assert "above 10000 px" in low and "far beyond the focal prior 4350-4808 px" in low
     high = focal_cap_message(replace(photo, priors=Priors(focal_px=(31000.0, 35000.0))))
     assert "capped at 70000 px (twice the focal prior's upper bound" in high
+
+
+# -- the face curve: work bounded by the photo, not the file ------------------------------------
+
+
+def test_zig_zag_face_curve_is_refused_at_once(case, tmp_path, capsys):
+    _, photo_dir = case
+    n = 5_000
+    zig = [[100 + 1000 * k / n, 100 if k % 2 else 800] for k in range(n)]
+    (photo_dir / "face_curve.json").write_text(json.dumps({"chin_jaw": zig}))
+    _one_line_error(
+        capsys,
+        _sfo(case, tmp_path / "out", "--method", "posest-sfo"),
+        "face_curve.json: chin_jaw is 3499300 px long",
+        "perimeter (4200 px)",
+        "give the outline once",
+    )
+
+
+def test_dense_face_curve_is_resampled_to_pixels(case):
+    import numpy as np
+
+    from lilium.io.curves import read_face_curve
+
+    _, photo_dir = case
+    t = np.linspace(0, np.pi, 5_000)
+    dense = np.c_[600 + 400 * np.cos(t), 500 + 300 * np.sin(t)]
+    path = photo_dir / "face_curve.json"
+    path.write_text(json.dumps({"chin_jaw": dense.tolist()}))
+    curve = read_face_curve(path, "frontal", (1200, 900))
+    assert 1000 < len(curve) < 2000  # one point per pixel along the arc (about 1100 px)
+    assert np.array_equal(curve, np.rint(curve))
+    assert np.abs(np.diff(curve, axis=0)).max() == 1  # 8-connected, no repeats
+    assert np.all(np.abs(np.diff(curve, axis=0)).sum(axis=1) > 0)
+
+
+# -- the command line --------------------------------------------------------------------------
+
+
+def test_population_beyond_memory_names_the_option(case, tmp_path, capsys):
+    argv = _sfo(case, tmp_path / "out", "--method", "lilium", "--population", "100000000")
+    line = _one_line_error(capsys, argv, "argument --population", "from 4 to 10000")
+    assert "out of memory" not in line and "downscale" not in line
+
+
+def test_view_given_for_a_photo_folder_is_not_ignored(case, tmp_path, capsys):
+    argv = ["case", "--skull", case[0], "--photo", case[1], "--out", tmp_path / "out"]
+    _one_line_error(
+        capsys,
+        argv + ["--view", "lateral_left"],
+        "photo.json: view is 'frontal' but --view says 'lateral_left'",
+        "edit it there",
+    )
+
+
+def test_garbage_mesh_names_the_format(case, tmp_path, capsys):
+    subject_dir, _ = case
+    (subject_dir / "skull.ply").write_bytes(
+        b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\nx y z\n"
+    )
+    _one_line_error(
+        capsys,
+        _sfo(case, tmp_path / "out", "--method", "posest-sfo"),
+        "skull.ply: not a readable PLY triangle mesh",
+        "export the skull surface again as PLY",
+    )
+
+
+def test_library_warnings_stay_off_the_console(case, tmp_path, capsys, monkeypatch):
+    import warnings
+
+    from lilium.casework import inputs
+
+    read_photo = inputs.read_photo
+
+    def noisy(*args, **kwargs):
+        warnings.warn("All-NaN slice encountered", RuntimeWarning, stacklevel=1)
+        return read_photo(*args, **kwargs)
+
+    monkeypatch.setattr(inputs, "read_photo", noisy)
+    monkeypatch.delenv("LILIUM_DEBUG")
+    code, _, err = _run(_sfo(case, tmp_path / "out", "--method", "posest-sfo"), capsys)
+    assert code == 0, err
+    assert "All-NaN" not in err and "RuntimeWarning" not in err
+
+
+# -- result databases ----------------------------------------------------------------------------
+
+
+@pytest.fixture
+def report_db(tmp_path):
+    from lilium.experiments.store import ResultStore
+    from test_report import make_rows
+
+    path = tmp_path / "results.sqlite"
+    with ResultStore(path) as store:
+        for row in make_rows():
+            assert store.insert(row)
+    return path
+
+
+def test_text_in_the_score_column_names_the_database(report_db, tmp_path, capsys):
+    import sqlite3
+
+    with sqlite3.connect(report_db) as conn:
+        conn.execute("UPDATE sfo SET score = 'abc' WHERE id = 3")
+    line = _one_line_error(capsys, ["report", report_db, "--out", tmp_path / "rep"], report_db)
+    assert "row 3 holds 'abc' in the numeric column score" in line
+    assert "internal error" not in line
+
+
+def test_terms_off_csv_has_its_header_when_nothing_was_off(report_db, tmp_path, capsys):
+    code, _, err = _run(["report", report_db, "--out", tmp_path / "rep"], capsys)
+    assert code == 0, err
+    header = (tmp_path / "rep" / "terms_off.csv").read_text().splitlines()
+    assert header == ["experiment,method,view,sfos,with_term_off"]

@@ -103,3 +103,8 @@ PRIOR_RANGES = {"focal_px": ((10.0, 1_000_000.0), "px"), "scd_mm": ((50.0, 100_0
 #: thickest facial soft tissue (cheek, gonion of an obese adult) is a few centimetres.
 MAX_DEPTH_MM = 100.0
 MAX_DEPTH_SD_MM = 50.0
+
+#: Largest DE population a command or config takes: the paper uses 30; a population is
+#: evaluated at once, so a typing slip (100000000) would exhaust the memory before the first
+#: generation.
+MAX_DE_POPULATION = 10_000

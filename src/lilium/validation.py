@@ -35,11 +35,20 @@ def is_numeric(value):
     >>> is_numeric([[1, 2.5], [None, 3]]), is_numeric([True, False]), is_numeric(["1", 2])
     (True, False, False)
     """
-    if isinstance(value, np.ndarray):
-        return value.dtype.kind in "iuf"
-    if isinstance(value, (list, tuple)):
-        return all(is_numeric(v) for v in value)
-    return value is None or _is_real(value)
+    stack = [value]
+    while stack:  # no recursion: a file's nesting must not reach Python's recursion limit
+        item = stack.pop()
+        kind = type(item)
+        if kind is float or kind is int or item is None:
+            continue
+        if kind is list or kind is tuple:
+            stack.extend(item)
+        elif isinstance(item, np.ndarray):
+            if item.dtype.kind not in "iuf":
+                return False
+        elif not _is_real(item):
+            return False
+    return True
 
 
 def check_interval(value, name, limits=None, unit=""):

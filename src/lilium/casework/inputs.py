@@ -194,6 +194,7 @@ def load_photos(
     lm_files = _per_photo(list(photo_landmarks), len(image_files), "--photo-landmarks")
     masks = _per_photo(list(masks), len(image_files), "--mask")
     curves = _per_photo(list(face_curves), len(image_files), "--face-curve")
+    view_for_all = views[0] if len(views or ()) == 1 else None
     views = _per_photo(list(views), len(image_files), "--view", allow_one=True)
     focal_cli = _check_interval(focal_px, "--focal-px", "focal_px")
     scd_cli = _check_interval(scd_mm, "--scd-mm", "scd_mm")
@@ -202,6 +203,12 @@ def load_photos(
         inputs, notes, facts, origin = {}, {}, None, None
         if path.is_dir():
             photo = read_photo(path)
+            if view_for_all is not None and view_for_all != photo.view:
+                raise ValueError(
+                    f"{path / 'photo.json'}: view is {photo.view!r} but --view says "
+                    f"{view_for_all!r}; --view sets the view of image files, a photo folder's is "
+                    "its photo.json's: edit it there (or leave --view out)"
+                )
             image = _first_file(path, IMAGE_NAMES)
             inputs["photo"] = image
             inputs["photo.json"] = path / "photo.json"
