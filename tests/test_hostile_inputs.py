@@ -322,3 +322,17 @@ def test_terms_off_csv_has_its_header_when_nothing_was_off(report_db, tmp_path, 
     assert code == 0, err
     header = (tmp_path / "rep" / "terms_off.csv").read_text().splitlines()
     assert header == ["experiment,method,view,sfos,with_term_off"]
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--subjects", "100000000"], "argument --subjects: must be an integer from 1 to 1000"),
+        (["--photos", "0"], "argument --photos: must be an integer from 1 to 1000"),
+        (["--workers", "-3"], "argument --workers: must be an integer from 1 to 256"),
+        (["--seed", "-1"], "argument --seed"),
+    ],
+)
+def test_synth_counts_are_bounded(tmp_path, capsys, args, needle):
+    _one_line_error(capsys, ["synth", "--out", tmp_path / "ds", *args], needle)
+    assert not (tmp_path / "ds").exists()
