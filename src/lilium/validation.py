@@ -19,7 +19,8 @@ def _show(value):
         return repr(value)
 
 
-def _is_real(x):
+def is_real(x):
+    """True for one real number (``True``/``False`` are not numbers here)."""
     return isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
 
 
@@ -46,7 +47,7 @@ def is_numeric(value):
         elif isinstance(item, np.ndarray):
             if item.dtype.kind not in "iuf":
                 return False
-        elif not _is_real(item):
+        elif not is_real(item):
             return False
     return True
 
@@ -83,7 +84,7 @@ def check_interval(value, name, limits=None, unit=""):
         items = [] if isinstance(value, str) else list(value)
     except TypeError:
         items = []
-    ok = len(items) == 2 and all(_is_real(x) for x in items)
+    ok = len(items) == 2 and all(is_real(x) for x in items)
     if ok:
         lo, hi = float(items[0]), float(items[1])
         ok = bool(np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi)

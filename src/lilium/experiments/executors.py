@@ -107,13 +107,13 @@ def local_results(tasks, workers, run):
 def _refused(address):
     """Why nothing listens at a ``tcp://host:port`` address (None when something does, or
     for other address kinds, which Dask itself then tries)."""
-    parts = urlsplit(address if "://" in address else f"tcp://{address}")
-    if parts.scheme not in ("tcp", "tls") or parts.hostname is None:
-        return None
     try:
+        parts = urlsplit(address if "://" in address else f"tcp://{address}")
+        if parts.scheme not in ("tcp", "tls") or parts.hostname is None:
+            return None
         port = parts.port or 8786
     except ValueError:
-        return f"{parts.netloc!r} is not host:port"
+        return "not an address of the form tcp://host:port"
     try:
         with socket.create_connection((parts.hostname, port), timeout=CONNECT_TIMEOUT_S):
             return None

@@ -21,7 +21,7 @@ from ..inputs import Photo, Priors, Skull
 from ..softtissue.depths import DepthStats, check_depth_table
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from ..softtissue.normals import surface_normals_at
-from ..validation import check_prior, is_numeric
+from ..validation import check_prior, is_real
 from .curves import read_face_curve
 from .formats import find_landmark_file, points_from_object, read_landmarks
 from .images import image_size_wh, read_image, read_mask
@@ -218,7 +218,7 @@ def parse_priors(path, priors):
             raise ValueError(f"{path}: {exc}") from None
     tolerance = priors.get("head_tolerance_deg")
     if tolerance is not None:
-        if not (is_numeric(tolerance) and 0 < tolerance <= 180):
+        if not (is_real(tolerance) and 0 < tolerance <= 180):
             raise ValueError(f"{path}: priors.head_tolerance_deg must be in (0, 180] degrees")
         tolerance = float(tolerance)
     if (rotation is None) != (tolerance is None):
@@ -404,14 +404,14 @@ def read_prepared(folder):
         except (ValueError, TypeError) as exc:
             raise ValueError(f"{meta_path}: {exc}") from None
         tolerance = priors.get("head_tolerance_face_deg", 15.0)
-        if not (isinstance(tolerance, (int, float)) and 0 < tolerance <= 180):
+        if not (is_real(tolerance) and 0 < tolerance <= 180):
             raise ValueError(
                 f"{meta_path}: priors.head_tolerance_face_deg must be in (0, 180] degrees"
             )
         tolerance = float(tolerance)
     if priors.get("iris_diameter_px") is not None:
         iris = priors["iris_diameter_px"]
-        if not (isinstance(iris, (int, float)) and np.isfinite(iris) and iris > 0):
+        if not (is_real(iris) and np.isfinite(iris) and iris > 0):
             raise ValueError(f"{meta_path}: priors.iris_diameter_px must be a positive number")
         iris = float(iris)
     angles = priors.get("head_angles_deg") if face2cam is not None else None
