@@ -533,6 +533,7 @@ def main(argv=None):
     parser.add_argument("--only", help="run the probes whose name holds this text")
     parser.add_argument("--limit-s", type=int, default=60, help="time limit per probe")
     parser.add_argument("--list", action="store_true", help="list the probes and stop")
+    parser.add_argument("--verbose", action="store_true", help="a line for every probe")
     args = parser.parse_args(argv)
     os.environ.pop("LILIUM_DEBUG", None)  # as users run it: the CLI's own handlers on
     probes = [p for p in all_probes() if not args.only or args.only in p.name]
@@ -555,8 +556,10 @@ def main(argv=None):
         except Exception as exc:  # noqa: BLE001 - a probe's own set-up failed
             verdict, seconds, detail = "traceback", 0.0, f"probe set-up: {exc!r}"
         counts[probe.owner][verdict] += 1
-        if verdict != "pass":
-            print(f"[{verdict}] {probe.owner}: {probe.name} ({seconds:.1f} s): {detail}")
+        if verdict != "pass" or args.verbose:
+            print(
+                f"[{verdict}] {probe.owner}: {probe.name} ({seconds:.1f} s): {detail}", flush=True
+            )
         shutil.rmtree(ws.root, ignore_errors=True)
     for owner, label in (("rel", "this work"), ("photo", "lilium photo"), ("ct", "import-ct")):
         total = sum(counts[owner].values())
