@@ -236,7 +236,8 @@ def test_dense_face_curve_is_resampled_to_pixels(case):
     path = photo_dir / "face_curve.json"
     path.write_text(json.dumps({"chin_jaw": dense.tolist()}))
     curve = read_face_curve(path, "frontal", (1200, 900))
-    assert 1000 < len(curve) < 2000  # one point per pixel along the arc (about 1100 px)
+    # One point per pixel step along the half ellipse: 2 (300 sin t0 + 400 cos t0) = 1000.
+    assert 950 < len(curve) < 1050
     assert np.array_equal(curve, np.rint(curve))
     assert np.abs(np.diff(curve, axis=0)).max() == 1  # 8-connected, no repeats
     assert np.all(np.abs(np.diff(curve, axis=0)).sum(axis=1) > 0)
