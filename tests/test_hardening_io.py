@@ -358,7 +358,7 @@ def test_out_not_writable(case, tmp_path, capsys, monkeypatch):
     [
         ("--seed", "-5", "argument --seed: must be an integer from 0"),
         ("--seed", str(2**64), "argument --seed"),
-        ("--population", "1", "argument --population: must be an integer of at least 4"),
+        ("--population", "1", "argument --population: must be an integer from 4 to 10000"),
         ("--generations", "0", "argument --generations: must be an integer of at least 1"),
         ("--max-seconds", "-1", "argument --max-seconds: must be a positive number"),
         ("--max-seconds", "nan", "argument --max-seconds"),
