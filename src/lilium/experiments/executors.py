@@ -36,15 +36,15 @@ class NoWorkersLeft(ValueError):
 
 
 def init_worker(parent_pid=None):
-    """Worker set-up: one OpenCV thread, no library warnings on the console (as ``lilium``'s
-    own process, unless ``LILIUM_DEBUG`` is set); with ``parent_pid``, exit when the parent
-    dies."""
+    """Worker set-up: one OpenCV thread; with ``parent_pid`` (a pool's process), no library
+    warnings on the console (as in ``lilium``'s own process, unless ``LILIUM_DEBUG`` is set)
+    and exit when the parent dies."""
     import warnings
 
     import cv2
 
-    if os.environ.get("LILIUM_DEBUG", "") in ("", "0"):
-        warnings.simplefilter("ignore")
+    if parent_pid is not None and os.environ.get("LILIUM_DEBUG", "") in ("", "0"):
+        warnings.simplefilter("ignore")  # a pool's process (serial runs: lilium.cli.main's)
 
     cv2.setNumThreads(1)
     if parent_pid is not None:
