@@ -534,9 +534,12 @@ def main(argv=None):
     parser.add_argument("--limit-s", type=int, default=60, help="time limit per probe")
     parser.add_argument("--list", action="store_true", help="list the probes and stop")
     parser.add_argument("--verbose", action="store_true", help="a line for every probe")
+    parser.add_argument("--range", default=":", help="probes START:STOP only (by index)")
     args = parser.parse_args(argv)
     os.environ.pop("LILIUM_DEBUG", None)  # as users run it: the CLI's own handlers on
-    probes = [p for p in all_probes() if not args.only or args.only in p.name]
+    start, stop = (int(x) if x else None for x in args.range.split(":"))
+    probes = all_probes()[start:stop]
+    probes = [p for p in probes if not args.only or args.only in p.name]
     if args.list:
         for p in probes:
             print(f"{p.owner:5} {p.expect:5} {p.name}")
