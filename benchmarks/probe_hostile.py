@@ -431,15 +431,19 @@ def _rows_db(change=None):
             for row in make_rows():
                 store.insert(row)
         if change:
-            with sqlite3.connect(path) as conn:
+            conn = sqlite3.connect(path)
+            with conn:
                 conn.execute(change)
+            conn.close()  # a connection left open leaves its WAL for the command to merge
 
     return setup
 
 
 def _foreign_db(ws):
-    with sqlite3.connect(ws.root / "in" / "r.sqlite") as conn:
+    conn = sqlite3.connect(ws.root / "in" / "r.sqlite")
+    with conn:
         conn.execute("CREATE TABLE t (x)")
+    conn.close()
 
 
 def experiment_probes():

@@ -236,8 +236,9 @@ def test_dense_face_curve_is_resampled_to_pixels(case):
     path = photo_dir / "face_curve.json"
     path.write_text(json.dumps({"chin_jaw": dense.tolist()}))
     curve = read_face_curve(path, "frontal", (1200, 900))
-    # One point per pixel step along the half ellipse: 2 (300 sin t0 + 400 cos t0) = 1000.
-    assert 950 < len(curve) < 1050
+    # One point per pixel step along the half ellipse: between its Chebyshev length,
+    # 2 (300 sin t0 + 400 cos t0) = 1000, and its Manhattan length, 800 + 2 * 300 = 1400.
+    assert 1000 <= len(curve) <= 1401
     assert np.array_equal(curve, np.rint(curve))
     assert np.abs(np.diff(curve, axis=0)).max() == 1  # 8-connected, no repeats
     assert np.all(np.abs(np.diff(curve, axis=0)).sum(axis=1) > 0)
@@ -337,3 +338,13 @@ def test_terms_off_csv_has_its_header_when_nothing_was_off(report_db, tmp_path, 
 def test_synth_counts_are_bounded(tmp_path, capsys, args, needle):
     _one_line_error(capsys, ["synth", "--out", tmp_path / "ds", *args], needle)
     assert not (tmp_path / "ds").exists()
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [(["--seed", "-1"], "argument --seed: must be an integer from 0"), (["--out", None], "--out")],
+)
+def test_demo_options_name_themselves(case, tmp_path, capsys, args, needle):
+    args = [str(case[0] / "skull.ply") if a is None else a for a in args]
+    line = _one_line_error(capsys, ["demo", *args], needle)
+    assert "Not a directory" not in line and "non-negative integer" not in line
