@@ -146,7 +146,7 @@ def test_unreadable_files(files, tmp_path, capsys):
     (files / "front.csv").write_bytes(b"\xff\xfe\x00\x81binary")
     _one_line_error(capsys, _argv(files, tmp_path), "front.csv", "cannot read", "UTF-8")
     (files / "skull.ply").write_bytes(b"ply\nformat garbage\n")
-    _one_line_error(capsys, _argv(files, tmp_path), "skull.ply", "cannot read the mesh")
+    _one_line_error(capsys, _argv(files, tmp_path), "skull.ply", "not a readable PLY triangle mesh")
 
 
 def test_unknown_landmark_suggests_the_closest(files, tmp_path, capsys):

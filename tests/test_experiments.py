@@ -281,3 +281,62 @@ def test_dask_local_cluster(dataset, tmp_path):
     assert summary.complete and summary.stored == n_expected(4, 2, cfg) == 16
     keys = db_keys(Path(cfg.db))
     assert len(set(keys)) == len(keys) == 16
+
+
+def test_scheduler_that_refuses_fails_fast_before_the_database(dataset, tmp_path, capsys):
+    pytest.importorskip("dask.distributed")
+    config = write_config(tmp_path / "refused", dataset, experiments=("A",))
+    db = tmp_path / "refused" / "r.sqlite"
+    start = time.monotonic()
+    code = main(["experiment", str(config), "--db", str(db), "--scheduler", "tcp://127.0.0.1:1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "--scheduler tcp://127.0.0.1:1: no Dask scheduler there" in err[0]
+    assert "dask scheduler" in err[0] and "disk space" not in err[0]
+    assert time.monotonic() - start < 15
+    assert not db.exists() and not list(db.parent.glob("r.sqlite*"))
+
+
+def test_dask_cluster_that_loses_every_worker(dataset, tmp_path, capsys, monkeypatch):
+    """Every worker gone: the run says so, keeps what is stored and exits; a rerun resumes."""
+    distributed = pytest.importorskip("dask.distributed")
+    import threading
+
+    from lilium.experiments import executors
+
+    monkeypatch.setattr(executors, "NO_WORKER_TIMEOUT_S", 1.0)
+    config = write_config(tmp_path / "lost", dataset, experiments=("A",))
+    db = Path(load_config(config).db)
+    argv = ["experiment", str(config), "--no-progress", "--scheduler"]
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+
+        def kill_workers_after_the_first_rows():
+            while not (db.exists() and _count_rows(db) >= 2):
+                time.sleep(0.1)
+            cluster.scale(0)
+
+        killer = threading.Thread(target=kill_workers_after_the_first_rows, daemon=True)
+        killer.start()
+        code = main(argv + [cluster.scheduler_address])
+        killer.join(timeout=30)
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert "has had no worker for 1 s" in err and "run the same command again to resume" in err
+    stored = _count_rows(db)
+    assert 2 <= stored < 16
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+    ) as cluster:
+        assert main(argv + [cluster.scheduler_address]) == 0
+    assert f"{stored} already in" in capsys.readouterr().out
+    assert len(set(db_keys(db))) == 16
+
+
+def _count_rows(db):
+    try:
+        with sqlite3.connect(db) as conn:
+            return conn.execute("SELECT COUNT(*) FROM sfo").fetchone()[0]
+    except sqlite3.Error:
+        return 0

@@ -93,7 +93,9 @@ def test_face_curve_of_the_wrong_shape_or_view(case, tmp_path, capsys):
     path.write_text(json.dumps({"forehead": [[1, 2], [3, 4]]}))
     _one_line_error(capsys, _sfo(case, tmp_path), "no 'chin_jaw' curve", "'forehead'")
     path.write_text(json.dumps({"chin_jaw": [[400, 700], [600, 790], [800, 700]]}))
-    assert read_photo(photo_dir).face_curve_uv.shape == (3, 2)
+    curve = read_photo(photo_dir).face_curve_uv  # resampled to whole pixels (issue 28)
+    assert curve[0].tolist() == [400, 700] and curve[-1].tolist() == [800, 700]
+    assert len(curve) == 401 and [600, 790] in curve.tolist()
 
 
 @pytest.mark.parametrize("size_wh", [(20000, 20000), (12000, 12000)])
@@ -356,7 +358,7 @@ def test_out_not_writable(case, tmp_path, capsys, monkeypatch):
     [
         ("--seed", "-5", "argument --seed: must be an integer from 0"),
         ("--seed", str(2**64), "argument --seed"),
-        ("--population", "1", "argument --population: must be an integer of at least 4"),
+        ("--population", "1", "argument --population: must be an integer from 4 to 10000"),
         ("--generations", "0", "argument --generations: must be an integer of at least 1"),
         ("--max-seconds", "-1", "argument --max-seconds: must be a positive number"),
         ("--max-seconds", "nan", "argument --max-seconds"),

@@ -93,3 +93,18 @@ MIN_LANDMARK_SPREAD_RATIO = 0.02
 
 #: Smallest extent of the cranial landmarks as a fraction of the skull mesh's extent.
 MIN_CRANIAL_EXTENT_FRACTION = 0.05
+
+#: Physical range of each camera prior (docs/checks.md), with its unit: a focal prior from 10 px
+#: (no lens) to 1,000,000 px (an 800 mm lens on a 100 MP sensor is 270,000 px); a
+#: subject-to-camera distance from 5 cm to 100 m. A prior outside it is a unit or typing error.
+PRIOR_RANGES = {"focal_px": ((10.0, 1_000_000.0), "px"), "scd_mm": ((50.0, 100_000.0), "mm")}
+
+#: Largest soft-tissue depth (mm) a depth table may give (min, mean, max), and largest SD: the
+#: thickest facial soft tissue (cheek, gonion of an obese adult) is a few centimetres.
+MAX_DEPTH_MM = 100.0
+MAX_DEPTH_SD_MM = 50.0
+
+#: Largest DE population a command or config takes: the paper uses 30; a population is
+#: evaluated at once, so a typing slip (100000000) would exhaust the memory before the first
+#: generation.
+MAX_DE_POPULATION = 10_000

@@ -31,7 +31,7 @@ from ..io.curves import read_face_curve
 from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
 from ..io.paths import safe_id
-from ..validation import check_interval
+from ..validation import check_prior, fmt_range
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
@@ -129,8 +129,8 @@ def _found(log, owner, what, path, beside):
         log(f"{owner}: using {what} {Path(path).name} (found beside {beside})")
 
 
-def _check_interval(values, option):
-    return None if values is None else check_interval(values, f"command line: {option}")
+def _check_interval(values, option, key):
+    return None if values is None else check_prior(values, key, f"command line: {option}")
 
 
 def load_photos(
@@ -194,14 +194,21 @@ def load_photos(
     lm_files = _per_photo(list(photo_landmarks), len(image_files), "--photo-landmarks")
     masks = _per_photo(list(masks), len(image_files), "--mask")
     curves = _per_photo(list(face_curves), len(image_files), "--face-curve")
+    view_for_all = views[0] if len(views or ()) == 1 else None
     views = _per_photo(list(views), len(image_files), "--view", allow_one=True)
-    focal_cli = _check_interval(focal_px, "--focal-px")
-    scd_cli = _check_interval(scd_mm, "--scd-mm")
+    focal_cli = _check_interval(focal_px, "--focal-px", "focal_px")
+    scd_cli = _check_interval(scd_mm, "--scd-mm", "scd_mm")
     records, k_file = [], 0
     for path in photos:
         inputs, notes, facts, origin = {}, {}, None, None
         if path.is_dir():
             photo = read_photo(path)
+            if view_for_all is not None and view_for_all != photo.view:
+                raise ValueError(
+                    f"{path / 'photo.json'}: view is {photo.view!r} but --view says "
+                    f"{view_for_all!r}; --view sets the view of image files, a photo folder's is "
+                    "its photo.json's: edit it there (or leave --view out)"
+                )
             image = _first_file(path, IMAGE_NAMES)
             inputs["photo"] = image
             inputs["photo.json"] = path / "photo.json"
@@ -358,7 +365,7 @@ def with_priors(photo, image, focal_px=None, scd_mm=None, use_exif=True, sensor_
             notes[label] = "none (penalty off)"
         else:
             where = details.get(key, sources[key])
-            notes[label] = f"{value[0]:.0f}-{value[1]:.0f} {unit} ({where})"
+            notes[label] = f"{fmt_range(*value, unit)} ({where})"
     photo = replace(photo, priors=priors, prior_sources=sources, warnings=tuple(warnings))
     return photo, notes
 

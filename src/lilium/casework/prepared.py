@@ -23,6 +23,8 @@ Decisions (docs/photo.md, "In a case"):
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from ..validation import fmt_range
+
 #: The words the report and the console use for landmarks nobody has looked at.
 UNREVIEWED = "automatic, unreviewed"
 
@@ -86,7 +88,7 @@ def landmark_origin(photo, facts):
 
 
 def _interval_text(values, unit):
-    return f"{values[0]:.0f}-{values[1]:.0f} {unit}"
+    return fmt_range(values[0], values[1], unit)
 
 
 def with_automatic_priors(photo, notes, facts, skull=None, scd_from_cli=False, log=None):

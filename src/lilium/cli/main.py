@@ -8,13 +8,16 @@ an input error (``ValueError``, whose message names the file or option and the f
 the system refuses (``OSError``: permissions, a full disk, a path under a file), memory running
 out, or, as a last resort, any other exception (a bug: the line asks to report it). Set
 :data:`DEBUG_ENV` (``LILIUM_DEBUG=1``) to get the traceback of anything but an input error
-instead; the test suite does, so real bugs stay visible there.
+instead; the test suite does, so real bugs stay visible there. Python warnings of the libraries
+(numpy, Pillow, matplotlib) are not shown unless :data:`DEBUG_ENV` is set: what a user needs to
+know is said by Lilium's own warnings (SPEC section 10), not by a library's internals.
 """
 
 import argparse
 import importlib
 import os
 import sys
+import warnings
 
 from .. import __version__
 
@@ -84,8 +87,12 @@ def main(argv=None):
         args = build_parser().parse_args(argv)
     except SystemExit as exc:  # --help, --version (0) or a bad argument (2, one line printed)
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+    debug = os.environ.get(DEBUG_ENV, "") not in ("", "0")
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            if not debug:  # library chatter (numpy's "All-NaN slice", Pillow, matplotlib)
+                warnings.simplefilter("ignore")
+            return int(args.func(args) or 0)
     except ValueError as exc:
         print(f"lilium {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
@@ -93,7 +100,7 @@ def main(argv=None):
         print(f"lilium {args.command}: interrupted", file=sys.stderr)
         return 130
     except Exception as exc:  # the last resort: never a traceback for the user
-        if os.environ.get(DEBUG_ENV, "") not in ("", "0"):
+        if debug:
             raise
         print(f"lilium {args.command}: error: {_describe(exc)}", file=sys.stderr)
         return 2

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from ..casework.folders import joint_sfo_on_folders, sfo_on_folders
 from ..casework.identify import conclusion_line
+from ..constants import MAX_DE_POPULATION
 from ..methods import METHODS, SfoOptions
 from ..optimisation.de import DEOptions
 from .argtypes import existing_file, int_in, output_folder, positive_float, seed
@@ -18,7 +19,12 @@ VARIANTS = METHODS["lilium"].variants
 
 #: Argument types shared with ``lilium case`` (a bad value names its option; exit 2).
 GENERATIONS = int_in(1)
-POPULATION = int_in(4, why=" (DE/rand/1 draws three other members)")
+POPULATION = int_in(
+    4,
+    MAX_DE_POPULATION,
+    " (DE/rand/1 draws three other members; the paper uses 30, and a population is evaluated "
+    "at once, in memory)",
+)
 MAX_SECONDS = positive_float(allow_inf=True)
 AXES_FILE = existing_file("soft-tissue axes file")
 DEPTH_TABLE_FILE = existing_file("depth table")

@@ -4,6 +4,12 @@ import argparse
 import time
 from pathlib import Path
 
+from .argtypes import int_in, output_folder, seed
+
+#: ``--subjects``, ``--photos``: as an experiment config's ``dataset.subjects`` / ``photos``; a
+#: typing slip (100000000) would otherwise generate for days.
+COUNT = int_in(1, 1000, " (as an experiment config's dataset.subjects and dataset.photos)")
+
 
 def fraction(closed):
     """``--no-mandible-share`` ([0, 1]) / ``--drop-landmark-rate`` ([0, 1)) argument type."""
@@ -30,16 +36,18 @@ def register(subparsers):
             "writes OUT/subjects, OUT/photos/<exp> and OUT/dataset.json."
         ),
     )
-    p.add_argument("--out", required=True, type=Path, help="output folder")
-    p.add_argument("--subjects", type=int, default=17, help="number of subjects (default 17)")
+    p.add_argument("--out", required=True, type=output_folder, help="output folder")
+    p.add_argument("--subjects", type=COUNT, default=17, help="number of subjects (default 17)")
     p.add_argument(
-        "--photos", type=int, default=30, help="frontal (and lateral) photos per subject"
+        "--photos", type=COUNT, default=30, help="frontal (and lateral) photos per subject"
     )
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed, default=0)
     p.add_argument(
         "--experiments", default="A,B,C", help="comma-separated noise profiles (default A,B,C)"
     )
-    p.add_argument("--workers", type=int, default=2, help="processes over subjects (default 2)")
+    p.add_argument(
+        "--workers", type=int_in(1, 256), default=2, help="processes over subjects (default 2)"
+    )
     p.add_argument(
         "--no-mandible-share",
         type=fraction(closed=True),

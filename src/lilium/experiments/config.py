@@ -47,6 +47,7 @@ import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ..constants import MAX_DE_POPULATION
 from ..methods.registry import METHODS
 from ..optimisation.de import DEOptions
 from ..synthetic.incomplete import check_fraction
@@ -76,7 +77,7 @@ LIMITS = {
     "dataset.subjects": (1, 1000),
     "dataset.photos": (1, 1000),
     "dataset.seed": (0, MAX_SEED),
-    "de.population": (4, 10000),
+    "de.population": (4, MAX_DE_POPULATION),
     "de.generations": (1, 10**7),
 }
 

@@ -45,7 +45,7 @@ from .identification import (
 )
 from .lr_report import SCORE_FITNESS, lr_identification
 from .store import ResultStore, database_error
-from .terms_off import terms_off_markdown, terms_off_rows, terms_off_table
+from .terms_off import TERMS_OFF_COLUMNS, terms_off_markdown, terms_off_rows, terms_off_table
 
 
 def _mean_sd(values):
@@ -298,9 +298,9 @@ def _markdown_table(header, lines):
     return "\n".join(out)
 
 
-def write_csv(path, table):
+def write_csv(path, table, columns=()):
     path = Path(path)
-    keys = list(table[0]) if table else []
+    keys = list(table[0]) if table else list(columns)  # an empty table keeps its header
     with path.open("w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys)
         writer.writeheader()
@@ -522,7 +522,7 @@ def write_report(db, out_dir):
         "summary": write_csv(out_dir / "summary.csv", summary),
         "wilcoxon": write_csv(out_dir / "wilcoxon.csv", tests),
         "implausible": write_csv(out_dir / "implausible.csv", implausible),
-        "terms_off": write_csv(out_dir / "terms_off.csv", terms_off),
+        "terms_off": write_csv(out_dir / "terms_off.csv", terms_off, TERMS_OFF_COLUMNS),
         "ranks": write_csv(out_dir / "ranks.csv", ranks),
         "rank_plot": plot_rank_distribution(ranks, out_dir / "rank_distribution.png"),
         "bpe_plot": plot_bpe(rows, out_dir / "bpe.png"),

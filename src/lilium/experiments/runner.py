@@ -24,7 +24,8 @@ once.
 Executors: a local process pool (default, all cores) or a Dask distributed cluster
 (``scheduler="tcp://host:8786"``); the dataset folder must then be readable by every worker at
 the same path (a shared file system). Local workers end when the parent process dies, however
-it dies (:func:`lilium.experiments.processes.exit_with_parent`).
+it dies (:func:`lilium.experiments.processes.exit_with_parent`); a Dask cluster is reached before
+anything else, and a cluster without workers ends the run (:mod:`lilium.experiments.executors`).
 """
 
 import functools
@@ -40,12 +41,9 @@ import numpy as np
 
 from ..optimisation.de import DEOptions
 from .dataset import check_index, check_task_files, dataset_fingerprint
+from .executors import connect_scheduler, dask_results, local_results
 from .joint_tasks import JOINT_METHODS, partner_tasks, photo_pairs, run_joint_task
-from .processes import exit_with_parent
 from .store import KEY_COLUMNS, ResultStore, RunLock, database_error
-
-#: Tasks in flight per worker (keeps workers busy without queueing the whole run).
-IN_FLIGHT_PER_WORKER = 3
 
 #: Cached cases per worker process (skulls are a few MB each).
 SKULL_CACHE = 48
@@ -53,9 +51,6 @@ PHOTO_CACHE = 256
 
 #: Keys of the SFO result dictionary that are not stored (long, and not needed by the report).
 _DROPPED_RESULT_KEYS = ("history", "genes")
-
-#: Environment variables that pin numerical libraries to one thread per worker process.
-_THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 @dataclass(frozen=True)
@@ -383,120 +378,6 @@ def result_columns(single, score, run):
     )
 
 
-def _init_worker(parent_pid=None):
-    """Worker set-up: one OpenCV thread; with ``parent_pid``, exit when the parent dies."""
-    import cv2
-
-    cv2.setNumThreads(1)
-    if parent_pid is not None:
-        exit_with_parent(parent_pid)
-
-
-# -- executors ----------------------------------------------------------------------------------
-def _local_results(tasks, workers):
-    """Yield ``(task, row or exception)`` from a local process pool (serial when workers = 1)."""
-    if workers <= 1:
-        _init_worker()
-        for task in tasks:
-            try:
-                yield task, run_task(task)
-            except Exception as exc:  # noqa: BLE001 - reported by the parent, retried on rerun
-                yield task, exc
-        return
-
-    import multiprocessing
-    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-
-    saved = {v: os.environ.get(v) for v in _THREAD_VARS}
-    for v in _THREAD_VARS:  # inherited by the spawned workers
-        os.environ.setdefault(v, "1")
-    try:
-        pool = ProcessPoolExecutor(
-            max_workers=workers,
-            mp_context=multiprocessing.get_context("spawn"),
-            initializer=_init_worker,
-            initargs=(os.getpid(),),
-        )
-    finally:
-        for v, value in saved.items():
-            if value is None:
-                os.environ.pop(v, None)
-            else:
-                os.environ[v] = value
-    todo = iter(tasks)
-    pending = {}
-    try:
-
-        def fill():
-            while len(pending) < IN_FLIGHT_PER_WORKER * workers:
-                task = next(todo, None)
-                if task is None:
-                    return
-                pending[pool.submit(run_task, task)] = task
-
-        fill()
-        while pending:
-            done, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for future in done:
-                task = pending.pop(future)
-                try:
-                    outcome = future.result()
-                except Exception as exc:  # noqa: BLE001
-                    outcome = exc
-                yield task, outcome
-            fill()
-    except BaseException:
-        # Interrupted (Ctrl-C, or the consumer stopped): do not wait for long SFOs in flight.
-        pool.shutdown(wait=False, cancel_futures=True)
-        raise
-    pool.shutdown(wait=True)
-
-
-def _dask_results(tasks, scheduler):
-    """Yield ``(task, row or exception)`` from a Dask distributed cluster.
-
-    ``scheduler`` is an address (``"tcp://host:8786"``) or a ``dask.distributed.Client``.
-    """
-    try:
-        from dask.distributed import Client, as_completed
-    except ImportError as exc:  # pragma: no cover - depends on the installation
-        raise ValueError(
-            "--scheduler needs dask.distributed; install it with pip install 'dask[distributed]'"
-        ) from exc
-    own = not isinstance(scheduler, Client)
-    client = Client(scheduler) if own else scheduler
-    todo = iter(tasks)
-    pending = {}
-    queue = as_completed()
-    try:
-
-        def fill():
-            threads = sum(client.nthreads().values()) or 1
-            while len(pending) < max(8, IN_FLIGHT_PER_WORKER * threads):
-                task = next(todo, None)
-                if task is None:
-                    return
-                future = client.submit(run_task, task, pure=False)
-                pending[future.key] = task
-                queue.add(future)
-
-        fill()
-        for future in queue:
-            task = pending.pop(future.key)
-            try:
-                outcome = future.result()
-            except Exception as exc:  # noqa: BLE001 - a failed or cancelled task, retried on rerun
-                outcome = exc
-            future.release()
-            yield task, outcome
-            fill()
-    finally:
-        for future in list(queue.futures):
-            future.cancel()
-        if own:
-            client.close()
-
-
 # -- driver -------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class RunSummary:
@@ -565,6 +446,12 @@ def run_experiment(cfg, scheduler=None, workers=None, db=None, progress=True, lo
     db = Path(db or cfg.db)
     if db.is_dir():
         raise ValueError(f"{db}: is a folder; give the results database file (--db)")
+    if isinstance(scheduler, str):  # reached first: a wrong address fails before any file
+        client = connect_scheduler(scheduler)
+        try:
+            return run_experiment(cfg, client, workers, db, progress, log)
+        finally:
+            client.close()
     try:
         db.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -608,10 +495,16 @@ def _run(cfg, store, tasks, root, fingerprint, scheduler, workers, progress, log
     todo = [t for t in tasks if t.key not in done]
     already = len(tasks) - len(todo)
     workers = max(1, min(workers, len(todo)))
-    where = f"Dask at {scheduler}" if scheduler is not None else f"{workers} local worker(s)"
+    where = (
+        f"Dask at {scheduler.scheduler.address}"
+        if scheduler is not None
+        else f"{workers} local worker(s)"
+    )
     log(f"{cfg.name}: {len(tasks)} SFOs, {already} already in {db}, {len(todo)} to run on {where}")
     results = (
-        _dask_results(todo, scheduler) if scheduler is not None else _local_results(todo, workers)
+        dask_results(todo, scheduler, run_task)
+        if scheduler is not None
+        else local_results(todo, workers, run_task)
     )
     bar = None
     if progress:

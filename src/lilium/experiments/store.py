@@ -58,6 +58,11 @@ VALUE_COLUMNS = {
 
 COLUMNS = KEY_COLUMNS + tuple(VALUE_COLUMNS)
 
+#: Columns that hold numbers (SQLite would store text in them too).
+_NUMERIC_COLUMNS = {"axes_set", "repetition", "seed"} | {
+    c for c, kind in VALUE_COLUMNS.items() if kind in ("REAL", "INTEGER")
+}
+
 _SCHEMA = f"""
 CREATE TABLE IF NOT EXISTS sfo (
     id INTEGER PRIMARY KEY,
@@ -255,7 +260,17 @@ class ResultStore:
         """All rows as dicts (``columns`` default: every column but ``result``)."""
         columns = columns or [c for c in COLUMNS if c != "result"]
         cur = self.conn.execute(f"SELECT {', '.join(columns)} FROM sfo ORDER BY id")
-        return [dict(zip(columns, r, strict=True)) for r in cur.fetchall()]
+        rows = [dict(zip(columns, r, strict=True)) for r in cur.fetchall()]
+        numeric = [c for c in columns if c in _NUMERIC_COLUMNS]
+        for k, row in enumerate(rows):  # SQLite stores any value in any column
+            for c in numeric:
+                if row[c] is not None and not isinstance(row[c], (int, float)):
+                    raise ValueError(
+                        f"{self.path}: row {k + 1} holds {str(row[c])[:40]!r} in the numeric "
+                        f"column {c}; the database was edited or damaged: restore it, or delete "
+                        "that row (lilium experiment then runs its SFO again)"
+                    )
+        return rows
 
 
 def task_key(row):

@@ -15,6 +15,9 @@ from pathlib import Path
 from .config import EXPERIMENTS, VIEW_GROUPS, method_label, method_order, view_group
 from .store import ResultStore, database_error
 
+#: The columns of ``terms_off.csv`` (then ``off_<term>`` for each term switched off somewhere).
+TERMS_OFF_COLUMNS = ("experiment", "method", "view", "sfos", "with_term_off")
+
 
 def terms_off_rows(db):
     """``experiment, method, variant, view, terms_off`` of every stored SFO (read-only)."""

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..constants import C_INF, FOCAL_MAX_PX, FOCAL_MIN_PX, focal_cap_px
 from ..geometry.rotations import geodesic_angle_deg
-from ..validation import check_interval
+from ..validation import check_interval, check_prior
 
 
 def _interval(value, name):
@@ -49,8 +49,9 @@ class CameraPriors:
     head_tolerance_deg: float | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "focal_px", _interval(self.focal_px, "focal_px"))
-        object.__setattr__(self, "scd_mm", _interval(self.scd_mm, "scd_mm"))
+        for key in ("focal_px", "scd_mm"):
+            value = getattr(self, key)
+            object.__setattr__(self, key, None if value is None else check_prior(value, key, key))
         if self.head_rotation_skull2cam is not None:
             R = np.asarray(self.head_rotation_skull2cam, dtype=float)
             if R.shape != (3, 3):

@@ -5,6 +5,8 @@ All functions accept leading batch axes: rotation vectors ``(..., 3)``, matrices
 
 import numpy as np
 
+from ..validation import is_numeric
+
 _SMALL_ANGLE = 1e-8
 
 
@@ -94,6 +96,8 @@ def check_rotation(R, name="rotation", tol=1e-6):
     ValueError
         If ``R`` is not a finite, orthonormal, right-handed 3x3 matrix.
     """
+    if not is_numeric(R):
+        raise ValueError(f"{name} must be a 3x3 matrix of numbers (not true/false or text)")
     R = np.asarray(R, dtype=float)
     if R.shape != (3, 3):
         raise ValueError(f"{name} must be a 3x3 matrix, got shape {R.shape}")

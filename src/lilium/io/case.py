@@ -21,11 +21,12 @@ from ..inputs import Photo, Priors, Skull
 from ..softtissue.depths import DepthStats, check_depth_table
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from ..softtissue.normals import surface_normals_at
-from ..validation import check_interval
+from ..validation import check_prior, is_real
 from .curves import read_face_curve
 from .formats import find_landmark_file, points_from_object, read_landmarks
 from .images import image_size_wh, read_image, read_mask
 from .jsonio import read_json
+from .keys import json_type, unknown_key_warnings
 from .mesh import MESH_SUFFIXES, read_mesh
 from .paths import path_id, safe_id
 
@@ -198,7 +199,7 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
 
 def _interval(path, priors, key):
     value = priors.get(key)
-    return None if value is None else check_interval(value, f"{path}: priors.{key}")
+    return None if value is None else check_prior(value, key, f"{path}: priors.{key}")
 
 
 def parse_priors(path, priors):
@@ -217,7 +218,7 @@ def parse_priors(path, priors):
             raise ValueError(f"{path}: {exc}") from None
     tolerance = priors.get("head_tolerance_deg")
     if tolerance is not None:
-        if not (isinstance(tolerance, (int, float)) and 0 < tolerance <= 180):
+        if not (is_real(tolerance) and 0 < tolerance <= 180):
             raise ValueError(f"{path}: priors.head_tolerance_deg must be in (0, 180] degrees")
         tolerance = float(tolerance)
     if (rotation is None) != (tolerance is None):
@@ -266,6 +267,11 @@ def read_photo(folder, load_image=True):
     image, size_wh = _photo_pixels(image_path, load_image)
     meta_path = folder / "photo.json"
     meta = read_json(meta_path)
+    if not isinstance(meta, dict):
+        raise ValueError(
+            f'{meta_path}: must be a JSON object {{"view": ..., "landmarks": {{...}}}}, '
+            f"got a JSON {json_type(meta)}; see SPEC section 8 for the photo folder"
+        )
     view = _field(meta_path, meta, "view")
     if view not in VIEWS:
         raise ValueError(f"{meta_path}: view must be one of {', '.join(VIEWS)}, got {view!r}")
@@ -298,6 +304,7 @@ def read_photo(folder, load_image=True):
         priors,
         image,
         landmark_sources=sources,
+        warnings=unknown_key_warnings(meta_path, meta),
     )
 
 
@@ -417,14 +424,14 @@ def read_prepared(folder):
         except (ValueError, TypeError) as exc:
             raise ValueError(f"{meta_path}: {exc}") from None
         tolerance = priors.get("head_tolerance_face_deg", 15.0)
-        if not (isinstance(tolerance, (int, float)) and 0 < tolerance <= 180):
+        if not (is_real(tolerance) and 0 < tolerance <= 180):
             raise ValueError(
                 f"{meta_path}: priors.head_tolerance_face_deg must be in (0, 180] degrees"
             )
         tolerance = float(tolerance)
     if priors.get("iris_diameter_px") is not None:
         iris = priors["iris_diameter_px"]
-        if not (isinstance(iris, (int, float)) and np.isfinite(iris) and iris > 0):
+        if not (is_real(iris) and np.isfinite(iris) and iris > 0):
             raise ValueError(f"{meta_path}: priors.iris_diameter_px must be a positive number")
         iris = float(iris)
     angles = priors.get("head_angles_deg") if face2cam is not None else None
@@ -569,9 +576,9 @@ def read_depth_table(path):
         for line, row in enumerate(reader, start=2):
             try:
                 stats = DepthStats(*(float(row[k]) for k in ("mean", "sd", "min", "max")))
-            except ValueError:
+            except (TypeError, ValueError):
                 raise ValueError(
                     f"{path}: line {line}: mean, sd, min and max must be numbers"
                 ) from None
-            table[row["landmark"].strip()] = stats
+            table[(row["landmark"] or "").strip()] = stats
     return check_depth_table(table, source=str(path))

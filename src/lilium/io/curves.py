@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..validation import is_numeric
 from .jsonio import read_json
 
 #: The curve key of each view.
@@ -32,13 +33,15 @@ def read_face_curve(path, view, image_size_wh=None):
     Returns
     -------
     ndarray of shape (K, 2)
-        ``K >= 2`` points ``(u, v)``, pixels.
+        ``K >= 2`` points ``(u, v)``, pixels; with ``image_size_wh``, whole pixels along an
+        8-connected path (at most the photo's perimeter long).
 
     Raises
     ------
     ValueError
         Naming the file: not found, not an object, no curve for the view, fewer than two finite
-        ``[u, v]`` points, or a point off the image.
+        ``[u, v]`` points, a point off the image, or (with ``image_size_wh``) a curve longer
+        than the photo's perimeter (a zig-zag).
     """
     path = Path(path)
     if not path.is_file():
@@ -59,12 +62,12 @@ def read_face_curve(path, view, image_size_wh=None):
         )
     raw = data[key]
     try:
-        curve = np.asarray(raw, dtype=float)
+        curve = np.asarray(raw, dtype=float) if is_numeric(raw) else np.empty((0,))
     except (TypeError, ValueError):
         curve = np.empty((0,))
     if isinstance(raw, str) or curve.ndim != 2 or curve.shape[1] != 2 or len(curve) < 2:
         raise ValueError(
-            f"{path}: {key} must be a list of at least two [u, v] points (pixels), got "
+            f"{path}: {key} must be a list of at least two [u, v] points (numbers, in pixels), got "
             f"{_short(raw)}"
         )
     if not np.all(np.isfinite(curve)):
@@ -79,7 +82,34 @@ def read_face_curve(path, view, image_size_wh=None):
                 f"{w}x{h} photo ({int(outside.sum())} of {len(curve)} points do); the curve is "
                 "in the photo's pixels, u = column, v = row"
             )
+        curve = _pixel_curve(path, key, curve, image_size_wh)
     return curve
+
+
+def _pixel_curve(path, key, curve, image_size_wh):
+    """The curve resampled to the photo's pixel grid (what P_pll uses: an 8-connected path of
+    whole pixels), its length bounded by the photo's perimeter.
+
+    The work P_pll does per camera grows with the curve's length in pixels, not with the
+    file's number of points: a 2-million-point smooth curve becomes a few hundred pixels, while
+    a zig-zag across the photo would be millions of pixels long (hours of fitting). A facial
+    outline runs once along the face, so a curve longer than the photo's perimeter is refused.
+    """
+    from ..fitness.curves import join_fragments
+
+    w, h = image_size_wh
+    limit = 2.0 * (w + h)
+    length = float(np.linalg.norm(np.diff(curve, axis=0), axis=1).sum())
+    if length > limit:
+        raise ValueError(
+            f"{path}: {key} is {length:.0f} px long, longer than the {w}x{h} photo's perimeter "
+            f"({limit:.0f} px): it runs back and forth; give the outline once, from one end to "
+            "the other, in the photo's pixels"
+        )
+    pixels = join_fragments(np.rint(curve))
+    keep = np.ones(len(pixels), bool)
+    keep[1:] = np.any(pixels[1:] != pixels[:-1], axis=1)
+    return pixels[keep]
 
 
 def _short(value, limit=40):

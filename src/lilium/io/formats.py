@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..softtissue.landmarks import CRANIAL_NAMES, FACIAL_NAMES, base_name, side
+from ..validation import is_numeric
 from .jsonio import parse_json
 
 KINDS = ("cranial", "facial")
@@ -312,12 +313,13 @@ def canonical_points(path, entries, kind, dim=None, allow_empty=False, finite=Tr
         if canonical is None:
             raise name_error(path, where, name, kind)
         try:
-            point = np.asarray(coords, dtype=float)
+            point = np.asarray(coords, dtype=float) if is_numeric(coords) else np.empty(0)
         except (TypeError, ValueError):
             point = np.empty(0)
         if point.shape != (dim,):
             raise ValueError(
-                f"{_at(path, where)}: {name!r} must have {dim} numeric coordinates, got {coords!r}"
+                f"{_at(path, where)}: {name!r} must have {dim} numeric coordinates (numbers, not "
+                f"true/false or quoted text), got {_short_repr(coords)}"
             )
         if finite and not np.all(np.isfinite(point)):
             raise ValueError(
@@ -333,6 +335,11 @@ def canonical_points(path, entries, kind, dim=None, allow_empty=False, finite=Tr
     if not out and not allow_empty:
         raise ValueError(f"{path}: no landmarks found; place landmarks and save the file again")
     return out
+
+
+def _short_repr(value, limit=60):
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def points_from_object(path, field, raw, kind, dim=None, allow_empty=False, finite=True):

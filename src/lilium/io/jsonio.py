@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -45,6 +46,23 @@ def _unique_keys(pairs):
     return out
 
 
+#: Deepest nesting of arrays and objects a JSON input may have: SPEC files need 4 levels; a
+#: deeper file is hostile or broken, and would exhaust Python's recursion further on.
+MAX_JSON_DEPTH = 64
+
+
+_STRING = re.compile(r'"(?:[^"\\]|\\.)*"')
+
+
+def _depth(text):
+    """Deepest nesting of arrays and objects in JSON text (brackets in strings not counted),
+    found before parsing, in linear time."""
+    codes = np.frombuffer(_STRING.sub("", text).encode("utf-8", "replace"), dtype=np.uint8)
+    folded = codes | 32  # "[" (91) becomes "{" (123), "]" (93) becomes "}" (125)
+    brackets = folded[(folded == 123) | (folded == 125)]
+    return int(np.cumsum(np.where(brackets == 123, 1, -1)).max()) if len(brackets) else 0
+
+
 def parse_json(text, source):
     """Parse JSON text; malformed JSON or a key given twice in one object is a ``ValueError``
     naming ``source`` (a file path, for messages).
@@ -52,14 +70,23 @@ def parse_json(text, source):
     Python's ``json`` lets the last of two equal keys win silently; here it is an error, as a
     landmark or prior written twice is a mistake the user must resolve.
     """
+    deep = ValueError(
+        f"{source}: JSON nested deeper than {MAX_JSON_DEPTH} levels of arrays or objects; "
+        "this is not a Lilium file: check that you gave the right file"
+    )
+    if _depth(text) > MAX_JSON_DEPTH:
+        raise deep
     try:
-        return json.loads(text, object_pairs_hook=_unique_keys)
+        data = json.loads(text, object_pairs_hook=_unique_keys)
+    except RecursionError:
+        raise deep from None
     except _DuplicateKey as exc:
         raise ValueError(
             f"{source}: the key {exc.args[0]!r} appears twice in one JSON object; keep one of them"
         ) from None
     except json.JSONDecodeError as exc:
         raise ValueError(f"{source}: not valid JSON ({exc}); fix the file's syntax") from exc
+    return data
 
 
 def read_json(path):

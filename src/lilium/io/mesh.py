@@ -39,7 +39,13 @@ def read_mesh(path):
     try:
         mesh = trimesh.load(path, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many kinds for a corrupt file
-        raise ValueError(f"{path}: cannot read the mesh ({exc}); re-export it as PLY") from exc
+        detail = " ".join(str(exc).split())[:120]
+        kind = path.suffix[1:].upper()
+        raise ValueError(
+            f"{path}: not a readable {kind} triangle mesh (its header or data are damaged or "
+            f"of another format: {type(exc).__name__}{f' {detail}' if detail else ''}); open it "
+            "in a mesh program (MeshLab, 3D Slicer) and export the skull surface again as PLY"
+        ) from exc
     vertices = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=float)
     faces = np.asarray(getattr(mesh, "faces", np.empty((0, 3))), dtype=np.int64)
     check_mesh(vertices, faces, str(path))

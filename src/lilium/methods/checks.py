@@ -43,6 +43,7 @@ from ..constants import FACING_MAX_DEG, VIEW_SPLIT_DEG, focal_cap_px
 from ..fitness.camera_penalty import head_deviation_deg
 from ..inputs import CaseWarning
 from ..softtissue.landmarks import side, twin
+from ..validation import fmt_number, fmt_range
 
 #: Anterior landmarks the anterior direction aims at when nasion is missing, in order.
 ANTERIOR_TARGETS = ("glabella", "subspinale", "prosthion", "metopion", "pogonion", "gnathion")
@@ -428,8 +429,8 @@ def prior_warnings(photo, camera=None, facial_landmarks_mm=None):
             out.append(
                 CaseWarning(
                     "outside_prior",
-                    f"the {label} found, {value:.0f} {unit}, lies outside its prior "
-                    f"{bounds[0]:.0f}-{bounds[1]:.0f} {unit} ({_source(photo, key, bounds)}); "
+                    f"the {label} found, {fmt_number(value)} {unit}, lies outside its prior "
+                    f"{fmt_range(*bounds, unit)} ({_source(photo, key, bounds)}); "
                     "check the prior and the landmarks",
                 )
             )

@@ -15,11 +15,12 @@ import time
 
 import numpy as np
 
-from ..constants import focal_cap_px
+from ..constants import FOCAL_MAX_PX, focal_cap_px
 from ..geometry.camera import principal_point_of
 from ..inputs import CaseWarning, correspondences
 from ..pose.posest import posest
 from ..softtissue.depths import depth_stats
+from ..validation import fmt_number, fmt_range
 from .checks import facing_check, facing_failure
 from .options import SfoOptions, with_cap_px, with_focal_cap
 from .result import SfoResult
@@ -147,8 +148,15 @@ def focal_cap_message(photo, focal_px=None):
             f"the focal length is capped at {cap:.0f} px without a focal prior; give the focal "
             "prior (a photo with EXIF, or --focal-px LO HI) to lift the cap for a long lens"
         )
+    if prior[1] <= FOCAL_MAX_PX:
+        return (
+            f"the landmarks call for a focal length above {fmt_number(cap)} px, the most a "
+            f"camera may have, far beyond the focal prior {fmt_range(*prior, 'px')}: check the "
+            "prior and that the skull's and the photo's landmarks match"
+        )
     return (
-        f"the focal length is capped at {cap:.0f} px (focal prior {prior[0]:.0f}-{prior[1]:.0f} px)"
+        f"the focal length is capped at {fmt_number(cap)} px (twice the focal prior's upper "
+        f"bound, {fmt_range(*prior, 'px')}): check the prior and the landmarks"
     )
 
 

@@ -18,6 +18,7 @@ from ..evaluation.metrics import outside_face
 from ..geometry.rotations import geodesic_angle_deg, matrix_to_rotvec
 from ..io.provenance import input_files, software_versions
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
+from ..validation import fmt_range
 from .pictures import sfo_pictures, skull_view_pictures, skull_views_for, view_box
 from .record_types import (
     CameraFacts,
@@ -173,9 +174,7 @@ def prior_rows(result):
         entry = priors.get(key)
         if entry is None:
             continue
-        value = (
-            "none" if entry["range"] is None else "{:.0f}-{:.0f} {}".format(*entry["range"], unit)
-        )
+        value = "none" if entry["range"] is None else fmt_range(*entry["range"], unit)
         rows.append((label, value, entry["source"]))
     head = priors.get("head_rotation")
     if head is not None:

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..constants import MAX_DEPTH_MM, MAX_DEPTH_SD_MM
+from ..validation import fmt_number
 from .landmarks import CRANIAL_TO_FACIAL, base_name
 
 
@@ -50,7 +52,9 @@ def check_depth_table(table, source="depth table"):
     Raises
     ------
     ValueError
-        Unknown landmark, non-finite value, or ``not 0 <= min <= mean <= max``.
+        Unknown landmark, non-finite value, ``not 0 <= min <= mean <= max``, a depth beyond
+        :data:`~lilium.constants.MAX_DEPTH_MM` or an SD outside
+        ``[0, MAX_DEPTH_SD_MM]``.
     """
     facial_base = {base_name(f): base_name(c) for c, f in CRANIAL_TO_FACIAL.items()}
     out = {}
@@ -65,6 +69,13 @@ def check_depth_table(table, source="depth table"):
         values = np.array([stats.mean_mm, stats.sd_mm, stats.min_mm, stats.max_mm], dtype=float)
         if not np.all(np.isfinite(values)):
             raise ValueError(f"{source}: landmark {key!r} has a NaN or infinite value")
+        if stats.max_mm > MAX_DEPTH_MM or not 0 <= stats.sd_mm <= MAX_DEPTH_SD_MM:
+            raise ValueError(
+                f"{source}: landmark {key!r} has max={fmt_number(stats.max_mm)} mm and "
+                f"sd={fmt_number(stats.sd_mm)} mm; facial soft tissue is at most "
+                f"{MAX_DEPTH_MM:g} mm deep (sd 0 to {MAX_DEPTH_SD_MM:g} mm): check the "
+                "values and that they are in millimetres"
+            )
         if not 0 <= stats.min_mm <= stats.mean_mm <= stats.max_mm:
             raise ValueError(
                 f"{source}: landmark {key!r} needs 0 <= min <= mean <= max, got "
