@@ -27,7 +27,7 @@ class CaseWarning:
     ----------
     code : str
         ``view_mismatch``, ``no_focal_prior``, ``no_scd_prior``, ``outside_prior``,
-        ``exif_focal_unusable``, ``focal_cap``.
+        ``exif_focal_unusable``, ``implausible_prior``, ``focal_cap``.
     message : str
         What is wrong and what fixes it.
     """

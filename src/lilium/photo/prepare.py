@@ -23,7 +23,7 @@ from ..io.case import read_image
 from ..io.formats import read_landmarks
 from ..io.jsonio import write_json
 from .analysis import analyse_face
-from .headpose import iris_distance_mm
+from .headpose import implausible_distance, iris_distance_mm
 from .mask import mask_outline
 from .review import review_page
 
@@ -43,6 +43,8 @@ class PreparedPhoto:
         One line for the user (why no face was found, or a summary).
     view : str
     n_tracked, n_template : int
+    warnings : tuple of dict
+        ``{"code", "message"}`` (SPEC section 10 codes), also in ``photo.json``.
     """
 
     folder: Path
@@ -51,6 +53,7 @@ class PreparedPhoto:
     view: str
     n_tracked: int = 0
     n_template: int = 0
+    warnings: tuple = ()
 
 
 def _copy_image(image_path, image, out):
@@ -67,10 +70,24 @@ def _copy_image(image_path, image, out):
 
 
 def _priors(image_path, analysis, sensor_width_mm):
-    from ..io.exif import focal_prior_from_exif
+    """``photo.json``'s priors and the warnings (``{"code", "message"}``) found on the way."""
+    from ..io.exif import exif_focal
 
-    priors, sources = {"source": "automatic"}, {}
-    focal = focal_prior_from_exif(image_path, sensor_width_mm=sensor_width_mm)
+    priors, sources, warnings = {"source": "automatic"}, {}, []
+    focal, unusable = exif_focal(image_path, sensor_width_mm=sensor_width_mm)
+    if unusable:
+        warnings.append({"code": "exif_focal_unusable", "message": unusable})
+    if focal is not None and analysis:
+        why = implausible_distance(focal.focal_px, analysis.iris_diameter_px)
+        if why:
+            warnings.append(
+                {
+                    "code": "implausible_prior",
+                    "message": f"{image_path}: EXIF focal not used: {why} ({focal.source}); if "
+                    "the distance is real, give the focal with lilium case --focal-px LO HI",
+                }
+            )
+            focal = None
     if focal is not None:
         priors["focal_px"] = [float(x) for x in focal.focal_px]
         sources["focal_px"] = f"EXIF: {focal.source}"
@@ -91,7 +108,7 @@ def _priors(image_path, analysis, sensor_width_mm):
                 f"{f:.0f} px -> {distance:.0f} mm (camera to eyes)"
             )
     priors["sources"] = sources
-    return priors
+    return priors, warnings
 
 
 def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_width_mm=None):
@@ -145,13 +162,16 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
         }
     out.mkdir(parents=True, exist_ok=True)
     _copy_image(image_path, image, out)
-    priors = _priors(image_path, analysis, sensor_width_mm)
+    priors, warnings = _priors(image_path, analysis, sensor_width_mm)
     meta = {
+        "prepared_by": "lilium photo",
         "view": view,
         "landmarks": {k: [round(float(x), 2) for x in v] for k, v in landmarks.items()},
         "landmark_sources": sources,
         "priors": priors,
     }
+    if warnings:
+        meta["warnings"] = warnings
     write_json(out / "photo.json", meta)
     outline = np.zeros((0, 2))
     if analysis:
@@ -174,4 +194,6 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
         message = f"{image_path}: {analysis.message}"
     page = review_page(image, meta["landmarks"], sources, outline, priors, image_path.name, message)
     (out / "review.html").write_text(page, encoding="utf-8")
-    return PreparedPhoto(out, bool(analysis), message, view, n_tracked, n_template)
+    return PreparedPhoto(
+        out, bool(analysis), message, view, n_tracked, n_template, tuple(warnings)
+    )

@@ -11,6 +11,9 @@ Image coordinates are ``uv`` (column, row) pixels of the original image, the cen
 top-left pixel at (0, 0) (SPEC section 8).
 """
 
+import contextlib
+import os
+import sys
 from dataclasses import dataclass
 from functools import cache
 from importlib import resources
@@ -55,11 +58,32 @@ def check_runtime():
     _interpreter_class()
 
 
+@contextlib.contextmanager
+def _quiet_stderr():
+    """Silence file descriptor 2 (the runtime's own C++ logging, e.g. "INFO: Created TensorFlow
+    Lite XNNPACK delegate for CPU.") for the block; Python's ``sys.stderr`` is flushed first."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError, AttributeError):  # no real fd 2 (embedded): nothing to silence
+        yield
+        return
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 2)
+            yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
 @cache
 def _model(kind):
     path = resources.files("lilium.photo") / "models" / MODEL_FILES[kind]
-    interpreter = _interpreter_class()(model_content=path.read_bytes(), num_threads=1)
-    interpreter.allocate_tensors()
+    interpreter_class = _interpreter_class()
+    with _quiet_stderr():
+        interpreter = interpreter_class(model_content=path.read_bytes(), num_threads=1)
+        interpreter.allocate_tensors()
     return interpreter
 
 
