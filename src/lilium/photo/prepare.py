@@ -19,11 +19,14 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import MIN_PHOTO_SIDE_PX
 from ..io.case import read_image
 from ..io.formats import read_landmarks
 from ..io.jsonio import write_json
 from .analysis import analyse_face
+from .folder import PREPARED_BY, check_image_path, claim_folder
 from .headpose import implausible_distance, iris_distance_mm
+from .landmarks import mesh_face_curves
 from .mask import mask_outline
 from .review import review_page
 
@@ -60,7 +63,8 @@ def _copy_image(image_path, image, out):
     suffix = image_path.suffix.lower()
     if suffix in (".png", ".jpg", ".jpeg"):
         target = out / f"image{suffix}"
-        shutil.copyfile(image_path, target)
+        if not (target.exists() and target.samefile(image_path)):  # the folder's own image
+            shutil.copyfile(image_path, target)
         return target
     from PIL import Image
 
@@ -119,7 +123,8 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
     image_path : str or Path
         PNG or JPEG (any format Pillow reads; others are stored as ``image.png``).
     out_dir : str or Path
-        The photo folder (created; files of the same names are replaced).
+        The photo folder (created). ``lilium photo`` owns it (:mod:`.folder`): its own files
+        of an earlier run are replaced, a folder holding another's is refused.
     view : {"frontal", "lateral_left", "lateral_right"}, optional
         Default: from the fitted yaw (frontal under 30 degrees).
     landmarks_path : str or Path, optional
@@ -134,15 +139,17 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
         ``face_found`` is False when the models found no face: the folder then has the image,
         a ``photo.json`` without automatic landmarks and the review page, to mark by hand.
     """
-    image_path = Path(image_path)
-    if not image_path.is_file():
-        raise ValueError(f"{image_path}: file not found; check the photo's path")
+    image_path = check_image_path(image_path)
+    out = Path(out_dir)
+    previous = claim_folder(out, image_path)
     image = read_image(image_path)
     h, w = image.shape[:2]
+    if min(h, w) < MIN_PHOTO_SIDE_PX:
+        raise ValueError(
+            f"{image_path}: the photo is {w}x{h} px, too small to prepare or superimpose (at "
+            f"least {MIN_PHOTO_SIDE_PX} px a side); use the original photograph"
+        )
     reviewed = read_landmarks(landmarks_path, "facial") if landmarks_path else None
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"{out}: exists and is not a folder; give a folder for --out")
     analysis = analyse_face(image)
     view = view or (analysis.view if analysis else "frontal")
     landmarks, sources = dict(analysis.landmarks), dict(analysis.sources)
@@ -160,27 +167,35 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
             k: {"source": "reviewed", "quality": quality.get(k, "manual"), "confirmed": True}
             for k in reviewed
         }
-    out.mkdir(parents=True, exist_ok=True)
-    _copy_image(image_path, image, out)
     priors, warnings = _priors(image_path, analysis, sensor_width_mm)
+    curves = mesh_face_curves(analysis.mesh_xyz, (w, h)) if analysis else {}
     meta = {
-        "prepared_by": "lilium photo",
+        "prepared_by": PREPARED_BY,
         "view": view,
         "landmarks": {k: [round(float(x), 2) for x in v] for k, v in landmarks.items()},
         "landmark_sources": sources,
         "priors": priors,
     }
+    if analysis:
+        meta["face_mask_is_head"] = True  # never a source of facial curves (SPEC section 11)
     if warnings:
         meta["warnings"] = warnings
+    out.mkdir(parents=True, exist_ok=True)
+    for path in previous:  # this command's files of an earlier run (folder.py)
+        path.unlink()
     write_json(out / "photo.json", meta)
+    _copy_image(image_path, image, out)
     outline = np.zeros((0, 2))
     if analysis:
         from PIL import Image
 
         Image.fromarray(analysis.mask.astype(np.uint8) * 255).save(out / "face_mask.png")
         outline = mask_outline(analysis.mask)
-    elif (out / "face_mask.png").is_file():
-        (out / "face_mask.png").unlink()  # a stale mask from an earlier run would mislead
+    if curves:
+        source = {"source": "automatic", "quality": "template", "from": "face mesh outline"}
+        curve_file = {k: np.round(c, 2).tolist() for k, c in curves.items()}
+        curve_file["curve_sources"] = {k: source for k in curves}
+        write_json(out / "face_curve.json", curve_file)
     n_tracked = sum(s["quality"] == "tracked" for s in sources.values())
     n_template = sum(s["quality"] == "template" for s in sources.values())
     if analysis:
@@ -194,6 +209,4 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
         message = f"{image_path}: {analysis.message}"
     page = review_page(image, meta["landmarks"], sources, outline, priors, image_path.name, message)
     (out / "review.html").write_text(page, encoding="utf-8")
-    return PreparedPhoto(
-        out, bool(analysis), message, view, n_tracked, n_template, tuple(warnings)
-    )
+    return PreparedPhoto(out, bool(analysis), message, view, n_tracked, n_template, tuple(warnings))
