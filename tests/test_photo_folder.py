@@ -106,3 +106,66 @@ def test_bad_images_are_one_line(tmp_path, capsys, make, needle):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and needle in err[0], err
     assert not (tmp_path / "p").exists()
+
+
+def _landmarks(folder):
+    meta = json.loads((folder / "photo.json").read_text())
+    return meta, {k: np.array(v) for k, v in meta["landmarks"].items()}
+
+
+def test_an_upside_down_face_is_prepared_upright(astro, tmp_path, capsys):
+    from skimage import data
+
+    Image.fromarray(data.astronaut()[::-1, ::-1]).save(tmp_path / "turned.png")
+    out = tmp_path / "turned"
+    assert main(["photo", str(tmp_path / "turned.png"), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "warning photo_turned:" in err and "turned by 180 degrees" in err
+    meta, turned = _landmarks(out)
+    _, upright = _landmarks(astro)
+    assert np.array_equal(np.asarray(Image.open(out / "image.png")), data.astronaut())
+    for name in ("exocanthion_l", "exocanthion_r", "subnasale", "cheilion_l"):
+        assert np.linalg.norm(turned[name] - upright[name]) < 3, name
+    assert abs(meta["priors"]["head_angles_deg"]["roll"]) < 10
+
+
+def test_the_exif_orientation_is_honoured(astro, tmp_path, capsys):
+    from skimage import data
+
+    exif = Image.Exif()
+    exif[0x0112] = 6  # "rotate 90 degrees clockwise to display": stored turned anticlockwise
+    Image.fromarray(np.rot90(data.astronaut(), 1)).save(
+        tmp_path / "side.jpg", exif=exif, quality=95
+    )
+    out = tmp_path / "side"
+    assert main(["photo", str(tmp_path / "side.jpg"), "--out", str(out)]) == 0
+    assert "photo_turned" not in capsys.readouterr().err
+    _, found = _landmarks(out)
+    _, upright = _landmarks(astro)
+    assert read_photo(out).image_size_wh == (512, 512)
+    for name in ("exocanthion_l", "exocanthion_r", "subnasale"):
+        assert np.linalg.norm(found[name] - upright[name]) < 4, name
+
+
+def test_two_faces_say_which_was_taken_and_how_to_take_the_other(tmp_path, capsys):
+    from skimage import data
+
+    head = data.astronaut()[0:240, 110:340]
+    pair = np.full((240, 520, 3), 200, np.uint8)
+    pair[:, 10:240], pair[:, 280:510] = head, head
+    Image.fromarray(pair).save(tmp_path / "pair.png")
+    out = tmp_path / "pair"
+    assert main(["photo", str(tmp_path / "pair.png"), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert (
+        "warning several_faces:" in err and "2 faces in the photo (numbered from the left)" in err
+    )
+    took = 1 if "took face 1" in err else 2
+    other = 3 - took
+    assert f"give --face {other} for box u" in err
+    _, first = _landmarks(out)
+    assert main(["photo", str(tmp_path / "pair.png"), "--out", str(out), "--face", str(other)]) == 0
+    _, second = _landmarks(out)
+    shift = (second["subnasale"] - first["subnasale"])[0]
+    assert abs(abs(shift) - 270) < 5  # the other head, 270 px along
+    capsys.readouterr()

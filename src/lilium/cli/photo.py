@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 from ..constants import VIEWS
-from .argtypes import positive_float
+from .argtypes import int_in, positive_float
 
 #: Exit status when no face was found but the folder was written for marking by hand.
 EXIT_NO_FACE = 3
@@ -41,6 +41,11 @@ def register(subparsers):
         type=positive_float(),
         help="sensor long side (mm), for the EXIF focal",
     )
+    p.add_argument(
+        "--face",
+        type=int_in(1, why=" (faces are numbered from the left, 1 = the leftmost)"),
+        help="which face of a photo with several (default: the most confident)",
+    )
     p.set_defaults(func=run)
 
 
@@ -49,7 +54,12 @@ def run(args):
 
     start = time.perf_counter()
     result = prepare_photo(
-        args.image, args.out, args.view, args.landmarks, sensor_width_mm=args.sensor_width_mm
+        args.image,
+        args.out,
+        args.view,
+        args.landmarks,
+        sensor_width_mm=args.sensor_width_mm,
+        face=args.face,
     )
     seconds = time.perf_counter() - start
     for warning in result.warnings:

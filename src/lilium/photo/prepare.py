@@ -23,7 +23,7 @@ from ..constants import MIN_PHOTO_SIDE_PX
 from ..io.case import read_image
 from ..io.formats import read_landmarks
 from ..io.jsonio import write_json
-from .analysis import analyse_face
+from .analysis import analyse_face, upright_turns
 from .folder import PREPARED_BY, check_image_path, claim_folder
 from .headpose import implausible_distance, iris_distance_mm
 from .landmarks import mesh_face_curves
@@ -59,9 +59,9 @@ class PreparedPhoto:
     warnings: tuple = ()
 
 
-def _copy_image(image_path, image, out):
+def _copy_image(image_path, image, out, turned=False):
     suffix = image_path.suffix.lower()
-    if suffix in (".png", ".jpg", ".jpeg"):
+    if suffix in (".png", ".jpg", ".jpeg") and not turned:
         target = out / f"image{suffix}"
         if not (target.exists() and target.samefile(image_path)):  # the folder's own image
             shutil.copyfile(image_path, target)
@@ -115,7 +115,9 @@ def _priors(image_path, analysis, sensor_width_mm):
     return priors, warnings
 
 
-def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_width_mm=None):
+def prepare_photo(
+    image_path, out_dir, view=None, landmarks_path=None, sensor_width_mm=None, face=None
+):
     """Write a photo folder from a photograph.
 
     Parameters
@@ -132,6 +134,13 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
         file): they replace the automatic ones and count as confirmed.
     sensor_width_mm : float, optional
         For the EXIF focal (see :mod:`lilium.io.exif`).
+    face : int, optional
+        Which face of a photo with several (1 = the leftmost); default the most confident.
+
+    A face that is upright only in a copy of the photo turned by 90, 180 or 270 degrees
+    (:func:`~lilium.photo.analysis.upright_turns`) is prepared on that copy, which the folder
+    holds as ``image.png``: landmarks, mask and curves are then in its pixels, the left-right
+    checks of a case hold, and the message says so.
 
     Returns
     -------
@@ -149,8 +158,12 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
             f"{image_path}: the photo is {w}x{h} px, too small to prepare or superimpose (at "
             f"least {MIN_PHOTO_SIDE_PX} px a side); use the original photograph"
         )
+    turns = upright_turns(image)
+    if turns:
+        image = np.ascontiguousarray(np.rot90(image, turns))
+        h, w = image.shape[:2]
     reviewed = read_landmarks(landmarks_path, "facial") if landmarks_path else None
-    analysis = analyse_face(image)
+    analysis = analyse_face(image, face)
     view = view or (analysis.view if analysis else "frontal")
     landmarks, sources = dict(analysis.landmarks), dict(analysis.sources)
     if reviewed is not None:
@@ -168,6 +181,20 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
             for k in reviewed
         }
     priors, warnings = _priors(image_path, analysis, sensor_width_mm)
+    if analysis and analysis.several_faces:
+        warnings.append(
+            {"code": "several_faces", "message": f"{image_path}: {analysis.several_faces}"}
+        )
+    if turns:
+        meta_turn = 90 * turns
+        warnings.append(
+            {
+                "code": "photo_turned",
+                "message": f"{image_path}: the face is upright only with the photo turned by "
+                f"{meta_turn} degrees (counter-clockwise): the folder holds the turned photo "
+                "(image.png), and its landmarks, mask and curves are in its pixels",
+            }
+        )
     curves = mesh_face_curves(analysis.mesh_xyz, (w, h)) if analysis else {}
     meta = {
         "prepared_by": PREPARED_BY,
@@ -184,7 +211,7 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
     for path in previous:  # this command's files of an earlier run (folder.py)
         path.unlink()
     write_json(out / "photo.json", meta)
-    _copy_image(image_path, image, out)
+    _copy_image(image_path, image, out, turned=bool(turns))
     outline = np.zeros((0, 2))
     if analysis:
         from PIL import Image
