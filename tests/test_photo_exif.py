@@ -130,3 +130,25 @@ def test_a_focal_that_puts_the_camera_far_away_is_implausible(tmp_path, capfd):
     assert warning["code"] == "implausible_prior"
     assert "outside the 0.3-10 m of a portrait" in warning["message"]
     assert "warning implausible_prior:" in err
+
+
+def test_a_large_photo_s_exif_is_read_without_pillow_s_warning(tmp_path):
+    import struct
+    import warnings
+    import zlib
+
+    from lilium.io.exif import read_exif
+
+    # A PNG whose header says 10000 x 9460 px (94.6 MP, over Pillow's warning threshold, under
+    # Lilium's 100 MP limit); only the header is read.
+    path = tmp_path / "big.png"
+    _grey_png = tmp_path / "small.png"
+    Image.new("RGB", (8, 8)).save(_grey_png)
+    blob = bytearray(_grey_png.read_bytes())
+    ihdr = struct.pack(">II", 10_000, 9_460) + bytes(blob[24:29])
+    blob[16:29] = ihdr
+    blob[29:33] = struct.pack(">I", zlib.crc32(b"IHDR" + ihdr))
+    path.write_bytes(bytes(blob))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert read_exif(path) == {"image_size_wh": (10_000, 9_460)}

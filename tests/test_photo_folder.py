@@ -77,7 +77,12 @@ def test_a_second_photo_replaces_the_first_one_s_files(tmp_path, capsys):
     # Rerun on the folder's own image: it stays in place.
     assert main(["photo", str(folder / "image.jpg"), "--out", str(folder)]) == 3
     assert (folder / "image.jpg").is_file() and (folder / "photo.json").is_file()
-    capsys.readouterr()
+    # A user's folder holding only the photo, named as SPEC section 8 names it.
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "image.jpg").write_bytes((folder / "image.jpg").read_bytes())
+    assert main(["photo", str(mine / "image.jpg"), "--out", str(mine)]) == 3
+    assert (mine / "photo.json").is_file() and "SameFile" not in capsys.readouterr().err
 
 
 def test_a_hand_made_folder_is_refused(tmp_path, capsys):

@@ -10,8 +10,8 @@ Rules (docs/photo.md):
   the new landmarks); files of other names (the review page's ``landmarks.json``, notes) stay.
 - A folder holding any of those names that ``lilium photo`` did not write (a hand-made photo
   folder) is refused: nothing of the user's is replaced.
-- The image may be the folder's own (``lilium photo D/image.jpg --out D``): it is read first and
-  kept in place.
+- The image may be the folder's own (``lilium photo D/image.jpg --out D``, the user's or an
+  earlier run's): it is read first and kept in place.
 """
 
 from pathlib import Path
@@ -58,6 +58,7 @@ def claim_folder(out, image_path):
     if out.exists() and not out.is_dir():
         raise ValueError(f"{out}: exists and is not a folder; give a folder for --out")
     present = [out / name for name in OWN_FILES if (out / name).exists()]
+    present = [p for p in present if not _same_file(p, image_path)]  # the photo: read, kept
     if not present:
         return []
     meta_path = out / "photo.json"
@@ -73,7 +74,7 @@ def claim_folder(out, image_path):
             f"{out}: holds {names}, not written by lilium photo; give a new or empty folder with "
             "--out (lilium photo replaces only its own files)"
         )
-    return [p for p in present if not _same_file(p, image_path)]
+    return present
 
 
 def check_image_path(image_path):
