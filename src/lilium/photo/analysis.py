@@ -17,6 +17,9 @@ LATERAL_YAW_DEG = 30.0
 #: its best face scores this much more than the photo as it is (the mesh model fits an upright
 #: template whatever it is given: an upside-down face gets upright landmarks, roll 0).
 TURN_SCORE_MARGIN = 0.1
+#: ... and at least this score: on photos without a face the detector's false alarms (a cup, a
+#: cat: 0.5-0.6) would otherwise turn them (measured on scikit-image's sample pictures).
+TURN_MIN_SCORE = 0.75
 
 
 @dataclass(frozen=True)
@@ -88,9 +91,11 @@ def _box_text(box):
 
 def upright_turns(image):
     """How many quarter turns (counter-clockwise, ``np.rot90``) put the face upright: 0 unless a
-    turned copy's best face scores :data:`TURN_SCORE_MARGIN` above the photo's own."""
+    turned copy's best face scores :data:`TURN_SCORE_MARGIN` above the photo's own, and at least
+    :data:`TURN_MIN_SCORE`."""
     found = runtime.detect_face(image)
-    best_k, best = 0, (found[0] if found else 0.0) + TURN_SCORE_MARGIN
+    own = found[0] if found else 0.0
+    best_k, best = 0, max(own + TURN_SCORE_MARGIN, TURN_MIN_SCORE)
     for k in (1, 2, 3):
         turned = runtime.detect_face(np.ascontiguousarray(np.rot90(image, k)))
         if turned is not None and turned[0] > best:
