@@ -160,6 +160,12 @@ def prepare_photo(
         )
     turns = upright_turns(image)
     if turns:
+        if image_path.resolve().parent == out.resolve():
+            raise ValueError(
+                f"{image_path}: the face is upright only with the photo turned by "
+                f"{90 * turns} degrees, and the photo lies in --out, where the turned copy would "
+                "sit beside it; give another --out folder"
+            )
         image = np.ascontiguousarray(np.rot90(image, turns))
         h, w = image.shape[:2]
     reviewed = read_landmarks(landmarks_path, "facial") if landmarks_path else None
