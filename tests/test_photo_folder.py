@@ -85,6 +85,16 @@ def test_a_second_photo_replaces_the_first_one_s_files(tmp_path, capsys):
     assert (mine / "photo.json").is_file() and "SameFile" not in capsys.readouterr().err
 
 
+def test_two_images_in_a_photo_folder_are_an_error(astro, tmp_path):
+    import shutil
+
+    folder = tmp_path / "two"
+    shutil.copytree(astro, folder)
+    Image.open(folder / "image.png").convert("RGB").save(folder / "image.jpg")
+    with pytest.raises(ValueError, match=r"two: holds image.png and image.jpg; keep only"):
+        read_photo(folder)
+
+
 def test_a_hand_made_folder_is_refused(tmp_path, capsys):
     folder = tmp_path / "mine"
     folder.mkdir()

@@ -263,6 +263,12 @@ def read_photo(folder, load_image=True):
     """
     folder = _check_folder(folder, "photo")
     image_path = _find(folder, IMAGE_NAMES, "photo image", "put the photograph there")
+    images = [name for name in IMAGE_NAMES if (folder / name).is_file()]
+    if len(images) > 1:  # which one the landmarks belong to is unknown
+        raise ValueError(
+            f"{folder}: holds {' and '.join(images)}; keep only the photograph its landmarks, "
+            "mask and curve were made on"
+        )
     image, size_wh = _photo_pixels(image_path, load_image)
     meta_path = folder / "photo.json"
     meta = read_json(meta_path)
