@@ -28,26 +28,40 @@ def _jpeg(path, size_wh=(600, 400), model=None, **exif_ifd):
 
 
 def test_focal_plane_resolution(tmp_path):
-    # 50 mm lens, 6000 px across a 36 mm sensor (mm units), image saved at 600 px (1/10).
+    # 50 mm lens, 600 px across a 3.6 mm sensor (mm units): the camera's own full frame.
     path = _jpeg(
         tmp_path / "a.jpg",
-        focal_mm=50.0,
-        plane_x=6000 / 36,
+        focal_mm=5.0,
+        plane_x=600 / 3.6,
         plane_unit=4,
-        pixel_x=6000,
-        pixel_y=4000,
+        pixel_x=600,
+        pixel_y=400,
     )
     prior = focal_prior_from_exif(path)
-    expected = 50 * 600 / 36
+    expected = 5 * 600 / 3.6
     assert prior.estimate_px == pytest.approx(expected, rel=1e-3)
     assert prior.focal_px == pytest.approx((0.95 * expected, 1.05 * expected), rel=1e-3)
     assert "FocalPlaneXResolution" in prior.source
 
 
+def test_a_resized_photo_gives_no_focal(tmp_path):
+    # The same camera's 6000 x 4000 frame saved at 600 x 400: the tags name the original size.
+    from lilium.io.exif import exif_focal
+
+    path = _jpeg(
+        tmp_path / "a.jpg", focal_mm=50.0, plane_x=6000 / 36, plane_unit=4, pixel_x=6000,
+        pixel_y=4000,
+    )  # fmt: skip
+    prior, unusable = exif_focal(path)
+    assert prior is None
+    assert "PixelXDimension/PixelYDimension 6000x4000 differ from the file's 600x400" in unusable
+    assert "--focal-px LO HI" in unusable
+
+
 def test_inch_units(tmp_path):
-    path = _jpeg(tmp_path / "a.jpg", focal_mm=35.0, plane_x=4000 / (23.5 / 25.4), plane_unit=2)
-    # No PixelXDimension: the stored image is taken as the original (4000 px / 23.5 mm).
-    assert focal_prior_from_exif(path).estimate_px == pytest.approx(35 * 4000 / 23.5, rel=1e-3)
+    path = _jpeg(tmp_path / "a.jpg", focal_mm=3.5, plane_x=600 / (2.35 / 25.4), plane_unit=2)
+    # No PixelXDimension: the stored image is taken as the original (600 px / 2.35 mm).
+    assert focal_prior_from_exif(path).estimate_px == pytest.approx(3.5 * 600 / 2.35, rel=1e-3)
 
 
 def test_sensor_width_given_and_from_the_table(tmp_path):
@@ -56,7 +70,7 @@ def test_sensor_width_given_and_from_the_table(tmp_path):
     assert "built-in table" in focal_prior_from_exif(path).source
     given = focal_prior_from_exif(path, sensor_width_mm=24.0)
     assert given.estimate_px == pytest.approx(85 * 600 / 24)
-    with pytest.raises(ValueError, match="sensor width must be a positive number"):
+    with pytest.raises(ValueError, match="--sensor-width-mm: the sensor width must be a positive"):
         focal_prior_from_exif(path, sensor_width_mm=-1)
 
 

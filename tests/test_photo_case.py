@@ -126,6 +126,18 @@ def test_a_command_line_focal_gives_the_iris_distance(standin, prepared, tmp_pat
 
 
 @needs_litert
+def test_a_focal_that_puts_the_camera_too_far_is_implausible(standin, prepared, tmp_path, capsys):
+    out = tmp_path / "out"
+    argv = ["case", "--skull", standin, "--photo", prepared, "--method", "posest-sfo"]
+    code, _, err = _run(argv + ["--focal-px", "40000", "42000", "--out", out], capsys)
+    assert code == 0, err
+    result = _result(out, "astro", "posest-sfo")
+    (warning,) = [w for w in result["warnings"] if w["code"] == "implausible_prior"]
+    assert "outside the 0.3-10 m of a portrait" in warning["message"]
+    assert result["priors"]["focal_px"]["source"] == "command line"  # stated: kept
+
+
+@needs_litert
 def test_confirmed_template_points_are_used(standin, prepared, tmp_path, capsys):
     folder = tmp_path / "reviewed"
     shutil.copytree(prepared, folder)

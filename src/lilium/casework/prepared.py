@@ -115,10 +115,32 @@ def with_automatic_priors(photo, notes, facts, skull=None, scd_from_cli=False, l
     """
     if facts is None or not facts.automatic_priors:
         return photo, notes
-    from ..photo.headpose import iris_distance_mm, skull_face_frame
+    from ..inputs import CaseWarning
+    from ..photo.headpose import implausible_distance, iris_distance_mm, skull_face_frame
 
     priors, sources, notes = photo.priors, dict(photo.prior_sources), dict(notes)
+    warnings = list(photo.warnings)
     auto = facts.automatic_priors
+    if facts.iris_diameter_px and priors.focal_px is not None:
+        why = implausible_distance(priors.focal_px, facts.iris_diameter_px)
+        if why and sources.get("focal_px") == "exif":  # nobody stated it: not used
+            priors, notes["focal prior"] = replace(priors, focal_px=None), "none (penalty off)"
+            sources.pop("focal_px")
+            warnings.append(
+                CaseWarning(
+                    "implausible_prior",
+                    f"{photo.id}: EXIF focal not used: {why}; if the distance is real, give "
+                    "the focal with --focal-px LO HI",
+                )
+            )
+        elif why:
+            warnings.append(
+                CaseWarning(
+                    "implausible_prior",
+                    f"{photo.id}: {why} (focal prior from {sources.get('focal_px')}); check "
+                    "--focal-px or photo.json's focal_px",
+                )
+            )
     for key, label, unit in (("focal_px", "focal prior", "px"), ("scd_mm", "SCD prior", "mm")):
         if key in auto and sources.get(key) == "photo.json":
             sources[key] = "automatic"
@@ -161,7 +183,8 @@ def with_automatic_priors(photo, notes, facts, skull=None, scd_from_cli=False, l
                     f"{found}; to skull2cam through the skull's {how}; tolerance "
                     f"{facts.head_tolerance_deg:g} deg"
                 )
-    return replace(photo, priors=priors, prior_sources=sources), notes
+    photo = replace(photo, priors=priors, prior_sources=sources, warnings=tuple(warnings))
+    return photo, notes
 
 
 def check_photo_extra():

@@ -61,6 +61,17 @@ def register(subparsers):
     p.add_argument("--header-bytes", type=int, default=0, help="raw data: bytes to skip per file")
     p.add_argument("--spacing", help="voxel size x,y,z in mm (raw data; overrides a header)")
     p.add_argument(
+        "--allow-outside-data",
+        action="store_true",
+        help="let a detached .nhdr/.mhd header name data files outside its own folder",
+    )
+    p.add_argument(
+        "--orientation",
+        help="for a file that names no orientation (raw data, ...): the side of the patient "
+        "each index axis (column, row, slice) points to as it grows, e.g. LPS, or LPI when the "
+        "first slice is the top of the head",
+    )
+    p.add_argument(
         "--landmarks",
         help="cranial landmarks in the volume file's coordinates (mm), any format lilium case "
         "reads (.json, .csv, .mrk.json/.fcsv in Slicer's own LPS/RAS frame, .pp); written in LPS",
@@ -89,6 +100,8 @@ def run(args):
             raise ValueError(f"--crop must look like i0:i1,j0:j1,k0:k1, got {args.crop!r}")
     if args.raw_shape is None and args.raw_dtype is None:
         options = {k: v for k, v in options.items() if k == "spacing"}
+    if args.allow_outside_data:
+        options["allow_outside_data"] = True
     result = import_ct(
         args.volume,
         args.out,
@@ -99,6 +112,7 @@ def run(args):
         landmarks=args.landmarks,
         target_faces=args.target_faces,
         crop=crop,
+        orientation=args.orientation,
         **options,
     )
     record = result["record"]

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 from ..constants import VIEWS
+from .argtypes import int_in, positive_float
 
 #: Exit status when no face was found but the folder was written for marking by hand.
 EXIT_NO_FACE = 3
@@ -35,7 +36,16 @@ def register(subparsers):
         type=Path,
         help="reviewed landmarks (review.html's landmarks.json, or any SPEC facial file)",
     )
-    p.add_argument("--sensor-width-mm", type=float, help="sensor long side, for the EXIF focal")
+    p.add_argument(
+        "--sensor-width-mm",
+        type=positive_float(),
+        help="sensor long side (mm), for the EXIF focal",
+    )
+    p.add_argument(
+        "--face",
+        type=int_in(1, why=" (faces are numbered from the left, 1 = the leftmost)"),
+        help="which face of a photo with several (default: the most confident)",
+    )
     p.set_defaults(func=run)
 
 
@@ -44,9 +54,16 @@ def run(args):
 
     start = time.perf_counter()
     result = prepare_photo(
-        args.image, args.out, args.view, args.landmarks, sensor_width_mm=args.sensor_width_mm
+        args.image,
+        args.out,
+        args.view,
+        args.landmarks,
+        sensor_width_mm=args.sensor_width_mm,
+        face=args.face,
     )
     seconds = time.perf_counter() - start
+    for warning in result.warnings:
+        print(f"warning {warning['code']}: {warning['message']}", file=sys.stderr)
     if not result.face_found:
         print(f"lilium photo: {result.message}", file=sys.stderr)
         print(f"wrote {result.folder} ({seconds:.1f} s)")

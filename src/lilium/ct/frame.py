@@ -150,3 +150,52 @@ def orientation_code_to_direction(code, source="volume"):
             "each pair R/L, A/P, I/S"
         )
     return direction
+
+
+#: ``--orientation`` letters: the side each index axis runs *towards* as its index grows
+#: (nibabel's axis codes; the opposite of ITK's letters above) -> (LPS axis, sign).
+_TO_LETTER = {
+    "L": (0, 1.0),
+    "R": (0, -1.0),
+    "P": (1, 1.0),
+    "A": (1, -1.0),
+    "S": (2, 1.0),
+    "I": (2, -1.0),
+}
+
+
+def index_orientation_to_lps(code, source="--orientation"):
+    """The columns of the index axes (i, j, k) in LPS from a code such as ``LPI``.
+
+    Each letter names the side of the patient its index axis points to as the index grows:
+    i = column (fastest in the file), j = row, k = slice. ``LPS`` is the identity; a raw axial
+    stack whose first slice is the vertex, rows and columns as in DICOM, is ``LPI``.
+
+    Parameters
+    ----------
+    code : str
+        Three letters, one of each pair R/L, A/P, I/S.
+
+    Returns
+    -------
+    ndarray of shape (3, 3)
+        ``p_lps = matrix @ (ijk * spacing) + origin``; a signed permutation (det +-1).
+
+    Raises
+    ------
+    ValueError
+        Naming ``source`` and the form expected.
+    """
+    letters = str(code).strip().upper()
+    valid = len(letters) == 3 and all(c in _TO_LETTER for c in letters)
+    if not valid or sorted(_TO_LETTER[c][0] for c in letters) != [0, 1, 2]:
+        raise ValueError(
+            f"{source} {code!r}: give three letters, one of each pair R/L, A/P, S/I, naming "
+            "the side each index axis (column, row, slice) points to as it grows, e.g. LPS or "
+            "LPI (first slice at the top of the head)"
+        )
+    matrix = np.zeros((3, 3))
+    for column, letter in enumerate(letters):
+        axis, sign = _TO_LETTER[letter]
+        matrix[axis, column] = sign
+    return matrix

@@ -5,6 +5,7 @@ the file's own frame; ``ct_import.json`` names it, gives the map from the file's
 the units and levels used and every warning (:mod:`lilium.ct.checks`).
 """
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,7 @@ from .checks import (
     spine_warning,
     voxel_warnings,
 )
-from .frame import PATIENT_FRAME, PATIENT_FRAME_TEXT, space_to_lps
+from .frame import PATIENT_FRAME, PATIENT_FRAME_TEXT, index_orientation_to_lps, space_to_lps
 from .mesh import _parse_crop, volume_to_mesh
 from .readers import read_volume
 from .volume import Volume
@@ -42,6 +43,33 @@ def _is_slicer(path):
             return False
         return '"markups"' in head
     return False
+
+
+#: What 3D Slicer writes as a markup's coordinate system (``0`` = RAS, ``1`` = LPS in old files).
+SLICER_SYSTEMS = {"LPS": "LPS", "RAS": "RAS", "1": "LPS", "0": "RAS"}
+
+_SYSTEM_FIELD = re.compile(r'coordinate\s*system"?\s*[=:]\s*"?([^",}\s]*)', re.IGNORECASE)
+
+
+def _slicer_systems(path):
+    """The coordinate systems a Slicer markup states (LPS when it states none).
+
+    Raises
+    ------
+    ValueError
+        A system Slicer does not write (e.g. ``CoordinateSystem = XYZ``): the points would be
+        read in a frame nobody stated.
+    """
+    text = Path(path).read_text(encoding="utf-8-sig", errors="replace")
+    found = [m.group(1) for m in _SYSTEM_FIELD.finditer(text)]
+    unknown = [v for v in found if v.strip().upper() not in SLICER_SYSTEMS]
+    if unknown:
+        raise ValueError(
+            f"{path}: coordinate system {unknown[0]!r} is not one 3D Slicer writes; state LPS or "
+            "RAS (the frame the points were placed in), e.g. '# CoordinateSystem = LPS'"
+        )
+    systems = sorted({SLICER_SYSTEMS[v.strip().upper()] for v in found})
+    return systems or ["LPS"]
 
 
 def read_landmark_file(path):
@@ -75,7 +103,8 @@ def _landmarks_to_lps(landmarks, to_lps):
     if isinstance(landmarks, (str, Path)):
         points = read_landmark_file(landmarks)
         if _is_slicer(landmarks):
-            return points, "3D Slicer markup: patient LPS/RAS as stated in the file"
+            systems = _slicer_systems(landmarks)
+            return points, f"3D Slicer markup: patient {'/'.join(systems)} as stated in the file"
     else:
         points = {k: np.asarray(v, dtype=float).reshape(3) for k, v in dict(landmarks).items()}
     return {k: to_lps @ v for k, v in points.items()}, "the volume file's coordinates"
@@ -92,6 +121,40 @@ def _extract(volume, level, crop, to_lps):
     if np.linalg.det(to_lps) < 0:  # a reflection turns the winding inside out
         faces = faces[:, ::-1]
     return lps, faces, index
+
+
+def _check_finite(volume, crop):
+    """Refuse NaN or infinite voxels: they would read as air, a hole through the bone."""
+    data = volume.data[_parse_crop(crop, volume.data.shape, volume.source)]
+    if data.dtype.kind != "f":
+        return
+    bad = ~np.isfinite(data)
+    if bad.any():
+        k, j, i = (int(x) for x in np.argwhere(bad)[0])
+        raise ValueError(
+            f"{volume.source}: {int(bad.sum())} voxels are NaN or infinite (the first at column "
+            f"{i}, row {j}, slice {k}); they would read as air and cut holes through the bone: "
+            "export the volume again with numbers there, or leave them out with --crop "
+            "i0:i1,j0:j1,k0:k1"
+        )
+
+
+def _oriented(volume, orientation):
+    """``volume`` with the index axes of ``--orientation`` (a file naming no anatomy only)."""
+    import dataclasses
+
+    to_lps, _ = space_to_lps(volume.space, volume.source)
+    if volume.space_known:
+        raise ValueError(
+            f"{volume.source}: the file states its orientation (space {volume.space}); "
+            "--orientation is for files that name none (raw data, NRRD without an anatomical "
+            "space, NIfTI without qform/sform): leave it out"
+        )
+    direction = index_orientation_to_lps(orientation)
+    return dataclasses.replace(
+        volume, direction=direction, origin_mm=to_lps @ volume.origin_mm, space="lps",
+        space_known=True,
+    )  # fmt: skip
 
 
 def _prepare_out(out_dir):
@@ -115,6 +178,7 @@ def import_ct(
     crop=None,
     face=True,
     units=None,
+    orientation=None,
     **reader_options,
 ):
     """Extract skull and skin from a CT volume and write a subject folder, in LPS.
@@ -140,6 +204,12 @@ def import_ct(
         Write ``face.ply`` (the skin surface).
     units : {"auto", "hu", "scanner"}, optional
         Intensity units; default: detected (:func:`~lilium.ct.checks.detect_units`).
+    orientation : str, optional
+        For a file that names no anatomical orientation (raw data, NRRD without an anatomical
+        space, NIfTI without qform/sform): the side each index axis (column, row, slice) points
+        to, e.g. ``"LPI"`` (:func:`~lilium.ct.frame.index_orientation_to_lps`). It replaces the
+        file's direction; ``ct_import.json`` says ``"orientation": "given (--orientation
+        LPI)"``. A file that states its orientation is an error with it.
 
     Returns
     -------
@@ -153,6 +223,8 @@ def import_ct(
 
     if not isinstance(volume, Volume):
         volume = read_volume(volume, **reader_options)
+    if orientation is not None:
+        volume = _oriented(volume, orientation)
     unit, unit_how = detect_units(volume, units)
     default_bone, default_skin = DEFAULT_LEVELS[unit]
     bone_iso = default_bone if bone_iso is None else float(bone_iso)
@@ -162,6 +234,7 @@ def import_ct(
             f"bone level ({bone_iso:g}) must be above the skin level ({skin_iso:g}): bone is "
             "denser than soft tissue (--bone-iso, --skin-iso)"
         )
+    _check_finite(volume, crop)
     to_lps, anatomy_known = space_to_lps(volume.space, volume.source)
     lm_lps, lm_frame = _landmarks_to_lps(landmarks, to_lps)
     out = _prepare_out(out_dir)
@@ -174,7 +247,9 @@ def import_ct(
                 f"the file names no anatomical orientation (space {volume.space or 'none'}): "
                 "its axes are taken as LPS"
                 + (" with z negated (a left-handed space)" if np.linalg.det(to_lps) < 0 else "")
-                + "; the mesh is not mirrored, but check which way is up and front",
+                + "; the mesh is not mirrored, but check which way is up and front, and state "
+                "the side each index axis points to with --orientation (e.g. LPI when the first "
+                "slice is the top of the head)",
             )
         )
     warnings += voxel_warnings(volume.spacing_mm)
@@ -220,7 +295,11 @@ def import_ct(
         "frame": PATIENT_FRAME,
         "frame_description": PATIENT_FRAME_TEXT,
         "source_space": volume.space,
-        "orientation": "from the file" if anatomy_known else "assumed",
+        "orientation": (
+            f"given (--orientation {orientation.strip().upper()})"
+            if orientation is not None
+            else ("from the file" if anatomy_known else "assumed")
+        ),
         "file_to_frame": file_to_lps,
         "index_to_frame": index_to_lps,
         "landmarks_frame_in": lm_frame,

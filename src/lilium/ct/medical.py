@@ -5,6 +5,8 @@ NIfTI's RAS (see :mod:`lilium.ct.frame`). Every failure of the package on a corr
 file becomes a one-line ``ValueError`` naming the file.
 """
 
+import contextlib
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -13,13 +15,39 @@ from .decode import check_voxel_count
 from .volume import Volume
 
 
-def read_nifti(path):
+class _Collect(logging.Handler):
+    def __init__(self):
+        super().__init__()
+        self.messages = []
+
+    def emit(self, record):
+        self.messages.append(record.getMessage())
+
+
+@contextlib.contextmanager
+def _nibabel_messages():
+    """nibabel's own log lines (e.g. "pixdim[1,2,3] should be non-zero; setting 0 dims to 1"),
+    kept off stderr and handed to the caller, which turns them into errors or header notes."""
+    loggers = [logging.getLogger(name) for name in ("nibabel", "nibabel.global")]
+    saved = [(lg.handlers[:], lg.propagate) for lg in loggers]
+    handler = _Collect()
+    for lg in loggers:  # nibabel.global has its own stderr handler
+        lg.handlers, lg.propagate = [handler], False
+    try:
+        yield handler.messages
+    finally:
+        for lg, (handlers, propagate) in zip(loggers, saved, strict=True):
+            lg.handlers, lg.propagate = handlers, propagate
+
+
+def read_nifti(path, spacing_given=False):
     """A NIfTI-1/2 volume (needs the optional package ``nibabel``).
 
     The voxel-to-world affine (the sform when its code is set, else the qform: nibabel's
     ``image.affine``) gives origin, spacing and direction in the RAS+ world, mm; the array
     (i, j, k) is transposed to ``[k, j, i]``. With both codes 0 the file states no orientation
-    (``space_known`` False).
+    (``space_known`` False). A zero voxel size (``pixdim``) is an error unless
+    ``spacing_given`` (``--spacing``): nibabel would take it as 1 mm.
     """
     try:
         import nibabel
@@ -28,9 +56,10 @@ def read_nifti(path):
             f"{path}: reading NIfTI needs the optional package nibabel (pip install nibabel)"
         ) from exc
     try:
-        image = nibabel.load(str(path))
-        check_voxel_count(image.shape[:3], str(path))
-        data = np.asarray(image.dataobj)
+        with _nibabel_messages() as messages:
+            image = nibabel.load(str(path))
+            check_voxel_count(image.shape[:3], str(path))
+            data = np.asarray(image.dataobj)
         header = image.header
         known = int(header["sform_code"]) > 0 or int(header["qform_code"]) > 0
     except ValueError as exc:
@@ -44,6 +73,12 @@ def read_nifti(path):
             f"{path}: cannot read the NIfTI file ({_one_line(exc)}); the file is truncated or "
             "corrupt, export it again"
         ) from exc
+    if any("setting 0 dims to 1" in m for m in messages) and not spacing_given:
+        raise ValueError(
+            f"{path}: the voxel size (pixdim) is 0, so the file does not say how large its voxels "
+            "are; give it with --spacing X,Y,Z (mm)"
+        )
+    notes = tuple(f"nibabel: {m}" for m in messages if "setting 0 dims to 1" not in m)
     if data.ndim == 4 and data.shape[3] == 1:
         data = data[..., 0]
     if data.ndim != 3:
@@ -61,6 +96,7 @@ def read_nifti(path):
         str(path),
         space="ras",
         space_known=known,
+        notes=notes,
     )
 
 

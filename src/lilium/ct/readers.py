@@ -34,6 +34,7 @@ def read_volume(
     origin=None,
     byte_order="little",
     header_bytes=0,
+    allow_outside_data=False,
 ):
     """Read a CT volume, the format chosen from the path.
 
@@ -56,6 +57,10 @@ def read_volume(
         Of raw data.
     header_bytes : int
         Bytes to skip at the start of each raw file.
+    allow_outside_data : bool
+        Let a detached NRRD/MetaImage header name data files outside its own folder
+        (``--allow-outside-data``); by default that is an error, as a header could name any
+        file on the machine.
 
     Returns
     -------
@@ -80,11 +85,11 @@ def read_volume(
     elif first.is_dir() or name.endswith(DICOM_SUFFIXES):
         volume = read_dicom(first)
     elif name.endswith(NRRD_SUFFIXES):
-        volume = read_nrrd(first)
+        volume = read_nrrd(first, allow_outside_data)
     elif name.endswith(NIFTI_SUFFIXES):
-        volume = read_nifti(first)
+        volume = read_nifti(first, spacing_given=spacing is not None)
     elif name.endswith(META_SUFFIXES):
-        volume = read_metaimage(first)
+        volume = read_metaimage(first, allow_outside_data)
     else:
         raise ValueError(
             f"{first}: unknown volume format; use a DICOM folder, .nrrd/.nhdr, .nii/.nii.gz, "
@@ -93,7 +98,9 @@ def read_volume(
     if spacing is not None or origin is not None:
         volume = dataclasses.replace(
             volume,
-            spacing_mm=volume.spacing_mm if spacing is None else check_spacing(spacing, str(first)),
+            spacing_mm=(
+                volume.spacing_mm if spacing is None else check_spacing(spacing, "--spacing")
+            ),
             origin_mm=volume.origin_mm if origin is None else origin,
         )
     return volume
@@ -247,7 +254,25 @@ def _header_end(blob):
     return min(ends) if ends else (-1, 0)
 
 
-def read_nrrd(path):
+def detached_file(header, name, field, allow_outside=False):
+    """The data file ``name`` a detached header names, checked to exist and, unless
+    ``allow_outside``, to lie in the header's folder (or below it)."""
+    target = header.parent / name
+    if not allow_outside:
+        folder = header.parent.resolve()
+        resolved = target.resolve()
+        if folder not in resolved.parents:
+            raise ValueError(
+                f"{header}: the data file {name!r} ({field}) lies outside the header's folder; "
+                "put the data beside the header, or give --allow-outside-data if you trust "
+                "this header"
+            )
+    if not target.is_file():
+        raise ValueError(f"{header}: detached data file {target} not found ({field})")
+    return target
+
+
+def read_nrrd(path, allow_outside_data=False):
     """An NRRD volume (``.nrrd`` with attached data or ``.nhdr`` with detached data files).
 
     Supports encodings raw, gzip and ascii, ``spacings`` or ``space directions``, ``space
@@ -350,9 +375,7 @@ def read_nrrd(path):
         names = _nrrd_data_files(data_file, list_files, path)
         payload = []
         for name in names:
-            target = path.parent / name
-            if not target.is_file():
-                raise ValueError(f"{path}: detached data file {target} not found (data file)")
+            target = detached_file(path, name, "data file", allow_outside_data)
             payload.append(read_bytes(target))
     if encoding in ("ascii", "text", "txt"):
         values = np.concatenate([floats(b.decode("latin-1"), "data (ascii)", src) for b in payload])
@@ -461,7 +484,7 @@ def _metaimage_header(path, blob):
     raise ValueError(f"{path}: MetaImage header lacks ElementDataFile (the last header field)")
 
 
-def read_metaimage(path):
+def read_metaimage(path, allow_outside_data=False):
     """A MetaImage volume: ``.mhd`` header with a ``.raw`` file, or a single ``.mha``.
 
     The world frame is LPS (ITK's). ``TransformMatrix`` (or ``Rotation``/``Orientation``) gives
@@ -524,9 +547,7 @@ def read_metaimage(path):
             "supported; save the volume as one .mha or .mhd/.raw"
         )
     else:
-        target = path.parent / data_file
-        if not target.is_file():
-            raise ValueError(f"{path}: data file {target} not found (ElementDataFile)")
+        target = detached_file(path, data_file, "ElementDataFile", allow_outside_data)
         raw = read_bytes(target)
     n = n_voxels * dt.itemsize
     compressed = fields.get("CompressedData", "False").lower()

@@ -108,12 +108,24 @@ class Volume:
         return (np.array(self.data.shape[::-1]) - 1) * self.spacing_mm
 
 
+#: Physical range of a CT voxel's side (mm): a micro-CT's 0.01 mm to a 20 mm scout. Outside it
+#: the number is a unit or typing error (1e-9 mm makes a flat skull, 0 is "unknown").
+VOXEL_SIZE_RANGE_MM = (0.01, 20.0)
+
+
 def check_spacing(spacing, source="volume"):
-    """Validate a voxel spacing of 3 positive finite numbers (x, y, z order) and return it."""
+    """Validate a voxel spacing of 3 numbers (x, y, z order, mm) in :data:`VOXEL_SIZE_RANGE_MM`
+    and return it."""
     spacing = np.asarray(spacing, dtype=float).reshape(-1)
+    lo, hi = VOXEL_SIZE_RANGE_MM
     if spacing.shape != (3,) or not np.all(np.isfinite(spacing)) or np.any(spacing <= 0):
         raise ValueError(
             f"{source}: spacing must be 3 positive numbers in mm (x, y, z), got "
             f"{np.asarray(spacing).tolist()}"
+        )
+    if np.any(spacing < lo) or np.any(spacing > hi):
+        raise ValueError(
+            f"{source}: voxel size {', '.join(f'{v:g}' for v in spacing)} mm (x, y, z) is "
+            f"outside the {lo:g}-{hi:g} mm of a CT voxel; give the size in mm (--spacing X,Y,Z)"
         )
     return spacing

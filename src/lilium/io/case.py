@@ -264,6 +264,12 @@ def read_photo(folder, load_image=True):
     """
     folder = _check_folder(folder, "photo")
     image_path = _find(folder, IMAGE_NAMES, "photo image", "put the photograph there")
+    images = [name for name in IMAGE_NAMES if (folder / name).is_file()]
+    if len(images) > 1:  # which one the landmarks belong to is unknown
+        raise ValueError(
+            f"{folder}: holds {' and '.join(images)}; keep only the photograph its landmarks, "
+            "mask and curve were made on"
+        )
     image, size_wh = _photo_pixels(image_path, load_image)
     meta_path = folder / "photo.json"
     meta = read_json(meta_path)
@@ -294,6 +300,9 @@ def read_photo(folder, load_image=True):
     mask = read_mask(mask_path, size_wh) if mask_path.is_file() else None
     curve_path = folder / "face_curve.json"
     curve = read_face_curve(curve_path, view, size_wh) if curve_path.is_file() else None
+    if curve is None and mask is not None and written_by_lilium_photo(meta):
+        # A head mask ends at the neck (often the collar): never a facial curve (SPEC 11).
+        curve = np.empty((0, 2))
     return Photo(
         path_id(folder),
         size_wh,
@@ -305,6 +314,27 @@ def read_photo(folder, load_image=True):
         image,
         landmark_sources=sources,
         warnings=unknown_key_warnings(meta_path, meta),
+    )
+
+
+#: ``photo.json``'s ``"prepared_by"`` in a folder ``lilium photo`` wrote.
+PREPARED_BY = "lilium photo"
+
+
+def written_by_lilium_photo(meta):
+    """Whether a ``photo.json`` object was written by ``lilium photo`` (this or an older one,
+    recognised by its automatic ``landmark_sources`` and ``priors.sources``): its
+    ``face_mask.png`` is then a head mask, down to the neck (SPEC section 11)."""
+    if not isinstance(meta, dict):
+        return False
+    if meta.get("prepared_by") == PREPARED_BY:
+        return True
+    priors, sources = meta.get("priors"), meta.get("landmark_sources")
+    return (
+        isinstance(priors, dict)
+        and priors.get("source") == "automatic"
+        and isinstance(sources, dict)
+        and isinstance(priors.get("sources"), dict)
     )
 
 

@@ -2,20 +2,27 @@
 
 The focal length in pixels is ``focal_mm * pixels_per_mm_on_the_sensor``. In order of trust:
 
-1. ``FocalLength`` with the sensor's pixel pitch from ``FocalPlaneXResolution`` and
-   ``FocalPlaneResolutionUnit`` (scaled when the image was resized after shooting: by its width
-   over ``PixelXDimension``);
-2. ``FocalLength`` with a sensor width: given by the user, or from the small built-in table of
-   camera models :data:`SENSOR_WIDTH_MM` (the sensor's long side matches the image's long side);
-3. ``FocalLengthIn35mmFilm``: makers derive it from the diagonal (CIPA) or from the width of
+1. ``FocalLength`` with a sensor width: given by the user (``--sensor-width-mm``), else the
+   sensor's pixel pitch from ``FocalPlaneXResolution`` and ``FocalPlaneResolutionUnit``, else
+   the small built-in table of camera models :data:`SENSOR_WIDTH_MM` (the sensor's long side
+   matches the image's long side);
+2. ``FocalLengthIn35mmFilm``: makers derive it from the diagonal (CIPA) or from the width of
    a 36 x 24 mm frame; the interval covers both readings.
 
-``DigitalZoomRatio`` > 1 multiplies the focal length of 1 and 2. The interval is the estimate
+``DigitalZoomRatio`` > 1 multiplies the focal length of 1. The interval is the estimate
 ``+- tolerance`` (5 % by default: the SPEC's focal prior width).
 
-A ``FocalLength`` that none of these converts (no 35 mm value, no pixel pitch, an unknown camera)
-is not dropped silently: :func:`exif_focal` says why, with the options that fix it (warning
-``exif_focal_unusable`` of SPEC section 10).
+EXIF describes the camera's pixel grid, not necessarily the file's (SPEC section 11): a photo
+cropped or resized after the shot converts to the wrong number of pixels. The focal is used only
+when the tags agree that the file is the camera's full frame at its own resolution
+(:func:`full_frame_problem`): ``PixelXDimension``/``PixelYDimension`` and ``ImageWidth``/
+``ImageLength`` equal the decoded size; ``Software`` names no editing program; the sensor that
+``FocalPlaneXResolution`` implies for this many pixels agrees with the camera's (built-in table,
+``--sensor-width-mm``) and with ``FocalLengthIn35mmFilm`` over ``FocalLength``; each focal
+length lies in :data:`EXIF_FOCAL_RANGE_MM`. Otherwise, and when a ``FocalLength`` cannot be
+converted at all (no 35 mm value, no pixel pitch, an unknown camera), :func:`exif_focal` says
+which tag and what fixes it (warning ``exif_focal_unusable`` of SPEC section 10), and no prior
+is taken.
 """
 
 from dataclasses import dataclass
@@ -29,6 +36,26 @@ FOCAL_TOLERANCE = 0.05
 #: Diagonal and width (mm) of a 35 mm film frame (36 x 24 mm).
 FILM_35MM_DIAGONAL_MM = float(np.hypot(36.0, 24.0))
 FILM_35MM_WIDTH_MM = 36.0
+
+#: Physical range (mm) of an EXIF focal length, actual or 35 mm equivalent (a phone's 1.5 mm
+#: ultra-wide to the 3000 mm equivalent of a superzoom compact); outside it the tag is wrong.
+EXIF_FOCAL_RANGE_MM = (1.0, 3000.0)
+
+#: Physical range (mm) of a camera sensor's long side (a phone's 1/4" to medium format).
+SENSOR_WIDTH_RANGE_MM = (2.0, 60.0)
+
+#: Relative disagreement beyond which two tags describe different pixel grids (the 35 mm
+#: equivalent's two conventions differ by up to 8 % on a 4:3 sensor).
+EXIF_AGREEMENT = 0.12
+
+#: Words in ``Software`` that name an editing program (lower case): the file was re-saved by an
+#: editor, most often cropped or resized, so its pixels are not the camera's.
+EDITING_SOFTWARE = (
+    "photoshop", "lightroom", "gimp", "paint.net", "affinity", "pixelmator", "snapseed",
+    "picasa", "irfanview", "acdsee", "luminar", "paintshop", "krita", "imagemagick",
+    "graphicsmagick", "darktable", "rawtherapee", "capture one", "photoscape", "faststone",
+    "xnview", "photopea", "canva", "fotor", "befunky", "digikam", "shotwell", "pillow",
+)  # fmt: skip
 
 #: Sensor width (long side, mm) of some common cameras, keyed by the EXIF ``Model`` in lower case.
 SENSOR_WIDTH_MM = {
@@ -56,7 +83,10 @@ SENSOR_WIDTH_MM = {
 }
 
 # EXIF tag numbers (Exif 2.3 / CIPA DC-008).
+_IMAGE_WIDTH = 0x0100
+_IMAGE_LENGTH = 0x0101
 _MODEL = 0x0110
+_SOFTWARE = 0x0131
 _EXIF_IFD = 0x8769
 _FOCAL_LENGTH = 0x920A
 _FOCAL_PLANE_X_RESOLUTION = 0xA20E
@@ -102,23 +132,32 @@ def read_exif(path):
     Returns
     -------
     dict
-        Keys among ``model``, ``focal_mm``, ``focal_35mm``, ``plane_x_resolution``,
-        ``plane_unit``, ``pixel_x``, ``pixel_y``, ``digital_zoom``, and ``image_size_wh``.
+        Keys among ``model``, ``software``, ``image_width``, ``image_length`` (IFD0),
+        ``focal_mm``, ``focal_35mm``, ``plane_x_resolution``, ``plane_unit``, ``pixel_x``,
+        ``pixel_y``, ``digital_zoom``, and ``image_size_wh`` (the stored size, before any
+        EXIF orientation).
     """
-    from PIL import Image, UnidentifiedImageError
+    from .images import open_image
 
     path = Path(path)
-    try:
-        with Image.open(path) as im:
+    with open_image(path) as im:  # the size limit, without Pillow's DecompressionBombWarning
+        try:
             exif = im.getexif()
-            size = im.size
-    except (UnidentifiedImageError, OSError, SyntaxError) as exc:
-        raise ValueError(f"{path}: cannot read the image ({exc}); save it as PNG or JPEG") from exc
+        except Exception:  # a broken EXIF block: no EXIF, as image viewers read it
+            exif = None
+        size = im.size
     ifd = exif.get_ifd(_EXIF_IFD) if exif else {}
     out = {"image_size_wh": size}
-    model = exif.get(_MODEL) if exif else None
-    if isinstance(model, str) and model.strip("\x00 "):
-        out["model"] = model.strip("\x00 ")
+    for key, tag in (("model", _MODEL), ("software", _SOFTWARE)):
+        text = exif.get(tag) if exif else None
+        if isinstance(text, bytes):
+            text = text.decode("latin-1")
+        if isinstance(text, str) and text.strip("\x00 "):
+            out[key] = text.strip("\x00 ")
+    for key, tag in (("image_width", _IMAGE_WIDTH), ("image_length", _IMAGE_LENGTH)):
+        value = _positive(exif.get(tag)) if exif else None
+        if value is not None:
+            out[key] = value
     fields = {
         "focal_mm": _FOCAL_LENGTH,
         "focal_35mm": _FOCAL_LENGTH_35MM,
@@ -150,9 +189,17 @@ def focal_prior_from_exif(path, sensor_width_mm=None, tolerance=FOCAL_TOLERANCE)
     Returns
     -------
     FocalPrior or None
+        None also when the tags do not describe the file's own pixels (:func:`exif_focal`
+        says why).
     """
-    info = read_exif(path)
-    return focal_prior_from_fields(info, sensor_width_mm, tolerance)
+    return exif_focal(path, sensor_width_mm, tolerance)[0]
+
+
+#: The fix named when the EXIF focal cannot be trusted for this file.
+_GIVE_FOCAL = (
+    "give the focal prior yourself if you know it (lilium case --focal-px LO HI, or "
+    '"focal_px" in photo.json\'s priors)'
+)
 
 
 def exif_focal(path, sensor_width_mm=None, tolerance=FOCAL_TOLERANCE):
@@ -168,12 +215,22 @@ def exif_focal(path, sensor_width_mm=None, tolerance=FOCAL_TOLERANCE):
     -------
     prior : FocalPrior or None
     unusable : str or None
-        When the photo has a ``FocalLength`` but no way to convert it to pixels: what is missing
-        and the options that fix it (``--sensor-width-mm``, ``--focal-px``); None otherwise.
+        When the photo has a focal length in EXIF that cannot be used: the tag that disagrees
+        (:func:`full_frame_problem`) or what is missing, and the options that fix it
+        (``--sensor-width-mm``, ``--focal-px``); None otherwise.
     """
+    _check_sensor_width(sensor_width_mm)
     info = read_exif(path)
+    if "focal_mm" not in info and "focal_35mm" not in info:
+        return None, None
+    problem = full_frame_problem(info, sensor_width_mm)
+    if problem:
+        return None, (
+            f"{path}: EXIF focal not used: {problem}; the focal in pixels would be wrong, so no "
+            f"focal or distance prior is taken from it; {_GIVE_FOCAL}"
+        )
     prior = focal_prior_from_fields(info, sensor_width_mm, tolerance)
-    if prior is not None or "focal_mm" not in info:
+    if prior is not None:
         return prior, None
     model = info.get("model")
     camera = f"camera {model!r} is not in the built-in sensor table" if model else "no camera model"
@@ -184,10 +241,113 @@ def exif_focal(path, sensor_width_mm=None, tolerance=FOCAL_TOLERANCE):
     )
 
 
+def _check_sensor_width(sensor_width_mm):
+    if sensor_width_mm is None:
+        return
+    lo, hi = SENSOR_WIDTH_RANGE_MM
+    if not (_positive(sensor_width_mm) and lo <= float(sensor_width_mm) <= hi):
+        raise ValueError(
+            f"--sensor-width-mm: the sensor width must be a positive number of mm from {lo:g} "
+            f"to {hi:g} (the sensor's long side), got {sensor_width_mm!r}"
+        )
+
+
+def _disagree(a, b):
+    return abs(a - b) > EXIF_AGREEMENT * max(a, b)
+
+
+def _same_size(tag_wh, size_wh):
+    """Whether EXIF's ``(w, h)`` (either may be None) is the stored size, in either order."""
+    w, h = size_wh
+    tw, th = tag_wh
+    for a, b in ((w, h), (h, w)):
+        if (tw is None or round(tw) == a) and (th is None or round(th) == b):
+            return True
+    return False
+
+
+def _plane_sensor_mm(info):
+    """The sensor's long side (mm) that ``FocalPlaneXResolution`` implies for the file's pixels."""
+    unit_mm = _UNIT_MM.get(int(info.get("plane_unit", 2)))
+    res = info.get("plane_x_resolution")
+    if res is None or unit_mm is None:
+        return None
+    return max(info["image_size_wh"]) / (res / unit_mm)
+
+
+def full_frame_problem(info, sensor_width_mm=None):
+    """Why the EXIF tags do not describe this file as the camera's full frame ("" when they do).
+
+    Parameters
+    ----------
+    info : dict
+        :func:`read_exif`.
+    sensor_width_mm : float, optional
+        The sensor's long side, given by the user.
+
+    Returns
+    -------
+    str
+        One clause naming the tag that disagrees (SPEC section 11), or "".
+    """
+    w, h = info["image_size_wh"]
+    size = f"the file's {w}x{h} px"
+    lo, hi = EXIF_FOCAL_RANGE_MM
+    for key, tag in (("focal_mm", "FocalLength"), ("focal_35mm", "FocalLengthIn35mmFilm")):
+        value = info.get(key)
+        if value is not None and not lo <= value <= hi:
+            return f"{tag} {value:g} mm is outside the physical {lo:g}-{hi:g} mm of a camera lens"
+    software = info.get("software", "")
+    editor = next((name for name in EDITING_SOFTWARE if name in software.lower()), None)
+    if editor:
+        return (
+            f"Software {software!r} is an editing program (the photo was re-saved after the "
+            "shot, most often cropped or resized)"
+        )
+    for (kw, kh), (nw, nh) in (
+        (("pixel_x", "pixel_y"), ("PixelXDimension", "PixelYDimension")),
+        (("image_width", "image_length"), ("ImageWidth", "ImageLength")),
+    ):
+        tag_wh = (info.get(kw), info.get(kh))
+        if tag_wh != (None, None) and not _same_size(tag_wh, (w, h)):
+            shown = "x".join("?" if v is None else f"{v:g}" for v in tag_wh)
+            return f"{nw}/{nh} {shown} differ from {size} (cropped or resized after the shot)"
+    sensors = []  # (sensor long side mm, where from)
+    if sensor_width_mm is not None:
+        sensors.append((float(sensor_width_mm), f"--sensor-width-mm {sensor_width_mm:g}"))
+    model = info.get("model", "")
+    if model.lower() in SENSOR_WIDTH_MM:
+        sensors.append((SENSOR_WIDTH_MM[model.lower()], f"the {model}'s sensor"))
+    plane = _plane_sensor_mm(info)
+    if plane is not None:
+        res = info["plane_x_resolution"]
+        what = f"FocalPlaneXResolution {res:g}/unit implies a {plane:.1f} mm sensor for {size}"
+        s_lo, s_hi = SENSOR_WIDTH_RANGE_MM
+        if not s_lo <= plane <= s_hi:
+            return f"{what}, outside the {s_lo:g}-{s_hi:g} mm of camera sensors"
+        for width, where in sensors:
+            if _disagree(plane, width):
+                return f"{what}, but {where} is {width:g} mm (resized after the shot)"
+        sensors.append((plane, "FocalPlaneXResolution"))
+    f35, focal = info.get("focal_35mm"), info.get("focal_mm")
+    if f35 is not None and focal is not None:
+        crop = f35 / (focal * info.get("digital_zoom", 1.0))
+        diagonal = float(np.hypot(w, h)) / max(w, h)  # sensor diagonal per mm of long side
+        for width, where in sensors:
+            expected = FILM_35MM_DIAGONAL_MM / (width * diagonal)
+            widthwise = FILM_35MM_WIDTH_MM / width
+            if min(abs(crop - expected), abs(crop - widthwise)) > EXIF_AGREEMENT * crop:
+                return (
+                    f"FocalLengthIn35mmFilm {f35:g} mm over FocalLength {focal:g} mm is a crop "
+                    f"factor of {crop:.2f}, but {where} ({width:.1f} mm) gives {expected:.2f}"
+                )
+    return ""
+
+
 def focal_prior_from_fields(info, sensor_width_mm=None, tolerance=FOCAL_TOLERANCE):
-    """:func:`focal_prior_from_exif` on fields already read by :func:`read_exif`."""
-    if sensor_width_mm is not None and not (_positive(sensor_width_mm)):
-        raise ValueError(f"sensor width must be a positive number of mm, got {sensor_width_mm!r}")
+    """The focal prior from fields already read by :func:`read_exif` (the tags are trusted:
+    :func:`exif_focal` checks :func:`full_frame_problem` first), or None."""
+    _check_sensor_width(sensor_width_mm)
     width, height = info["image_size_wh"]
     long_px = max(width, height)
     zoom = info.get("digital_zoom", 1.0)
@@ -195,30 +355,26 @@ def focal_prior_from_fields(info, sensor_width_mm=None, tolerance=FOCAL_TOLERANC
     focal_mm = info.get("focal_mm")
     estimates, source = None, None
     if focal_mm is not None:
-        unit_mm = _UNIT_MM.get(int(info.get("plane_unit", 2)))
-        res = info.get("plane_x_resolution")
+        plane = _plane_sensor_mm(info)
         if sensor_width_mm is not None:
-            px_per_mm = long_px / float(sensor_width_mm)
+            sensor = float(sensor_width_mm)
+            source = f"EXIF FocalLength {focal_mm:g} mm, sensor width {sensor:g} mm (given)"
+        elif plane is not None:
+            sensor = plane
             source = (
-                f"EXIF FocalLength {focal_mm:g} mm, sensor width {sensor_width_mm:g} mm (given)"
+                f"EXIF FocalLength {focal_mm:g} mm, FocalPlaneXResolution "
+                f"{info['plane_x_resolution']:g}/unit"
             )
-        elif res is not None and unit_mm is not None:
-            px_per_mm = res / unit_mm
-            exif_w, exif_h = info.get("pixel_x"), info.get("pixel_y")
-            if exif_w and exif_h:  # resized since shooting: scale by the long sides
-                px_per_mm *= long_px / max(exif_w, exif_h)
-            source = f"EXIF FocalLength {focal_mm:g} mm, FocalPlaneXResolution {res:g}/unit"
         elif info.get("model", "").lower() in SENSOR_WIDTH_MM:
             sensor = SENSOR_WIDTH_MM[info["model"].lower()]
-            px_per_mm = long_px / sensor
             source = (
                 f"EXIF FocalLength {focal_mm:g} mm, {info['model']} sensor width {sensor:g} mm "
                 "(built-in table)"
             )
         else:
-            px_per_mm = None
-        if px_per_mm is not None:
-            estimates = [focal_mm * zoom * px_per_mm]
+            sensor = None
+        if sensor is not None:
+            estimates = [focal_mm * zoom * long_px / sensor]
             source += zoom_note
     if estimates is None and "focal_35mm" in info:
         f35 = info["focal_35mm"]

@@ -37,6 +37,9 @@ IRIS_DIAMETER_MM = 11.7
 #: Its spread (mm) between adults and the measuring error (px) assumed on the diameter.
 IRIS_DIAMETER_SPREAD_MM = 0.5
 IRIS_MEASURE_ERROR_PX = 0.5
+#: Subject-to-camera distances (mm) of a portrait (SPEC section 11): a focal prior that puts the
+#: camera nearer or farther through the iris is wrong (warning ``implausible_prior``).
+PLAUSIBLE_DISTANCE_MM = (300.0, 10_000.0)
 #: Angle (degrees) from the Frankfurt plane's normal (up) to the face frame's ``-y`` axis
 #: (gnathion -> nasion), positive with the chin forward. Textbook adult craniofacial
 #: proportions put the facial profile line (nasion-pogonion) about 5 degrees off the
@@ -179,3 +182,33 @@ def iris_distance_mm(focal_px, iris_diameter_px):
     lo /= iris_diameter_px + IRIS_MEASURE_ERROR_PX
     hi /= iris_diameter_px - IRIS_MEASURE_ERROR_PX
     return float(d), (float(lo), float(hi))
+
+
+def implausible_distance(focal_px, iris_diameter_px):
+    """Why a focal prior is implausible through the iris, or "" (SPEC section 11).
+
+    Parameters
+    ----------
+    focal_px : (lo, hi)
+    iris_diameter_px : float
+
+    Returns
+    -------
+    str
+        A clause naming the focal interval and the distance it implies when the distance at the
+        interval's middle lies outside :data:`PLAUSIBLE_DISTANCE_MM`; "" otherwise (also when
+        the iris is too small to measure).
+    """
+    lo, hi = (float(f) for f in focal_px)
+    try:
+        distance, _ = iris_distance_mm((lo + hi) / 2, iris_diameter_px)
+    except ValueError:
+        return ""
+    d_lo, d_hi = PLAUSIBLE_DISTANCE_MM
+    if d_lo <= distance <= d_hi:
+        return ""
+    return (
+        f"the focal prior {lo:.0f}-{hi:.0f} px puts the camera {distance / 1000:.2f} m from the "
+        f"eyes (iris {iris_diameter_px:.1f} px = {IRIS_DIAMETER_MM:g} mm), outside the "
+        f"{d_lo / 1000:g}-{d_hi / 1000:g} m of a portrait"
+    )

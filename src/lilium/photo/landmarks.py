@@ -70,3 +70,61 @@ def mesh_to_landmarks(mesh_uv):
         landmarks[name] = mesh_uv[index, :2].copy()
         sources[name] = {"source": "automatic", "quality": quality, "mesh_index": index}
     return landmarks, sources
+
+
+#: Mesh vertices of the midline from the top of the face mesh over metopion (151) to glabella
+#: (9): in a lateral view, the forehead's profile.
+FOREHEAD_LINE = (10, 151, 9)
+
+#: Mesh vertices of the mouth corners (cheilion_r, cheilion_l): the chin-jaw curve lies between
+#: their verticals (the span the face mask's curve takes, SPEC section 5).
+MOUTH_CORNERS = (61, 291)
+
+#: Largest step (pixels) between two points of a facial curve.
+CURVE_STEP_PX = 1.0
+
+
+def _densify(points, step=CURVE_STEP_PX):
+    """A polyline ``(K, 2)`` resampled so that no two consecutive points are over ``step`` apart."""
+    out = [points[:1]]
+    for a, b in zip(points[:-1], points[1:], strict=True):
+        n = max(1, int(np.ceil(np.linalg.norm(b - a) / step)))
+        t = np.arange(1, n + 1)[:, None] / n
+        out.append(a + t * (b - a))
+    return np.concatenate(out)
+
+
+def mesh_face_curves(mesh_uv, image_size_wh):
+    """The facial curves of SPEC section 11 from the face mesh, for ``face_curve.json``.
+
+    Chin-jaw: the mesh's lower face contour (:data:`JAW_LINE`) between the verticals of the mouth
+    corners. Forehead: the midline (:data:`FOREHEAD_LINE`) from the top of the mesh to glabella.
+    Both follow the face, never the head mask (whose lower edge is the neck, often the collar).
+
+    Parameters
+    ----------
+    mesh_uv : ndarray of shape (468, 2) or (468, 3)
+        Mesh points in image pixels.
+    image_size_wh : tuple (width, height)
+        Points off the image are left out.
+
+    Returns
+    -------
+    dict of str -> ndarray of shape (K, 2)
+        ``"chin_jaw"`` and ``"forehead"``, ``(u, v)`` pixels at most :data:`CURVE_STEP_PX`
+        apart; a curve with fewer than two points on the image is left out.
+    """
+    mesh_uv = np.asarray(mesh_uv, dtype=float)[:, :2]
+    w, h = image_size_wh
+    u_lo, u_hi = sorted(mesh_uv[list(MOUTH_CORNERS), 0])
+    jaw = _densify(mesh_uv[list(JAW_LINE)])
+    curves = {
+        "chin_jaw": jaw[(jaw[:, 0] >= u_lo) & (jaw[:, 0] <= u_hi)],
+        "forehead": _densify(mesh_uv[list(FOREHEAD_LINE)]),
+    }
+    out = {}
+    for key, curve in curves.items():
+        inside = (curve >= -0.5).all(axis=1) & (curve[:, 0] <= w - 0.5) & (curve[:, 1] <= h - 0.5)
+        if inside.sum() >= 2:
+            out[key] = curve[inside]
+    return out

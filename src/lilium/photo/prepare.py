@@ -19,11 +19,14 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import MIN_PHOTO_SIDE_PX
 from ..io.case import read_image
 from ..io.formats import read_landmarks
 from ..io.jsonio import write_json
-from .analysis import analyse_face
-from .headpose import iris_distance_mm
+from .analysis import analyse_face, upright_turns
+from .folder import PREPARED_BY, check_image_path, claim_folder
+from .headpose import implausible_distance, iris_distance_mm
+from .landmarks import mesh_face_curves
 from .mask import mask_outline
 from .review import review_page
 
@@ -43,6 +46,8 @@ class PreparedPhoto:
         One line for the user (why no face was found, or a summary).
     view : str
     n_tracked, n_template : int
+    warnings : tuple of dict
+        ``{"code", "message"}`` (SPEC section 10 codes), also in ``photo.json``.
     """
 
     folder: Path
@@ -51,13 +56,15 @@ class PreparedPhoto:
     view: str
     n_tracked: int = 0
     n_template: int = 0
+    warnings: tuple = ()
 
 
-def _copy_image(image_path, image, out):
+def _copy_image(image_path, image, out, turned=False):
     suffix = image_path.suffix.lower()
-    if suffix in (".png", ".jpg", ".jpeg"):
+    if suffix in (".png", ".jpg", ".jpeg") and not turned:
         target = out / f"image{suffix}"
-        shutil.copyfile(image_path, target)
+        if not (target.exists() and target.samefile(image_path)):  # the folder's own image
+            shutil.copyfile(image_path, target)
         return target
     from PIL import Image
 
@@ -67,10 +74,24 @@ def _copy_image(image_path, image, out):
 
 
 def _priors(image_path, analysis, sensor_width_mm):
-    from ..io.exif import focal_prior_from_exif
+    """``photo.json``'s priors and the warnings (``{"code", "message"}``) found on the way."""
+    from ..io.exif import exif_focal
 
-    priors, sources = {"source": "automatic"}, {}
-    focal = focal_prior_from_exif(image_path, sensor_width_mm=sensor_width_mm)
+    priors, sources, warnings = {"source": "automatic"}, {}, []
+    focal, unusable = exif_focal(image_path, sensor_width_mm=sensor_width_mm)
+    if unusable:
+        warnings.append({"code": "exif_focal_unusable", "message": unusable})
+    if focal is not None and analysis:
+        why = implausible_distance(focal.focal_px, analysis.iris_diameter_px)
+        if why:
+            warnings.append(
+                {
+                    "code": "implausible_prior",
+                    "message": f"{image_path}: EXIF focal not used: {why} ({focal.source}); if "
+                    "the distance is real, give the focal with lilium case --focal-px LO HI",
+                }
+            )
+            focal = None
     if focal is not None:
         priors["focal_px"] = [float(x) for x in focal.focal_px]
         sources["focal_px"] = f"EXIF: {focal.source}"
@@ -91,10 +112,12 @@ def _priors(image_path, analysis, sensor_width_mm):
                 f"{f:.0f} px -> {distance:.0f} mm (camera to eyes)"
             )
     priors["sources"] = sources
-    return priors
+    return priors, warnings
 
 
-def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_width_mm=None):
+def prepare_photo(
+    image_path, out_dir, view=None, landmarks_path=None, sensor_width_mm=None, face=None
+):
     """Write a photo folder from a photograph.
 
     Parameters
@@ -102,7 +125,8 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
     image_path : str or Path
         PNG or JPEG (any format Pillow reads; others are stored as ``image.png``).
     out_dir : str or Path
-        The photo folder (created; files of the same names are replaced).
+        The photo folder (created). ``lilium photo`` owns it (:mod:`.folder`): its own files
+        of an earlier run are replaced, a folder holding another's is refused.
     view : {"frontal", "lateral_left", "lateral_right"}, optional
         Default: from the fitted yaw (frontal under 30 degrees).
     landmarks_path : str or Path, optional
@@ -110,6 +134,13 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
         file): they replace the automatic ones and count as confirmed.
     sensor_width_mm : float, optional
         For the EXIF focal (see :mod:`lilium.io.exif`).
+    face : int, optional
+        Which face of a photo with several (1 = the leftmost); default the most confident.
+
+    A face that is upright only in a copy of the photo turned by 90, 180 or 270 degrees
+    (:func:`~lilium.photo.analysis.upright_turns`) is prepared on that copy, which the folder
+    holds as ``image.png``: landmarks, mask and curves are then in its pixels, the left-right
+    checks of a case hold, and the message says so.
 
     Returns
     -------
@@ -117,16 +148,28 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
         ``face_found`` is False when the models found no face: the folder then has the image,
         a ``photo.json`` without automatic landmarks and the review page, to mark by hand.
     """
-    image_path = Path(image_path)
-    if not image_path.is_file():
-        raise ValueError(f"{image_path}: file not found; check the photo's path")
+    image_path = check_image_path(image_path)
+    out = Path(out_dir)
+    previous = claim_folder(out, image_path)
     image = read_image(image_path)
     h, w = image.shape[:2]
+    if min(h, w) < MIN_PHOTO_SIDE_PX:
+        raise ValueError(
+            f"{image_path}: the photo is {w}x{h} px, too small to prepare or superimpose (at "
+            f"least {MIN_PHOTO_SIDE_PX} px a side); use the original photograph"
+        )
+    turns = upright_turns(image)
+    if turns:
+        if image_path.resolve().parent == out.resolve():
+            raise ValueError(
+                f"{image_path}: the face is upright only with the photo turned by "
+                f"{90 * turns} degrees, and the photo lies in --out, where the turned copy would "
+                "sit beside it; give another --out folder"
+            )
+        image = np.ascontiguousarray(np.rot90(image, turns))
+        h, w = image.shape[:2]
     reviewed = read_landmarks(landmarks_path, "facial") if landmarks_path else None
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"{out}: exists and is not a folder; give a folder for --out")
-    analysis = analyse_face(image)
+    analysis = analyse_face(image, face)
     view = view or (analysis.view if analysis else "frontal")
     landmarks, sources = dict(analysis.landmarks), dict(analysis.sources)
     if reviewed is not None:
@@ -143,24 +186,49 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
             k: {"source": "reviewed", "quality": quality.get(k, "manual"), "confirmed": True}
             for k in reviewed
         }
-    out.mkdir(parents=True, exist_ok=True)
-    _copy_image(image_path, image, out)
-    priors = _priors(image_path, analysis, sensor_width_mm)
+    priors, warnings = _priors(image_path, analysis, sensor_width_mm)
+    if analysis and analysis.several_faces:
+        warnings.append(
+            {"code": "several_faces", "message": f"{image_path}: {analysis.several_faces}"}
+        )
+    if turns:
+        meta_turn = 90 * turns
+        warnings.append(
+            {
+                "code": "photo_turned",
+                "message": f"{image_path}: the face is upright only with the photo turned by "
+                f"{meta_turn} degrees (counter-clockwise): the folder holds the turned photo "
+                "(image.png), and its landmarks, mask and curves are in its pixels",
+            }
+        )
+    curves = mesh_face_curves(analysis.mesh_xyz, (w, h)) if analysis else {}
     meta = {
+        "prepared_by": PREPARED_BY,
         "view": view,
         "landmarks": {k: [round(float(x), 2) for x in v] for k, v in landmarks.items()},
         "landmark_sources": sources,
         "priors": priors,
     }
+    if analysis:
+        meta["face_mask_is_head"] = True  # never a source of facial curves (SPEC section 11)
+    if warnings:
+        meta["warnings"] = warnings
+    out.mkdir(parents=True, exist_ok=True)
+    for path in previous:  # this command's files of an earlier run (folder.py)
+        path.unlink()
     write_json(out / "photo.json", meta)
+    _copy_image(image_path, image, out, turned=bool(turns))
     outline = np.zeros((0, 2))
     if analysis:
         from PIL import Image
 
         Image.fromarray(analysis.mask.astype(np.uint8) * 255).save(out / "face_mask.png")
         outline = mask_outline(analysis.mask)
-    elif (out / "face_mask.png").is_file():
-        (out / "face_mask.png").unlink()  # a stale mask from an earlier run would mislead
+    if curves:
+        source = {"source": "automatic", "quality": "template", "from": "face mesh outline"}
+        curve_file = {k: np.round(c, 2).tolist() for k, c in curves.items()}
+        curve_file["curve_sources"] = {k: source for k in curves}
+        write_json(out / "face_curve.json", curve_file)
     n_tracked = sum(s["quality"] == "tracked" for s in sources.values())
     n_template = sum(s["quality"] == "template" for s in sources.values())
     if analysis:
@@ -174,4 +242,4 @@ def prepare_photo(image_path, out_dir, view=None, landmarks_path=None, sensor_wi
         message = f"{image_path}: {analysis.message}"
     page = review_page(image, meta["landmarks"], sources, outline, priors, image_path.name, message)
     (out / "review.html").write_text(page, encoding="utf-8")
-    return PreparedPhoto(out, bool(analysis), message, view, n_tracked, n_template)
+    return PreparedPhoto(out, bool(analysis), message, view, n_tracked, n_template, tuple(warnings))

@@ -11,6 +11,9 @@ Image coordinates are ``uv`` (column, row) pixels of the original image, the cen
 top-left pixel at (0, 0) (SPEC section 8).
 """
 
+import contextlib
+import os
+import sys
 from dataclasses import dataclass
 from functools import cache
 from importlib import resources
@@ -55,11 +58,32 @@ def check_runtime():
     _interpreter_class()
 
 
+@contextlib.contextmanager
+def _quiet_stderr():
+    """Silence file descriptor 2 (the runtime's own C++ logging, e.g. "INFO: Created TensorFlow
+    Lite XNNPACK delegate for CPU.") for the block; Python's ``sys.stderr`` is flushed first."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError, AttributeError):  # no real fd 2 (embedded): nothing to silence
+        yield
+        return
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 2)
+            yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
 @cache
 def _model(kind):
     path = resources.files("lilium.photo") / "models" / MODEL_FILES[kind]
-    interpreter = _interpreter_class()(model_content=path.read_bytes(), num_threads=1)
-    interpreter.allocate_tensors()
+    interpreter_class = _interpreter_class()
+    with _quiet_stderr():
+        interpreter = interpreter_class(model_content=path.read_bytes(), num_threads=1)
+        interpreter.allocate_tensors()
     return interpreter
 
 
@@ -132,8 +156,8 @@ class Crop:
         return out
 
 
-def detect_face(image):
-    """The most confident face, or ``None``.
+def detect_faces(image):
+    """Every face the detector finds, most confident first.
 
     Parameters
     ----------
@@ -141,8 +165,9 @@ def detect_face(image):
 
     Returns
     -------
-    tuple (score, box_uv (4,) as [u_min, v_min, u_max, v_max], keypoints_uv (6, 2)) or None
-        Keypoints: subject's right eye, left eye, nose tip, mouth, right ear, left ear.
+    list of tuple (score, box_uv (4,) as [u_min, v_min, u_max, v_max], keypoints_uv (6, 2))
+        Keypoints: subject's right eye, left eye, nose tip, mouth, right ear, left ear. The
+        overlapping boxes of one face are averaged (MediaPipe's weighted suppression).
     """
     h, w = image.shape[:2]
     side = max(h, w)
@@ -152,27 +177,34 @@ def detect_face(image):
     tensor = cv2.resize(square, (128, 128), interpolation=cv2.INTER_AREA) / 127.5 - 1.0
     raw, logits = _run("detector", tensor)
     scores = 1.0 / (1.0 + np.exp(-np.clip(logits[:, 0].astype(float), -100, 100)))
-    best = int(np.argmax(scores))
-    if scores[best] < MIN_DETECTION_SCORE:
-        return None
-    # Average the boxes overlapping the best one (MediaPipe's weighted suppression).
     anchors = _anchors()
     centres = raw[:, :2] / 128 + anchors
-    keep = (scores >= MIN_DETECTION_SCORE) & (
-        np.linalg.norm(centres - centres[best], axis=1) < 0.5 * raw[best, 2] / 128
-    )
-    weights = scores[keep] / scores[keep].sum()
-    decoded = raw[keep].copy()
-    decoded[:, 0:2] = centres[keep]
-    decoded[:, 2:4] /= 128
-    decoded[:, 4:] = decoded[:, 4:] / 128 + np.tile(anchors[keep], 6)
-    mean = weights @ decoded
-    to_px = side, np.array([pad_u, pad_v])
-    centre = mean[0:2] * to_px[0] - to_px[1]
-    half = mean[2:4] * to_px[0] / 2
-    box = np.concatenate([centre - half, centre + half])
-    keypoints = mean[4:].reshape(6, 2) * to_px[0] - to_px[1]
-    return float(scores[best]), box, keypoints
+    left = scores >= MIN_DETECTION_SCORE
+    faces = []
+    while left.any():
+        best = int(np.argmax(np.where(left, scores, -1.0)))
+        keep = left & (np.linalg.norm(centres - centres[best], axis=1) < 0.5 * raw[best, 2] / 128)
+        keep[best] = True
+        left &= ~keep
+        weights = scores[keep] / scores[keep].sum()
+        decoded = raw[keep].copy()
+        decoded[:, 0:2] = centres[keep]
+        decoded[:, 2:4] /= 128
+        decoded[:, 4:] = decoded[:, 4:] / 128 + np.tile(anchors[keep], 6)
+        mean = weights @ decoded
+        offset = np.array([pad_u, pad_v])
+        centre = mean[0:2] * side - offset
+        half = mean[2:4] * side / 2
+        box = np.concatenate([centre - half, centre + half])
+        keypoints = mean[4:].reshape(6, 2) * side - offset
+        faces.append((float(scores[best]), box, keypoints))
+    return faces
+
+
+def detect_face(image):
+    """The most confident face of :func:`detect_faces`, or ``None``."""
+    faces = detect_faces(image)
+    return faces[0] if faces else None
 
 
 def face_crop(box_uv, keypoints_uv):
