@@ -297,6 +297,25 @@ def test_scheduler_that_refuses_fails_fast_before_the_database(dataset, tmp_path
     assert not db.exists() and not list(db.parent.glob("r.sqlite*"))
 
 
+def test_dask_cluster_without_workers_ends_the_run(dataset, tmp_path, capsys, monkeypatch):
+    """No worker at all: the run says so within the stated time and exits (exit 2)."""
+    distributed = pytest.importorskip("dask.distributed")
+    from lilium.experiments import executors
+
+    monkeypatch.setattr(executors, "NO_WORKER_TIMEOUT_S", 1.0)
+    config = write_config(tmp_path / "none", dataset, experiments=("A",))
+    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+        code = main(
+            ["experiment", str(config), "--no-progress", "--scheduler"]
+            + [cluster.scheduler_address]
+        )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "has had no worker for 1 s, with 8 SFOs waiting" in err[0]
+    assert "run the same command again to resume" in err[0]
+
+
+@pytest.mark.slow
 def test_dask_cluster_that_loses_every_worker(dataset, tmp_path, capsys, monkeypatch):
     """Every worker gone: the run says so, keeps what is stored and exits; a rerun resumes."""
     distributed = pytest.importorskip("dask.distributed")
