@@ -388,8 +388,9 @@ def sfo_table(problems, seed):
             if ref is not None:
                 r = ref[views == view]
                 both = np.isfinite(b) & np.isfinite(r)
+                mb, mr = (b[both].mean(), r[both].mean()) if both.any() else (np.nan, np.nan)
                 line += (
-                    f" {b[both].mean():18.2f} {r[both].mean():6.2f} "
+                    f" {mb:18.2f} {mr:6.2f} "
                     f"{np.nanmean(b) / np.nanmean(r):6.2f}"
                 )
             print(line + f" {ms[name]:6.1f}")
