@@ -389,10 +389,7 @@ def sfo_table(problems, seed):
                 r = ref[views == view]
                 both = np.isfinite(b) & np.isfinite(r)
                 mb, mr = (b[both].mean(), r[both].mean()) if both.any() else (np.nan, np.nan)
-                line += (
-                    f" {mb:18.2f} {mr:6.2f} "
-                    f"{np.nanmean(b) / np.nanmean(r):6.2f}"
-                )
+                line += f" {mb:18.2f} {mr:6.2f} {np.nanmean(b) / np.nanmean(r):6.2f}"
             print(line + f" {ms[name]:6.1f}")
     print(
         "fail = no camera or f > 10,000 px; BPE over the solved problems; 'both solved' = the"
