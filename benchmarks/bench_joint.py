@@ -85,6 +85,7 @@ def run_pair(task):
         view = "frontal" if photo.view == "frontal" else "lateral"
         rows.append(
             dict(method="independent", subject=subject, seed=seed, view=view, seconds=seconds)
+            | dict(pair=photo_ids[0])
             | _metrics(result, skull, photo, truth)
         )
     for design in designs:
@@ -97,7 +98,13 @@ def run_pair(task):
         for result, photo, truth in zip(joint.photos, photos, truths, strict=True):
             view = "frontal" if photo.view == "frontal" else "lateral"
             rows.append(
-                dict(method=f"joint {design}", subject=subject, seed=seed, view=view)
+                dict(
+                    method=f"joint {design}",
+                    subject=subject,
+                    seed=seed,
+                    view=view,
+                    pair=photo_ids[0],
+                )
                 | dict(seconds=seconds / len(photos))  # the pair's time, split evenly
                 | _metrics(result, skull, photo, truth)
             )
@@ -171,7 +178,7 @@ def summarise(rows, designs):
     for m in methods[1:]:
         s = stats[m]
         wins = 0
-        keys = {(r["subject"], r["seed"]) for r in rows if r["method"] == m}
+        keys = {(r["subject"], r["seed"], r["pair"]) for r in rows if r["method"] == m}
         for key in keys:
 
             def pair_bpe(method, key=key):
@@ -179,7 +186,7 @@ def summarise(rows, designs):
                     [
                         r["bpe"]
                         for r in rows
-                        if r["method"] == method and (r["subject"], r["seed"]) == key
+                        if r["method"] == method and (r["subject"], r["seed"], r["pair"]) == key
                     ]
                 )
 

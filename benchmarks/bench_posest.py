@@ -388,10 +388,8 @@ def sfo_table(problems, seed):
             if ref is not None:
                 r = ref[views == view]
                 both = np.isfinite(b) & np.isfinite(r)
-                line += (
-                    f" {b[both].mean():18.2f} {r[both].mean():6.2f} "
-                    f"{np.nanmean(b) / np.nanmean(r):6.2f}"
-                )
+                mb, mr = (b[both].mean(), r[both].mean()) if both.any() else (np.nan, np.nan)
+                line += f" {mb:18.2f} {mr:6.2f} {np.nanmean(b) / np.nanmean(r):6.2f}"
             print(line + f" {ms[name]:6.1f}")
     print(
         "fail = no camera or f > 10,000 px; BPE over the solved problems; 'both solved' = the"
