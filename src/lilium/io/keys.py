@@ -17,6 +17,10 @@ PHOTO_KEYS = (
     "ground_truth",
     "landmark_sources",
     "soft_tissue_axes_sets",
+    # written by ``lilium photo`` (SPEC section 11)
+    "prepared_by",
+    "face_mask_is_head",
+    "warnings",
 )
 
 #: Keys of ``photo.json``'s ``priors`` (SPEC section 8; ``lilium photo``'s automatic ones).
