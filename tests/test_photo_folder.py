@@ -47,7 +47,10 @@ def test_the_chin_jaw_curve_follows_the_chin_not_the_collar(astro):
     assert np.nonzero(mask[:, u])[0].max() > lm["gnathion"][1] + 15
     forehead = np.array(curves["forehead"])
     assert forehead[:, 1].max() == pytest.approx(lm["glabella"][1], abs=1)
-    assert np.allclose(read_photo(astro).face_curve_uv, chin)
+    # Read back as whole pixels along the written curve (lilium.io.curves resamples it).
+    read = read_photo(astro).face_curve_uv
+    gap = np.linalg.norm(read[:, None, :] - chin[None, :, :], axis=2).min(axis=1)
+    assert len(read) >= 0.8 * len(chin) and gap.max() <= 1.0
 
 
 def test_a_prepared_head_mask_never_gives_a_curve(astro, tmp_path):

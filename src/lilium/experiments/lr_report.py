@@ -82,7 +82,14 @@ def lr_identification_table(decision_pairs, validated):
         weights = np.array([t["photo_runs"] for t in parts], float)
         merged = dict(parts[0])
         for name in ("rank1_rate", "mean_rank", "auc"):
-            merged[name] = float(np.average([t[name] for t in parts], weights=weights))
+            known = [
+                (t[name], w) for t, w in zip(parts, weights, strict=True) if t[name] is not None
+            ]
+            merged[name] = (
+                float(np.average([v for v, _ in known], weights=[w for _, w in known]))
+                if known
+                else None
+            )
         merged.update(
             photo_runs=int(weights.sum()),
             runs=sum(t["runs"] for t in parts),
