@@ -506,7 +506,7 @@ def photo_and_ct_probes():
         Probe("photo text as image", photo(), "error", ("p.png",), _write("in", "p.png", "x"), "photo"),  # noqa: E501
         Probe("photo missing image", photo(name="none.png"), "error", ("none.png",), None, "photo"),  # noqa: E501
         Probe("photo --sensor-width-mm -3", photo("--sensor-width-mm", "-3"), "error", ("--sensor-width-mm",), img((64, 64)), "photo"),  # noqa: E501
-        Probe("photo same file as output", lambda ws: ["photo", ws.photo / "image.png", "--out", ws.photo], "error", ("image.png",), None, "photo"),  # noqa: E501
+        Probe("photo same file as output", lambda ws: ["photo", ws.photo / "image.png", "--out", ws.photo], "error", ("--out", "lilium photo replaces only its own files"), None, "photo"),  # noqa: E501
         Probe("photo header 400 MP", photo(), "error", ("too large",), _write("in", "p.png", _png_header(20000, 20000)), "photo"),  # noqa: E501
         Probe("import-ct missing", imp("none.nrrd"), "error", ("none.nrrd",), None, "ct"),
         Probe("import-ct garbage nrrd", imp("v.nrrd"), "error", ("v.nrrd",), ct("v.nrrd", bytes(range(256)) * 2), "ct"),  # noqa: E501
