@@ -241,7 +241,9 @@ def check_skull_labels(skull):
         f"{where}: left and right are mirrored (the _r minus _l direction, anterior and superior "
         f"form a left-handed frame, {handedness:+.2f}); swap every _l and _r name in this file "
         "(zygion_l <-> zygion_r, ...), or, if the labels follow the anatomy, the mesh itself is "
-        "mirrored: re-import it with its true handedness"
+        "mirrored: re-import the CT with lilium import-ct --orientation (the anatomical "
+        "direction of each index axis, e.g. RPI) when its files name none, or mirror the mesh "
+        "back in the program that exported it"
     )
 
 
