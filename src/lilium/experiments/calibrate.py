@@ -39,21 +39,40 @@ from .store import COLUMNS, ResultStore
 TERMS_KEY = "identification_terms"
 
 
-def with_terms(row, skull, photos, singles, facial_landmarks_mm, key=TERMS_KEY):
+def with_terms(row, skull, photos, singles, facial_landmarks_mm, rows, key=TERMS_KEY):
     """Add the identification terms of one decision to a row's ``result`` JSON (under
     ``key``; nothing for a failed SFO): ``lilium calibrate`` and ``lilium report`` read them
     instead of reading the skull and photos again
-    (:func:`lilium.identification.score.identification_terms`).
+    (:func:`lilium.identification.score.identification_terms`). ``rows`` are the photos' own
+    rows, whose skull raster and P_pll (:func:`row_image`) are not computed again.
     """
     if not all(singles) or not row.get("result"):
         return row
+    cameras = [s.camera for s in singles]
     data = json.loads(row["result"])
     data[key] = identification_terms(
-        skull, photos, [s.camera for s in singles], facial_landmarks_mm
+        skull,
+        photos,
+        cameras,
+        facial_landmarks_mm,
+        image=[row_image(r, skull, p, c) for r, p, c in zip(rows, photos, cameras, strict=True)],
     )
     row["result"] = json.dumps(data)
     return row
 
+
+def row_image(row, skull, photo, camera):
+    """``(outside_fraction, pll_face)`` of a stored row from its own skull raster
+    (``outside_px``, ``skull_px``) and P_pll (computed only when the row has none); None when
+    the row has no raster (no face mask)."""
+    if row.get("skull_px") is None:
+        return None
+    eye_px = eye_corner_px(camera, correspondences(skull, photo).cranial_mm)
+    pll = row["p_pll"] / eye_px if row.get("p_pll") is not None else None
+    if pll is None:
+        pll = pll_face(skull, photo, camera, eye_px)
+    outside = row["outside_px"] / row["skull_px"] if row["skull_px"] else 1.0
+    return outside, pll
 
 
 class DatasetInputs:
@@ -123,22 +142,9 @@ def single_terms(rows, inputs=None):
             )
         else:
             skull, photo = _inputs(r, inputs)
-            image = None
-            if r["skull_px"] is not None:  # the row's own raster and P_pll, when it has them
-                eye_px = eye_corner_px(camera, _cranial(skull, photo))
-                pll = (
-                    r["p_pll"] / eye_px
-                    if r["p_pll"] is not None
-                    else pll_face(skull, photo, camera, eye_px)
-                )
-                outside = r["outside_px"] / r["skull_px"] if r["skull_px"] else 1.0
-                image = [(outside, pll)]
+            image = [row_image(r, skull, photo, camera)]
             out.append(identification_terms(skull, [photo], [camera], _facial(r), image=image))
     return out
-
-
-def _cranial(skull, photo):
-    return correspondences(skull, photo).cranial_mm
 
 
 def _facial(row):
@@ -228,19 +234,23 @@ def validate(decision_pairs, folds=5):
 
 
 def _pair_sum(pairs, decision_pairs, validated, key):
-    """Per pair: the frontal and the lateral SFO's cross-validated log10 LR, added."""
-    lookup = {}
-    for view in ("frontal", "lateral"):
+    """Per pair: the frontal and the lateral SFO's cross-validated log10 LR, added (the
+    person's first lateral photo against the same skull in the same run)."""
+    frontal, lateral = {}, {}
+    for view, table in (("frontal", frontal), ("lateral", lateral)):
         single = decision_pairs.get((key[0], key[1], view), [])
         lrs = validated.get((key[0], key[1], view), {}).get("log10_lr", [])
         for p, v in zip(single, lrs, strict=True):
-            lookup[(view, p["run"], p["person"], p["skull"], p["photo"])] = v
+            person = (p["run"], p["person"], p["skull"])
+            if view == "frontal":
+                table[person + (p["photo"],)] = v
+            else:
+                table.setdefault(person, v)
     out = []
     for p in pairs:
-        f = lookup.get(("frontal", p["run"], p["person"], p["skull"], p["photo"]), np.nan)
-        lat = [v for k, v in lookup.items()
-               if k[0] == "lateral" and k[1:4] == (p["run"], p["person"], p["skull"])]
-        out.append(f + lat[0] if lat else np.nan)
+        person = (p["run"], p["person"], p["skull"])
+        f = frontal.get(person + (p["photo"],), np.nan)
+        out.append(f + lateral[person] if person in lateral else np.nan)
     return np.array(out, float)
 
 

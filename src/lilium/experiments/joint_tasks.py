@@ -106,9 +106,9 @@ def run_joint_task(task):
             truth = replace(truth, facial_landmarks_mm=_facial_truth(task.subject_dir))
         row.update(score_result(single, skull, photo, truth, topology))
         row.update(result_columns(single, result.fitness if result else None, result))
-        with_terms(row, skull, [photo], [single], result.facial_landmarks_mm)
+        with_terms(row, skull, [photo], [single], result.facial_landmarks_mm, [row])
         row.update(task_seconds=time.perf_counter() - start, finished_at=time.time())
     # The joint decision's terms (both photos, one soft tissue), on the frontal row.
-    with_terms(rows[0], skull, photos, list(result.photos), result.facial_landmarks_mm,
+    with_terms(rows[0], skull, photos, list(result.photos), result.facial_landmarks_mm, rows,
                key=TERMS_KEY + "_joint")
     return rows[::-1]

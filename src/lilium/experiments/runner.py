@@ -343,7 +343,7 @@ def run_task(task):
     row.update(result_columns(result, result.fitness, result))
     from .calibrate import with_terms
 
-    with_terms(row, skull, [photo], [result], result.facial_landmarks_mm)
+    with_terms(row, skull, [photo], [result], result.facial_landmarks_mm, [row])
     row.update(task_seconds=time.perf_counter() - start, finished_at=time.time())
     return row
 

@@ -81,9 +81,10 @@ def identification_terms(
         The soft tissue the SFO found (facial points, skull frame); for separate SFOs any one
         of them, or None to leave ``soft_tissue_z2`` out.
     depth_table : dict, optional
-    image : sequence of (float or None, float or None), optional
+    image : sequence of (float or None, float or None) or None, optional
         Per photo, ``(outside_fraction, pll_face)`` already known (e.g. from the photo's own
-        SFO when several are combined); computed when not given.
+        SFO when several are combined); computed for a photo whose entry is None, or for every
+        photo when not given.
 
     Returns
     -------
@@ -96,7 +97,7 @@ def identification_terms(
         corr = correspondences(skull, photo)
         view = make_view(camera, corr, photo.landmark_sources, depth_table)
         views.append(view)
-        if image is not None:
+        if image is not None and image[k] is not None:
             o, p = image[k]
         else:
             o, p = image_consistency(skull, photo, camera, eye_corner_px(camera, view.cranial_mm))
