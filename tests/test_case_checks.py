@@ -9,7 +9,7 @@ import shutil
 import pytest
 from PIL import Image
 
-from lilium.cli.main import main
+from cli_helpers import _run
 from lilium.softtissue.landmarks import side, twin
 from lilium.synthetic.dataset import generate_dataset
 
@@ -24,11 +24,6 @@ def generated(tmp_path_factory):
     photos = {p["view"].split("_")[0]: root / p["paths"]["C"] for p in index["photos"]}
     return subject, photos["frontal"], photos["lateral"]
 
-
-def _run(argv, capsys):
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def _mirrored_skull(subject, folder):

@@ -9,6 +9,7 @@ import pytest
 from PIL import Image
 from PIL.TiffImagePlugin import IFDRational
 
+from cli_helpers import _one_line_error, _run
 from lilium.cli.main import main
 from lilium.io.mesh import write_mesh
 
@@ -37,11 +38,6 @@ def files(case, tmp_path):
     shutil.copy(photo_dir / "face_mask.png", folder / "front_mask.png")
     return folder
 
-
-def _run(argv, capsys):
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_folders_two_photos_one_report(case, tmp_path, capsys):
@@ -100,15 +96,6 @@ def test_focal_prior_from_exif(files, tmp_path, capsys):
     code, _, _ = _run(argv + ["--method", "posest-sfo", "--no-exif", "--out", out], capsys)
     assert "none (penalty off)" in (out / "report.html").read_text()
 
-
-def _one_line_error(capsys, argv, *needles):
-    code, _, err = _run(argv, capsys)
-    assert code == 2, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    for needle in needles:
-        assert needle in lines[0], lines[0]
-    return lines[0]
 
 
 def _argv(files, tmp_path, **change):

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from cli_helpers import _edit_json, _one_line_error, _run, _sfo
 from lilium.cli import argtypes
 from lilium.cli.main import main
 from lilium.constants import MAX_PHOTO_PIXELS
@@ -23,33 +24,6 @@ from lilium.io.formats import name_error
 from lilium.io.images import image_size_wh, read_image, read_mask
 from lilium.io.paths import path_id, safe_id
 from lilium.report.html import relative_href
-
-
-def _run(argv, capsys):
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
-
-
-def _one_line_error(capsys, argv, *needles):
-    code, _, err = _run(argv, capsys)
-    assert code == 2, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    for needle in needles:
-        assert str(needle) in lines[0], lines[0]
-    return lines[0]
-
-
-def _sfo(case, out, *extra):
-    subject_dir, photo_dir = case
-    return ["sfo", "--skull", subject_dir, "--photo", photo_dir, "--out", out, *extra]
-
-
-def _edit_json(path, change):
-    data = json.loads(path.read_text())
-    change(data)
-    path.write_text(json.dumps(data))
 
 
 def _png_header(path, width, height):

@@ -6,35 +6,7 @@ import json
 
 import pytest
 
-from lilium.cli.main import main
-
-
-def _run(argv, capsys):
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
-
-
-def _one_line_error(capsys, argv, *needles):
-    code, _, err = _run(argv, capsys)
-    assert code == 2, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    for needle in needles:
-        assert str(needle) in lines[0], lines[0]
-    return lines[0]
-
-
-def _sfo(case, out, *extra):
-    subject_dir, photo_dir = case
-    return ["sfo", "--skull", subject_dir, "--photo", photo_dir, "--out", out, *extra]
-
-
-def _edit_json(path, change):
-    data = json.loads(path.read_text())
-    change(data)
-    path.write_text(json.dumps(data))
-
+from cli_helpers import _edit_json, _one_line_error, _run, _sfo
 
 # -- JSON booleans are not numbers -----------------------------------------------------------
 

@@ -15,6 +15,7 @@ import pytest
 from PIL import Image
 from PIL.TiffImagePlugin import IFDRational
 
+from cli_helpers import _run
 from lilium.cli.main import main
 from lilium.geometry.rotations import geodesic_angle_deg
 from standin_case import make_standin_case
@@ -31,11 +32,6 @@ needs_litert = pytest.mark.skipif(not HAVE_LITERT, reason="needs lilium[photo] (
 #: A DE budget that only shows the flow.
 SMALL_DE = ["--generations", "3", "--population", "16"]
 
-
-def _run(argv, capsys):
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def _result(out, photo_id, tag):
