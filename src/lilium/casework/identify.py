@@ -108,10 +108,9 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
             "note": "no camera: the SFO failed, so nothing can be concluded",
         }
     facial = facial_landmarks_mm or results[0].facial_landmarks_mm
-    terms = identification_terms(
-        skull, photos, [r.camera for r in results], facial,
-        depth_table=None,
-    )
+    # The built-in depth table, whatever the SFO used: the calibration was fitted on terms
+    # computed with it, and a user's table would move the terms off that calibration.
+    terms = identification_terms(skull, photos, [r.camera for r in results], facial)
     model = calibrations.get(key)
     note = ""
     if model is None:
@@ -124,10 +123,8 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
     else:
         lr = float(model.log10_lr([terms])[0])
         record["calibration"]["provenance"] = model.provenance
-        if len(photos) > 1 and not joint and sorted(p.view != "frontal" for p in photos) != [
-            False,
-            True,
-        ]:
+        views = sorted("frontal" if p.view == "frontal" else "lateral" for p in photos)
+        if len(photos) > 1 and not joint and views != ["frontal", "lateral"]:
             note = "calibrated on one frontal and one lateral photo; these photos differ"
     inconsistent = _inconsistent(results, terms)
     verdict = conclude(lr, caps, inconsistent)
