@@ -219,3 +219,80 @@ def test_lineup_refuses_a_name_given_twice(case, tmp_path, capsys):
     code = main(["lineup", "--skull", str(subject_dir), "--candidate", "a", str(photo_dir),
                  "--candidate", "a", str(photo_dir), "--out", str(tmp_path / "o")])
     assert code == 2 and "given twice" in capsys.readouterr().err
+
+
+def test_balanced_fit_recovers_the_log_lr_of_imbalanced_classes():
+    """1 same-person pair in 20: each class weighs half, so the fitted log LR is the classes'
+    own (two unit Gaussians of ln chi2 two apart: log LR = 2 (1 - x) in nats) whatever the
+    pairs' proportion, shrunk a little by the ridge."""
+    rng = np.random.default_rng(5)
+    x_same, x_diff = rng.normal(0.0, 1.0, 400), rng.normal(2.0, 1.0, 8000)
+    terms = [{"landmark_chi2": float(np.exp(x))} for x in np.concatenate([x_same, x_diff])]
+    model = fit(terms, [True] * 400 + [False] * 8000)
+    grid = np.array([-0.5, 0.5, 1.0, 1.5, 2.5])
+    got = model.log10_lr([{"landmark_chi2": float(np.exp(x))} for x in grid]) * np.log(10)
+    true = 2.0 * (1.0 - grid)
+    assert abs(got[2]) < 0.1  # even odds where the classes' densities cross
+    # The ridge shrinks towards "no evidence" (a conservative LR), never past the true one.
+    ratio = got[[0, 1, 3, 4]] / true[[0, 1, 3, 4]]
+    assert np.all((ratio > 0.7) & (ratio <= 1.05)), ratio
+
+
+def _rotation(rotvec):
+    from lilium.geometry.rotations import rotvec_to_matrix
+
+    return rotvec_to_matrix(np.asarray(rotvec, float))
+
+
+def test_camera_refit_recovers_the_camera_and_kabsch_the_pose():
+    from lilium.identification.cohort import kabsch, refit_cameras
+    from lilium.identification.terms import landmark_sigma_px
+
+    rng = np.random.default_rng(6)
+    view = _view(rng, noise=False)
+    cam = view.camera
+    R0 = (_rotation([0.03, -0.02, 0.01]) @ cam.R)[None]
+    R, t, f = refit_cameras(R0, (cam.t + [4.0, -3.0, 60.0])[None], np.array([cam.focal_px * 1.1]),
+                            cam.principal_point_px, view.cranial_mm[None], view.axes[None],
+                            view.depth_mean_mm, view.depth_sd_mm, view.uv_px,
+                            landmark_sigma_px(view))
+    refit = Camera.from_rt(R[0], t[0], f[0], cam.principal_point_px)
+    mean_mm = view.cranial_mm + view.depth_mean_mm[:, None] * view.axes
+    assert np.abs(refit.project(mean_mm) - view.uv_px).max() < 0.05  # exact data: fitted
+    assert f[0] == pytest.approx(cam.focal_px, rel=2e-3)
+    Rt = _rotation([0.2, -0.4, 0.1])
+    Ra, ta = kabsch(view.cranial_mm, view.cranial_mm @ Rt.T + [5.0, 6.0, 7.0])
+    np.testing.assert_allclose(Ra, Rt, atol=1e-9)
+    np.testing.assert_allclose(ta, [5.0, 6.0, 7.0], atol=1e-9)
+
+
+def test_cohort_reads_a_photo_against_other_skulls(tmp_path):
+    """Candidate and cohort skulls in different frames: the cohort fits are found from the
+    candidate's camera through the rigid fit of the skulls, and the true skull fits its photo
+    better than the cohort's skulls do."""
+    from lilium.identification.cohort import Cohort, cohort_chi2, cohort_terms
+    from lilium.io.calibration import read_cohort, write_cohort
+
+    rng = np.random.default_rng(7)
+    view = _view(rng)
+    names = view.names
+    landmarks, axes = [], []
+    for k in range(8):
+        other = _view(np.random.default_rng(100 + k), noise=False)  # another person's skull
+        moved = other.cranial_mm @ _rotation([0.0, 0.3 * k, 0.0]).T + [10.0 * k, 0.0, 0.0]
+        landmarks.append(dict(zip(names, moved, strict=True)))
+        axes.append(dict(zip(names, other.axes @ _rotation([0.0, 0.3 * k, 0.0]).T, strict=True)))
+    cohort = Cohort(tuple(landmarks), tuple(axes), {"test": True})
+    values = cohort_chi2([view], cohort)
+    assert len(values) == 8 and np.all(values > 3 * landmark_chi2([view])[0])
+    mean, sd = cohort_terms([view], cohort)
+    assert mean == pytest.approx(np.log(values).mean()) and sd > 0
+    write_cohort(tmp_path / "cohort.json", cohort)
+    again = read_cohort(tmp_path / "cohort.json")
+    assert again.provenance == {"test": True}
+    assert cohort_terms([view], again) == pytest.approx((mean, sd))
+    (tmp_path / "bad.json").write_text('{"format": "lilium-cohort", "skulls": [{"axes": {}}]}')
+    with pytest.raises(ValueError, match="bad.json: skull 0 needs"):
+        read_cohort(tmp_path / "bad.json")
+    # A cohort without the views' landmarks gives no terms.
+    assert cohort_terms([view], Cohort(({"x": np.zeros(3)},), ({"x": np.ones(3)},))) == (None, None)

@@ -14,7 +14,7 @@ from dataclasses import replace
 from ..identification.conclusion import conclude, material_caps
 from ..identification.score import identification_terms, nll_score
 from ..inputs import correspondences
-from ..io.calibration import read_calibration, shipped_path
+from ..io.calibration import read_calibration, shipped_cohort, shipped_path
 
 #: Cranial landmarks on the mandible: a skull with none of them has no mandible.
 MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")
@@ -110,7 +110,9 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
     facial = facial_landmarks_mm or results[0].facial_landmarks_mm
     # The built-in depth table, whatever the SFO used: the calibration was fitted on terms
     # computed with it, and a user's table would move the terms off that calibration.
-    terms = identification_terms(skull, photos, [r.camera for r in results], facial)
+    terms = identification_terms(
+        skull, photos, [r.camera for r in results], facial, cohort=shipped_cohort()
+    )
     model = calibrations.get(key)
     note = ""
     if model is None:

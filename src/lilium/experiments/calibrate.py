@@ -27,10 +27,13 @@ import numpy as np
 
 from ..geometry.camera import Camera
 from ..identification.calibration import cross_validated, fit, performance
+from ..identification.cohort import Cohort
 from ..identification.score import identification_terms, pll_face
-from ..identification.terms import eye_corner_px
+from ..identification.terms import TERM_NAMES, eye_corner_px
 from ..inputs import correspondences
+from ..io.calibration import shipped_cohort
 from ..io.case import read_photo, read_skull
+from ..synthetic.subjects import axes_on_skull, make_subjects
 from .config import view_group
 from .store import COLUMNS, ResultStore
 
@@ -56,6 +59,7 @@ def with_terms(row, skull, photos, singles, facial_landmarks_mm, rows, key=TERMS
         cameras,
         facial_landmarks_mm,
         image=[row_image(r, skull, p, c) for r, p, c in zip(rows, photos, cameras, strict=True)],
+        cohort=shipped_cohort(),
     )
     row["result"] = json.dumps(data)
     return row
@@ -126,14 +130,21 @@ def _inputs(row, inputs):
     return skull, inputs.photo(row["photo"], row["experiment"])
 
 
-def single_terms(rows, inputs=None):
-    """The terms of every row (None for a failed SFO): stored, or computed with ``inputs``."""
+def _complete(terms):
+    """Whether stored terms have every term of this version (older runs lack the cohort's)."""
+    return terms is not None and all(name in terms for name in TERM_NAMES)
+
+
+def single_terms(rows, inputs=None, cohort_cache=None):
+    """The terms of every row (None for a failed SFO): stored, or computed with ``inputs``
+    (also when the stored ones lack a term of this version)."""
     out = []
+    cohort_cache = {} if cohort_cache is None else cohort_cache
     for r in rows:
         camera = _camera(r) if r["success"] else None
         if camera is None:
             out.append(None)
-        elif TERMS_KEY in r["data"]:
+        elif _complete(r["data"].get(TERMS_KEY)):
             out.append(r["data"][TERMS_KEY])
         elif inputs is None:
             raise ValueError(
@@ -143,8 +154,24 @@ def single_terms(rows, inputs=None):
         else:
             skull, photo = _inputs(r, inputs)
             image = [row_image(r, skull, photo, camera)]
-            out.append(identification_terms(skull, [photo], [camera], _facial(r), image=image))
+            out.append(identification_terms(
+                skull, [photo], [camera], _facial(r), image=image, cohort=shipped_cohort(),
+                cohort_cache=cohort_cache,
+            ))
     return out
+
+
+def make_cohort(n_skulls, seed):
+    """A :class:`~lilium.identification.cohort.Cohort` of ``n_skulls`` generated people
+    (:func:`lilium.synthetic.subjects.make_subjects` at ``seed``): each skull's cranial
+    landmarks and true soft-tissue axes."""
+    subjects = make_subjects(n_skulls, seed=seed, prefix="cohort")
+    return Cohort(
+        tuple(dict(s.cranial_landmarks) for s in subjects),
+        tuple(axes_on_skull(s) for s in subjects),
+        {"generator": "lilium.synthetic.subjects.make_subjects", "skulls": int(n_skulls),
+         "seed": int(seed)},
+    )
 
 
 def _facial(row):
@@ -156,7 +183,7 @@ def _run_key(r):
     return (r["experiment"], r["method"], r["variant"], r["axes_set"], r["repetition"])
 
 
-def decisions(rows, terms, inputs=None):
+def decisions(rows, terms, inputs=None, cohort_cache=None):
     """Every decision of the database with its terms (see the module docstring).
 
     Returns
@@ -194,14 +221,15 @@ def decisions(rows, terms, inputs=None):
                 out[(run[1], run[2], "joint" if joint else "pair")].append(base | {"terms": None})
                 continue
             stored = (fr["data"] or {}).get(TERMS_KEY + "_joint") if joint else None
-            if stored is None:
+            if not _complete(stored):
                 if inputs is None:
                     raise ValueError("pair terms need the dataset; give --dataset DIR")
                 skull, pf = _inputs(fr, inputs)
                 _, pl = _inputs(lr, inputs)
                 image = [(t["outside_fraction"], t["pll_face"]) for t in (ft, lt)]
                 stored = identification_terms(
-                    skull, [pf, pl], [_camera(fr), _camera(lr)], _facial(fr), image=image
+                    skull, [pf, pl], [_camera(fr), _camera(lr)], _facial(fr), image=image,
+                    cohort=shipped_cohort(), cohort_cache=cohort_cache,
                 )
             out[(run[1], run[2], "joint" if joint else "pair")].append(base | {"terms": stored})
             if not joint:
@@ -302,8 +330,9 @@ def database_decisions(dbs, dataset=None, log=print):
         rows, root = stored_rows(db)
         root = dataset or root
         inputs = DatasetInputs(root) if root and Path(root, "dataset.json").is_file() else None
-        terms = single_terms(rows, inputs)
-        for key, pairs in decisions(rows, terms, inputs).items():
+        cache = {}
+        terms = single_terms(rows, inputs, cache)
+        for key, pairs in decisions(rows, terms, inputs, cache).items():
             for p in pairs:
                 p.update(person=f"{k}:{p['person']}", skull=f"{k}:{p['skull']}",
                          run=(k,) + tuple(p["run"]))

@@ -15,7 +15,9 @@ from ..methods.checks import scd_point_mm
 from ..methods.lilium_terms import PllTerm, TermOff
 from ..softtissue.depths import depth_stats
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
+from .cohort import cohort_terms
 from .terms import (
+    PHOTO_TERMS,
     TERM_NAMES,
     eye_corner_px,
     landmark_chi2,
@@ -65,7 +67,8 @@ def image_consistency(skull, photo, camera, eye_px):
 
 
 def identification_terms(
-    skull, photos, cameras, facial_landmarks_mm, depth_table=None, image=None
+    skull, photos, cameras, facial_landmarks_mm, depth_table=None, image=None, cohort=None,
+    cohort_cache=None,
 ):
     """The identification terms of one SFO result.
 
@@ -85,6 +88,13 @@ def identification_terms(
         Per photo, ``(outside_fraction, pll_face)`` already known (e.g. from the photo's own
         SFO when several are combined); computed for a photo whose entry is None, or for every
         photo when not given.
+    cohort : Cohort, optional
+        Other people's skulls (:mod:`lilium.identification.cohort`): without it
+        ``cohort_mean`` and ``cohort_sd`` are None.
+    cohort_cache : dict, optional
+        Cohort terms already computed, by the photos and their landmark names: the cohort
+        terms describe the photos, so scoring many skulls against one photo computes them
+        once (the first skull's camera starts the cohort's fits).
 
     Returns
     -------
@@ -106,6 +116,13 @@ def identification_terms(
         point = scd_point_mm(facial_landmarks_mm) if facial_landmarks_mm else corr.cranial_mm[0]
         excess.append(prior_excess(camera, photo.priors, point))
     chi2, nll = landmark_chi2(views)
+    cohort_mean = cohort_sd = None
+    if cohort is not None and np.isfinite(chi2):
+        key = tuple((id(p), v.names) for p, v in zip(photos, views, strict=True))
+        cache = {} if cohort_cache is None else cohort_cache
+        if key not in cache:
+            cache[key] = cohort_terms(views, cohort)
+        cohort_mean, cohort_sd = cache[key]
     st = _soft_tissue_term(skull, facial_landmarks_mm or {}, depth_table)
 
     def mean(values):
@@ -122,6 +139,8 @@ def identification_terms(
             if any(e is not None for e in excess)
             else None
         ),
+        cohort_mean=cohort_mean,
+        cohort_sd=cohort_sd,
     )
     assert tuple(out) == TERM_NAMES
     out["nll"] = nll
@@ -131,8 +150,9 @@ def identification_terms(
 
 def nll_score(terms):
     """The unweighted identification score (lower = more likely the same person): the
-    landmarks' chi^2 per coordinate plus the other terms as they are (a None counts 0)."""
-    return float(sum(terms[k] or 0.0 for k in TERM_NAMES))
+    landmarks' chi^2 per coordinate plus the other terms of the skull as they are (a None
+    counts 0; the cohort terms describe the photo and are left out)."""
+    return float(sum(terms[k] or 0.0 for k in TERM_NAMES if k not in PHOTO_TERMS))
 
 
 def cameras_of(result):

@@ -31,6 +31,10 @@ The terms (all "lower is better", dimensionless):
 - ``prior_excess``: how far the camera lies outside its priors, relative to each prior
   (focal and distance as a fraction of the bound, the head angle in units of its tolerance),
   squared and summed.
+- ``cohort_mean``, ``cohort_sd``: not about the skull but about the photo(s): the mean and SD
+  of ``ln landmark_chi2`` of a cohort of other people's skulls, each under its own best
+  camera (:mod:`lilium.identification.cohort`); they let the calibration read a
+  ``landmark_chi2`` against what this photo gives any skull.
 
 A term whose input is missing (no mask, no curve, no prior) is None; the calibration
 (:mod:`lilium.identification.calibration`) reads a None as the term's typical value and says so.
@@ -62,13 +66,31 @@ DIRECTION_SD_DEG = 15.0
 BONE_SD_MM = 1.0
 
 #: Order of the terms.
-TERM_NAMES = ("landmark_chi2", "soft_tissue_z2", "outside_fraction", "pll_face", "prior_excess")
+TERM_NAMES = (
+    "landmark_chi2",
+    "soft_tissue_z2",
+    "outside_fraction",
+    "pll_face",
+    "prior_excess",
+    "cohort_mean",
+    "cohort_sd",
+)
+
+#: The terms about the photo(s) rather than the skull (left out of the unweighted score).
+PHOTO_TERMS = ("cohort_mean", "cohort_sd")
 
 #: The terms the calibration uses. ``soft_tissue_z2`` is reported but left out: measured on 20
 #: generated subjects (docs/method.md, Identification) it lowered Lilium's frontal per-photo
 #: AUC from 0.963 to 0.939; the soft tissue's plausibility is already in the marginal
 #: landmark term.
-CALIBRATED_TERMS = ("landmark_chi2", "outside_fraction", "pll_face", "prior_excess")
+CALIBRATED_TERMS = (
+    "landmark_chi2",
+    "outside_fraction",
+    "pll_face",
+    "prior_excess",
+    "cohort_mean",
+    "cohort_sd",
+)
 
 
 @dataclass(frozen=True)
@@ -161,6 +183,15 @@ def _mean_points_and_jacobians(view):
     return residual, jac_cam @ cam.R, z
 
 
+def landmark_sigma_px(view):
+    """The 2D error ``(N,)`` (pixels per coordinate) of each landmark of a view: its source's
+    fraction of the eye-corner distance, never below :data:`SIGMA_FLOOR_PX`."""
+    fraction = [SIGMA_FRACTION.get(s, SIGMA_FRACTION["manual"]) for s in view.sources]
+    return np.maximum(
+        SIGMA_FLOOR_PX, np.array(fraction) * eye_corner_px(view.camera, view.cranial_mm)
+    )
+
+
 def landmark_chi2(views):
     """The marginal landmark term over one or several photos of one person.
 
@@ -186,11 +217,7 @@ def landmark_chi2(views):
         residual, jac, z = _mean_points_and_jacobians(view)
         if not np.all(z > 0) or not np.all(np.isfinite(residual)):
             return np.inf, np.inf
-        sigma_px = np.maximum(
-            SIGMA_FLOOR_PX,
-            np.array([SIGMA_FRACTION.get(s, SIGMA_FRACTION["manual"]) for s in view.sources])
-            * eye_corner_px(view.camera, view.cranial_mm),
-        )
+        sigma_px = landmark_sigma_px(view)
         cov = soft_tissue_covariance(view.axes, view.depth_mean_mm, view.depth_sd_mm)
         for k, name in enumerate(view.names):
             by_name.setdefault(name, []).append((residual[k], jac[k], sigma_px[k], cov[k]))

@@ -7,12 +7,20 @@ A calibration file is JSON: ``{"format": "lilium-calibration", "version": 1, "mo
 The package ships one (``lilium/data/calibration.json``, fitted by ``lilium calibrate`` on
 generated subjects; its provenance says how); ``lilium calibrate DB`` writes another, and
 ``--calibration FILE`` makes a command use it.
+
+A cohort file (``lilium/data/cohort.json``, format ``lilium-cohort``) holds the cranial
+landmarks and soft-tissue axes of other people's skulls, the reference the identification
+reads a photo's landmark fit against (:mod:`lilium.identification.cohort`).
 """
 
+from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
+
 from ..identification.calibration import Calibration
+from ..identification.cohort import Cohort
 from .jsonio import read_json, write_json
 
 #: The ``format`` field of a calibration file.
@@ -21,10 +29,54 @@ FORMAT = "lilium-calibration"
 #: The calibration shipped with the package.
 SHIPPED = "calibration.json"
 
+#: The ``format`` field of a cohort file, and the cohort shipped with the package.
+COHORT_FORMAT = "lilium-cohort"
+SHIPPED_COHORT = "cohort.json"
 
-def shipped_path():
-    """Path of the package's own calibration file."""
-    return Path(str(resources.files("lilium") / "data" / SHIPPED))
+
+def shipped_path(name=SHIPPED):
+    """Path of one of the package's own files (the calibration by default)."""
+    return Path(str(resources.files("lilium") / "data" / name))
+
+
+def read_cohort(path=None):
+    """The :class:`~lilium.identification.cohort.Cohort` of a cohort file (the shipped one by
+    default).
+
+    Raises
+    ------
+    ValueError
+        Not a cohort file, or a skull without landmarks or axes, naming the file.
+    """
+    path = shipped_path(SHIPPED_COHORT) if path is None else Path(path)
+    data = read_json(path)
+    if not isinstance(data, dict) or data.get("format") != COHORT_FORMAT:
+        raise ValueError(f"{path}: not a Lilium cohort file (no \"format\": \"{COHORT_FORMAT}\")")
+    landmarks, axes = [], []
+    for k, skull in enumerate(data.get("skulls") or []):
+        try:
+            landmarks.append({n: np.asarray(v, float) for n, v in skull["landmarks"].items()})
+            axes.append({n: np.asarray(v, float) for n, v in skull["axes"].items()})
+        except (KeyError, TypeError, AttributeError, ValueError):
+            raise ValueError(f"{path}: skull {k} needs \"landmarks\" and \"axes\"") from None
+    return Cohort(tuple(landmarks), tuple(axes), dict(data.get("provenance") or {}))
+
+
+@lru_cache(maxsize=1)
+def shipped_cohort():
+    """The package's own cohort, read once per process."""
+    return read_cohort()
+
+
+def write_cohort(path, cohort):
+    """Write a :class:`~lilium.identification.cohort.Cohort` as a cohort file."""
+    skulls = [
+        {"landmarks": {n: np.asarray(v).tolist() for n, v in lm.items()},
+         "axes": {n: np.asarray(v).tolist() for n, v in ax.items()}}
+        for lm, ax in zip(cohort.landmarks_mm, cohort.axes, strict=True)
+    ]
+    write_json(path, {"format": COHORT_FORMAT, "version": 1, "provenance": cohort.provenance,
+                      "skulls": skulls})
 
 
 def read_calibration(path=None):

@@ -1,0 +1,233 @@
+"""Cohort normalisation of the landmark term (SPEC section 12): how well does this photo fit
+*this* skull compared with how well it fits other people's skulls?
+
+The marginal landmark term ``landmark_chi2`` (:mod:`lilium.identification.terms`) varies from
+photo to photo for reasons that have nothing to do with the skull: the view, how many
+landmarks are visible, how sharp they are. Measured on 40 generated subjects, that spread
+across photos, not the ranking within a photo, is what kept the pooled calibration poor
+(docs/method.md, Identification). Speaker and face recognition meet the same problem and
+answer it with test normalisation ("T-norm"): score the same observation against a cohort of
+impostor models and express the candidate's score in the cohort's units.
+
+Here the cohort is a set of skulls, each a set of cranial landmarks and soft-tissue axes
+(no mesh: the landmark term needs none). For each cohort skull:
+
+1. it is moved onto the candidate skull (rigid Kabsch fit of their common landmarks), so the
+   SFO's camera is a starting camera for it;
+2. that camera is refitted to the photo's landmarks under the same marginal likelihood (a
+   batched Levenberg-Marquardt over rotation, translation and log focal, all cohort skulls at
+   once): the best any camera does for that skull;
+3. its ``landmark_chi2`` is computed with the refitted camera(s) (several photos of one person
+   still share their soft tissue).
+
+The mean and the SD of ``ln chi2_j`` over the cohort are two terms of the identification
+(``cohort_mean``, ``cohort_sd``): they change nothing in how the skulls of one photo rank, and
+tell the calibration how far this photo's ``landmark_chi2`` values spread. Test normalisation
+proper (dividing the candidate's term by them) was measured too and lost to letting the
+calibration weigh them (docs/method.md, Identification).
+
+Maths only: the shipped cohort is read by :mod:`lilium.io.calibration`.
+"""
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..geometry.camera import Camera
+from ..geometry.rotations import rotvec_to_matrix
+from .terms import landmark_chi2, landmark_sigma_px, soft_tissue_covariance
+
+#: Levenberg-Marquardt iterations of a camera refit.
+REFIT_ITERATIONS = 25
+
+#: Finite-difference steps of the refit's parameters: rotation vector (rad), translation (mm),
+#: log focal.
+FD_STEPS = np.array([1e-4, 1e-4, 1e-4, 1e-2, 1e-2, 1e-2, 1e-4])
+
+#: Fewest cohort skulls a normalisation needs.
+MIN_COHORT = 5
+
+
+@dataclass(frozen=True)
+class Cohort:
+    """Skulls of other people, as landmarks only.
+
+    Attributes
+    ----------
+    landmarks_mm : tuple of dict
+        Per skull, cranial name -> ``(3,)`` point (each skull in its own frame).
+    axes : tuple of dict
+        Per skull, cranial name -> unit ``(3,)`` soft-tissue axis.
+    provenance : dict
+    """
+
+    landmarks_mm: tuple
+    axes: tuple
+    provenance: dict = field(default_factory=dict)
+
+    def __len__(self):
+        return len(self.landmarks_mm)
+
+
+def kabsch(source_mm, target_mm):
+    """Rigid ``(R, t)`` with ``target ~ source @ R.T + t`` (least squares, no reflection).
+
+    Parameters
+    ----------
+    source_mm, target_mm : ndarray of shape (N, 3)
+    """
+    cs, ct = source_mm.mean(axis=0), target_mm.mean(axis=0)
+    H = (source_mm - cs).T @ (target_mm - ct)
+    U, _, Vt = np.linalg.svd(H)
+    d = np.sign(np.linalg.det(Vt.T @ U.T))
+    R = Vt.T @ np.diag([1.0, 1.0, d]) @ U.T
+    return R, ct - cs @ R.T
+
+
+def _whitened(R, t, f, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
+    """Whitened residuals ``(K, 2N)`` of K skulls under K cameras (R ``(K,3,3)``, t ``(K,3)``,
+    f ``(K,)``); the marginal covariance ``S = J Sigma J^T + sigma^2 I`` of each landmark
+    whitens its residual, so the squared norm is ``sum r^T S^-1 r``."""
+    points = cranial + mean_mm[None, :, None] * axes
+    X = np.einsum("kij,knj->kni", R, points) + t[:, None, :]
+    z = X[..., 2]
+    bad = ~(z > 0).all(axis=1)
+    z = np.where(z > 0, z, np.nan)
+    fz = f[:, None] / z
+    r = uv[None] - (X[..., :2] * fz[..., None] + pp)
+    J = np.zeros(X.shape[:2] + (2, 3))
+    J[..., 0, 0] = J[..., 1, 1] = fz
+    J[..., 0, 2] = -fz * X[..., 0] / z
+    J[..., 1, 2] = -fz * X[..., 1] / z
+    J = J @ R[:, None]
+    sigma = soft_tissue_covariance(axes.reshape(-1, 3), np.tile(mean_mm, len(R)),
+                                   np.tile(sd_mm, len(R))).reshape(J.shape[:2] + (3, 3))
+    S = J @ sigma @ np.swapaxes(J, -1, -2)
+    S[..., 0, 0] += sigma_px**2
+    S[..., 1, 1] += sigma_px**2
+    a = np.sqrt(S[..., 0, 0])
+    b = S[..., 1, 0] / a
+    c = np.sqrt(np.maximum(S[..., 1, 1] - b**2, 1e-12))
+    w0 = r[..., 0] / a
+    w = np.stack([w0, (r[..., 1] - b * w0) / c], axis=-1).reshape(len(R), -1)
+    w[bad | ~np.isfinite(w).all(axis=1)] = 1e3
+    return w
+
+
+def _cameras(R0, t0, f0, p):
+    return rotvec_to_matrix(p[:, :3]) @ R0, t0 + p[:, 3:6], f0 * np.exp(p[:, 6])
+
+
+def refit_cameras(R0, t0, f0, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
+    """Refit K cameras, one per skull, to one photo's landmarks under the marginal likelihood.
+
+    Parameters
+    ----------
+    R0 : ndarray of shape (K, 3, 3)
+    t0 : ndarray of shape (K, 3)
+    f0 : ndarray of shape (K,)
+        Starting cameras (skull frame to camera frame, mm, px).
+    pp : ndarray of shape (2,)
+        Principal point (kept).
+    cranial, axes : ndarray of shape (K, N, 3)
+        Each skull's cranial landmarks and unit soft-tissue axes.
+    mean_mm, sd_mm : ndarray of shape (N,)
+        Population depth statistics.
+    uv : ndarray of shape (N, 2)
+        The photo's facial landmarks.
+    sigma_px : ndarray of shape (N,)
+        The landmarks' 2D errors (kept fixed).
+
+    Returns
+    -------
+    R : ndarray of shape (K, 3, 3)
+    t : ndarray of shape (K, 3)
+    f : ndarray of shape (K,)
+    """
+    K = len(R0)
+    args = (pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px)
+    p = np.zeros((K, 7))
+    w = _whitened(*_cameras(R0, t0, f0, p), *args)
+    cost = np.sum(w**2, axis=1)
+    lam = np.full(K, 1e-3)
+    for _ in range(REFIT_ITERATIONS):
+        J = np.empty((K, w.shape[1], 7))
+        for j in range(7):
+            q = p.copy()
+            q[:, j] += FD_STEPS[j]
+            J[:, :, j] = (_whitened(*_cameras(R0, t0, f0, q), *args) - w) / FD_STEPS[j]
+        JtJ = np.swapaxes(J, 1, 2) @ J
+        g = np.einsum("kmj,km->kj", J, w)
+        A = JtJ + lam[:, None, None] * (np.eye(7) * np.diagonal(JtJ, axis1=1, axis2=2)[:, None]
+                                        + 1e-9 * np.eye(7))
+        step = -np.linalg.solve(A, g[..., None])[..., 0]
+        trial = p + step
+        w_trial = _whitened(*_cameras(R0, t0, f0, trial), *args)
+        cost_trial = np.sum(w_trial**2, axis=1)
+        better = cost_trial < cost
+        p[better], w[better], cost[better] = trial[better], w_trial[better], cost_trial[better]
+        lam = np.where(better, lam * 0.3, lam * 10.0)
+    return _cameras(R0, t0, f0, p)
+
+
+def cohort_chi2(views, cohort):
+    """``landmark_chi2`` of every cohort skull against the photos of ``views``.
+
+    Parameters
+    ----------
+    views : sequence of View
+        The candidate's views (its correspondences and SFO cameras), one per photo.
+    cohort : Cohort
+
+    Returns
+    -------
+    ndarray of shape (K',)
+        One value per cohort skull that has every landmark the views use (the others are
+        left out).
+    """
+    names = sorted({n for v in views for n in v.names})
+    members = [k for k in range(len(cohort)) if all(
+        n in cohort.landmarks_mm[k] and n in cohort.axes[k] for n in names)]
+    if not members:
+        return np.empty(0)
+    candidate = {n: c for v in views for n, c in zip(v.names, v.cranial_mm, strict=True)}
+    target = np.array([candidate[n] for n in names])
+    cohort_views = [[] for _ in members]
+    for view in views:
+        cam = view.camera
+        R0, t0, cranial, axes = [], [], [], []
+        for k in members:
+            source = np.array([cohort.landmarks_mm[k][n] for n in names])
+            Ra, ta = kabsch(source, target)  # cohort frame -> candidate frame
+            R0.append(cam.R @ Ra)
+            t0.append(cam.R @ ta + cam.t)
+            cranial.append([cohort.landmarks_mm[k][n] for n in view.names])
+            axes.append([cohort.axes[k][n] for n in view.names])
+        cranial = np.array(cranial, float)
+        axes = np.array(axes, float)
+        axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
+        R, t, f = refit_cameras(
+            np.array(R0), np.array(t0), np.full(len(members), cam.focal_px),
+            cam.principal_point_px, cranial, axes, view.depth_mean_mm, view.depth_sd_mm,
+            view.uv_px, landmark_sigma_px(view),
+        )
+        for j in range(len(members)):
+            cohort_views[j].append(replace(
+                view, camera=Camera.from_rt(R[j], t[j], f[j], cam.principal_point_px),
+                cranial_mm=cranial[j], axes=axes[j],
+            ))
+    return np.array([landmark_chi2(v)[0] for v in cohort_views])
+
+
+def cohort_terms(views, cohort):
+    """The cohort's fit to the photo(s): mean and SD of ``ln landmark_chi2`` over the cohort
+    skulls (None, None when fewer than :data:`MIN_COHORT` have the views' landmarks).
+
+    They describe the photo, not the candidate skull: how hard it is for any skull to fit
+    these landmarks. The calibration reads them beside the candidate's own ``landmark_chi2``.
+    """
+    values = cohort_chi2(views, cohort)
+    values = np.log(values[np.isfinite(values) & (values > 0)])
+    if len(values) < MIN_COHORT:
+        return None, None
+    return float(values.mean()), float(max(values.std(), 1e-6))
