@@ -296,3 +296,31 @@ def test_cohort_reads_a_photo_against_other_skulls(tmp_path):
         read_cohort(tmp_path / "bad.json")
     # A cohort without the views' landmarks gives no terms.
     assert cohort_terms([view], Cohort(({"x": np.zeros(3)},), ({"x": np.ones(3)},))) == (None, None)
+
+
+def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path):
+    """Separate SFOs of one frontal and one lateral photo: the decision's log10 LR is the sum
+    of the two photos' own (each from its view's model); other sets use the pair model."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from lilium.casework.identify import Calibrations, identify
+    from lilium.io.case import read_photo, read_skull
+
+    subject_dir, photo_dir = case
+    assert main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
+                 "--photo", str(photo_dir), "--out", str(tmp_path / "out")]) == 0
+    data = json.loads((tmp_path / "out" / "result.json").read_text())
+    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[],
+                             camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
+    skull, frontal = read_skull(subject_dir), read_photo(photo_dir)
+    lateral = replace(frontal, view="lateral_left")  # the same landmarks, scored as lateral
+    calibrations = Calibrations()
+    one = [identify(skull, [p], [result], calibrations) for p in (frontal, lateral)]
+    both = identify(skull, [frontal, lateral], [result, result], calibrations)
+    assert both["calibration"]["model"] == "posest-sfo//frontal + posest-sfo//lateral"
+    assert both["log10_lr"] == pytest.approx(one[0]["log10_lr"] + one[1]["log10_lr"])
+    assert "single_photo" not in both["caps"]
+    two_frontal = identify(skull, [frontal, frontal], [result, result], calibrations)
+    assert two_frontal["calibration"]["model"] == "posest-sfo//pair"
+    assert "these photos differ" in two_frontal["note"]

@@ -3,10 +3,14 @@ the conclusion, for one photo, a joint SFO, or a person's photos taken together.
 
 Which calibration model a decision uses (``lilium/data/calibration.json`` unless the user
 gives another): ``<method>/<variant>/frontal`` or ``/lateral`` for one photo,
-``lilium-joint/<variant>/joint`` for a joint SFO, ``<method>/<variant>/pair`` for separate
-SFOs of two or more photos (fitted on a frontal and a lateral photo; used for any two or more
-photos, and the result says so). Without a model for the decision the LR is not given and the
-conclusion is "undetermined", naming the model missing and how to fit it.
+``lilium-joint/<variant>/joint`` for a joint SFO. Separate SFOs of one frontal and one lateral
+photo add the two photos' log10 LRs (each from its own view's model): measured on 40
+generated subjects this beat one model of both photos with their soft tissue shared (Cllr
+0.34 against 0.45, per-photo AUC 0.983 against 0.978; docs/method.md), although the two photos
+are not independent evidence. Any other two or more photos use ``<method>/<variant>/pair``
+(that shared-soft-tissue model, fitted on a frontal and a lateral photo; the result says so).
+Without a model for the decision the LR is not given and the conclusion is "undetermined",
+naming the model missing and how to fit it.
 """
 
 from dataclasses import replace
@@ -31,14 +35,25 @@ class Calibrations:
         return self.models.get(key)
 
 
+def _group(photo):
+    return "frontal" if photo.view == "frontal" else "lateral"
+
+
+def adds_views(photos, joint=False):
+    """Whether the decision adds a frontal and a lateral photo's LRs (module docstring)."""
+    return not joint and sorted(_group(p) for p in photos) == ["frontal", "lateral"]
+
+
 def decision_key(method, variant, photos, joint=False):
-    """The calibration key of a decision (module docstring)."""
+    """The calibration key of a decision (module docstring); for a frontal and a lateral
+    photo taken separately, the two keys joined by ``+``."""
     if joint:
         return f"lilium-joint/{variant or ''}/joint"
+    if adds_views(photos):
+        return " + ".join(f"{method}/{variant or ''}/{_group(p)}" for p in photos)
     if len(photos) > 1:
         return f"{method}/{variant or ''}/pair"
-    group = "frontal" if photos[0].view == "frontal" else "lateral"
-    return f"{method}/{variant or ''}/{group}"
+    return f"{method}/{variant or ''}/{_group(photos[0])}"
 
 
 def _inconsistent(results, terms):
@@ -115,7 +130,18 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
     )
     model = calibrations.get(key)
     note = ""
-    if model is None:
+    if adds_views(photos, joint):
+        parts = [
+            identify(skull, [p], [r], calibrations, facial) for p, r in zip(photos, results,
+                                                                            strict=True)
+        ]
+        lrs = [part["log10_lr"] for part in parts]
+        lr = None if None in lrs else float(sum(lrs))
+        note = "; ".join(part["note"] for part in parts if part["note"]) or (
+            "the frontal and the lateral photo's log10 LRs added"
+        )
+        record["calibration"]["provenance"] = parts[0]["calibration"].get("provenance")
+    elif model is None:
         lr = None
         note = (
             f"no calibration for {key} in {calibrations.path}: fit one with lilium calibrate "
@@ -125,8 +151,7 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
     else:
         lr = float(model.log10_lr([terms])[0])
         record["calibration"]["provenance"] = model.provenance
-        views = sorted("frontal" if p.view == "frontal" else "lateral" for p in photos)
-        if len(photos) > 1 and not joint and views != ["frontal", "lateral"]:
+        if len(photos) > 1 and not joint:
             note = "calibrated on one frontal and one lateral photo; these photos differ"
     inconsistent = _inconsistent(results, terms)
     verdict = conclude(lr, caps, inconsistent)

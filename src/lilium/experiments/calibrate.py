@@ -15,7 +15,8 @@ photo once.
   the other terms add up; calibrated as a model of its own;
 - ``pair_sum``: the same two SFOs' cross-validated log10 LRs added, i.e. as if the photos
   were independent evidence (they are not: they share the soft tissue); measured beside
-  ``pair`` to show which is better, never shipped;
+  ``pair``, and better (docs/method.md), so it is what a case with one frontal and one lateral
+  photo reports (:mod:`lilium.casework.identify`); it needs no model of its own;
 - ``joint``: a joint SFO (SPEC section 9) of the pair: its shared soft tissue and two cameras.
 """
 
