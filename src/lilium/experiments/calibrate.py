@@ -220,6 +220,8 @@ def decisions(rows, terms, inputs=None, cohort_cache=None):
                         photo=fr["photo"], run=run)
             if ft is None or lt is None:
                 out[(run[1], run[2], "joint" if joint else "pair")].append(base | {"terms": None})
+                if not joint:  # a failed SFO: ranked last, counted as failed
+                    out[(run[1], run[2], "pair_sum")].append(base | {"parts": (ft, lt)})
                 continue
             stored = (fr["data"] or {}).get(TERMS_KEY + "_joint") if joint else None
             if not _complete(stored):
