@@ -34,7 +34,7 @@ def decision_label(method, variant, decision):
     label = method_label(method, variant)
     return {
         "pair": f"{label}, separate SFOs, shared soft tissue",
-        "pair_sum": f"{label}, separate SFOs, LRs added (independence)",
+        "pair_sum": f"{label}, separate SFOs, LRs added",
     }.get(decision, label)
 
 
@@ -109,11 +109,13 @@ def plot_tippett(validated, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    keys = [k for k in sorted(validated) if k[2] != "pair_sum"]
-    fig, axes = plt.subplots(
-        1, max(len(keys), 1), figsize=(3.6 * max(len(keys), 1), 3.6), squeeze=False
-    )
-    for ax, key in zip(axes[0], keys, strict=False):
+    keys = sorted(validated)
+    cols = min(max(len(keys), 1), 4)
+    rows = -(-max(len(keys), 1) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.6 * rows), squeeze=False)
+    for ax in axes.ravel()[len(keys):]:
+        ax.set_visible(False)
+    for ax, key in zip(axes.ravel(), keys, strict=False):
         lr = validated[key]["log10_lr"]
         same = validated[key]["same"]
         ok = np.isfinite(lr)
