@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+from lilium.casework.identify import conclusion_line
 from lilium.cli.main import main
 from lilium.geometry.camera import Camera
 from lilium.identification.calibration import (
@@ -136,7 +137,9 @@ def test_conclusion_scale_caps_and_consistency():
     assert set(caps) == {"no_mandible", "single_photo"}
     capped = conclude(2.5, caps)
     assert capped.label == "limited support" and capped.uncapped == "strong support"
-    assert "no mandible" in capped.sentence
+    assert "no mandible" in conclusion_line(
+        {"conclusion": capped.label, "conclusion_uncapped": capped.uncapped, "caps": caps,
+         "log10_lr": 2.5, "inconsistent": {}})
     four = material_caps(False, 1, True, 6)
     assert conclude(3.0, four).label == "undetermined"
     assert conclude(-2.5, four).label == "strong support for exclusion"  # exclusion uncapped

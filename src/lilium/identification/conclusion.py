@@ -116,15 +116,6 @@ class Conclusion:
     caps: dict
     inconsistent: dict
 
-    @property
-    def sentence(self):
-        """One line: the label, and why it is lower than the LR alone, if it is."""
-        why = []
-        if self.label != self.uncapped:
-            why += list(self.inconsistent.values()) + list(self.caps.values())
-        return self.label + (f" (capped from {self.uncapped}: " + "; ".join(why) + ")"
-                             if why else "")
-
 
 def conclude(log10_lr, caps=None, inconsistent=None):
     """The conclusion of a log10 LR under the material caps and consistency failures.
