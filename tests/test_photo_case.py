@@ -180,14 +180,14 @@ def test_auto_landmarks_prepares_a_bare_photo_in_the_output_folder(
     assert sorted(p.name for p in portrait.parent.iterdir()) == before  # nothing beside it
     prepared = out / "astronaut" / "prepared"
     assert (prepared / "photo.json").is_file() and (prepared / "review.html").is_file()
-    assert "astronaut: lilium photo: 10 tracked and 11 template landmarks" in stdout
+    assert "astronaut: lilium photo: 12 tracked and 9 template landmarks" in stdout
     result = _result(out, "astronaut", "posest-sfo")
     assert {v["source"] for v in result["priors"].values()} == {"automatic"}
     sources = json.loads((prepared / "photo.json").read_text())["landmark_sources"]
     used = result["landmark_error"]["per_landmark_px"]
     assert all(sources[k]["quality"] == "tracked" for k in used)
     text = (out / "report.html").read_text()
-    line = "facial landmarks automatic, unreviewed: all 10 placed by lilium photo"
+    line = "facial landmarks automatic, unreviewed: all 12 placed by lilium photo"
     assert f"Photo <b>astronaut</b>: {line}" in text
     assert "check them in astronaut/prepared/review.html" in text  # relative: the folder moves
     assert '<a href="astronaut/prepared/review.html">review page</a>' in text
