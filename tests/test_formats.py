@@ -210,3 +210,99 @@ def test_subject_folder_with_a_slicer_file_instead_of_the_json(case):
     (subject_dir / "skull.fcsv").rename(subject_dir / "mine.fcsv")
     with pytest.raises(ValueError, match=r"several landmark files \(mine.fcsv, other.pp\)"):
         read_skull(subject_dir)
+
+
+def _fcsv(path, system_line, points):
+    lines = ["# Markups fiducial file version = 4.11"] + ([system_line] if system_line else [])
+    lines.append("# columns = id,x,y,z,ow,ox,oy,oz,vis,sel,lock,label,desc,associatedNodeID")
+    for k, (name, (x, y, z)) in enumerate(points.items()):
+        lines.append(f"vtkMRMLMarkupsFiducialNode_{k},{x},{y},{z},0,0,0,1,1,1,0,{name},,")
+    return _write(path, "\n".join(lines) + "\n")
+
+
+def _mrk(path, *systems):
+    """A ``.mrk.json`` with one point list per system (None: no ``coordinateSystem`` key)."""
+    markups = []
+    for system in systems:
+        markup = {"type": "Fiducial", "coordinateUnits": "mm", "controlPoints": []}
+        if system is not None:
+            markup["coordinateSystem"] = system
+        markups.append(markup)
+    names = list(POINTS)
+    for k, name in enumerate(names):
+        point = {"label": name, "position": POINTS[name], "positionStatus": "defined"}
+        markups[k % len(markups)]["controlPoints"].append(point)
+    return _write(path, json.dumps({"markups": markups}))
+
+
+@pytest.mark.parametrize(
+    ("system_line", "sign"),
+    [
+        (None, 1),  # states none: LPS, Slicer's default (as lilium import-ct reads it)
+        ("# CoordinateSystem = LPS", 1),
+        ("# CoordinateSystem = 1", 1),
+        ("# CoordinateSystem = RAS", -1),
+        ("# CoordinateSystem = 0", -1),
+    ],
+)
+def test_slicer_fcsv_frames(tmp_path, system_line, sign):
+    points = read_landmarks(_fcsv(tmp_path / "s.fcsv", system_line, POINTS), "cranial")
+    for name, value in POINTS.items():
+        np.testing.assert_allclose(points[name], np.array(value) * [sign, sign, 1])
+
+
+@pytest.mark.parametrize("system", [None, "", "LPS", "RAS"])
+def test_slicer_mrk_json_frames(tmp_path, system):
+    points = read_landmarks(_mrk(tmp_path / "s.mrk.json", system), "cranial")
+    sign = -1 if system == "RAS" else 1  # no key or "": LPS, the schema's default
+    np.testing.assert_allclose(points["nasion"], np.array(POINTS["nasion"]) * [sign, sign, 1])
+
+
+def test_a_slicer_frame_slicer_does_not_write_is_refused(tmp_path):
+    fcsv = _fcsv(tmp_path / "s.fcsv", "# CoordinateSystem = XYZ", POINTS)
+    with pytest.raises(ValueError, match=r"s\.fcsv: coordinate system 'XYZ' is not one 3D Slicer"):
+        read_landmarks(fcsv, "cranial")
+    mrk = _mrk(tmp_path / "s.mrk.json", "IJK")
+    with pytest.raises(ValueError, match=r"'IJK' .* e\.g\. \"coordinateSystem\": \"LPS\""):
+        read_landmarks(mrk, "cranial")
+    mixed = _mrk(tmp_path / "m.mrk.json", "LPS", "RAS")
+    with pytest.raises(ValueError, match=r"markups\[0\] is in LPS and markups\[1\] in RAS"):
+        read_landmarks(mixed, "cranial")
+    broken = _write(tmp_path / "b.mrk.json", json.dumps({"markups": [{"controlPoints": {"x": 1}}]}))
+    with pytest.raises(ValueError, match=r"controlPoints is not a list of points"):
+        read_landmarks(broken, "cranial")
+
+
+def test_lilium_case_reads_slicer_frames_as_import_ct_does(case, tmp_path, capsys):
+    """Issue 25: an unknown CoordinateSystem was read as LPS by ``lilium case``; now it is
+    refused in one line (as ``lilium import-ct`` refuses it), an absent one is LPS and RAS is
+    converted."""
+    from cli_helpers import _one_line_error, _run
+
+    subject_dir, photo_dir = case
+    cranial = json.loads((subject_dir / "cranial_landmarks.json").read_text())["landmarks"]
+    ras = {k: [-v[0], -v[1], v[2]] for k, v in cranial.items()}
+
+    def argv(landmarks, out):
+        files = ["--skull", subject_dir / "skull.ply", "--landmarks", landmarks]
+        return [
+            "case",
+            *files,
+            "--photo",
+            photo_dir,
+            "--method",
+            "posest-sfo",
+            "--out",
+            tmp_path / out,
+        ]
+
+    bad = _fcsv(tmp_path / "skull.fcsv", "# CoordinateSystem = XYZ", cranial)
+    _one_line_error(capsys, argv(bad, "o1"), bad, "coordinate system 'XYZ'", "LPS or RAS")
+    for name, system, points in [("none", None, cranial), ("ras", "# CoordinateSystem = RAS", ras)]:
+        landmarks = _fcsv(tmp_path / f"{name}.fcsv", system, points)
+        code, _, err = _run(argv(landmarks, name), capsys)
+        assert code == 0, err
+        result = json.loads(
+            (tmp_path / name / "standin_frontal" / "posest-sfo" / "result.json").read_text()
+        )
+        assert result["camera"] is not None and result["landmark_error"]["mean_px"] < 5

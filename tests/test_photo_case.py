@@ -15,7 +15,7 @@ import pytest
 from PIL import Image
 from PIL.TiffImagePlugin import IFDRational
 
-from cli_helpers import _run
+from cli_helpers import _edit_json, _run
 from lilium.cli.main import main
 from lilium.geometry.rotations import geodesic_angle_deg
 from standin_case import make_standin_case
@@ -31,7 +31,6 @@ needs_litert = pytest.mark.skipif(not HAVE_LITERT, reason="needs lilium[photo] (
 
 #: A DE budget that only shows the flow.
 SMALL_DE = ["--generations", "3", "--population", "16"]
-
 
 
 def _result(out, photo_id, tag):
@@ -180,14 +179,14 @@ def test_auto_landmarks_prepares_a_bare_photo_in_the_output_folder(
     assert sorted(p.name for p in portrait.parent.iterdir()) == before  # nothing beside it
     prepared = out / "astronaut" / "prepared"
     assert (prepared / "photo.json").is_file() and (prepared / "review.html").is_file()
-    assert "astronaut: lilium photo: 10 tracked and 11 template landmarks" in stdout
+    assert "astronaut: lilium photo: 12 tracked and 9 template landmarks" in stdout
     result = _result(out, "astronaut", "posest-sfo")
     assert {v["source"] for v in result["priors"].values()} == {"automatic"}
     sources = json.loads((prepared / "photo.json").read_text())["landmark_sources"]
     used = result["landmark_error"]["per_landmark_px"]
     assert all(sources[k]["quality"] == "tracked" for k in used)
     text = (out / "report.html").read_text()
-    line = "facial landmarks automatic, unreviewed: all 10 placed by lilium photo"
+    line = "facial landmarks automatic, unreviewed: all 12 placed by lilium photo"
     assert f"Photo <b>astronaut</b>: {line}" in text
     assert "check them in astronaut/prepared/review.html" in text  # relative: the folder moves
     assert '<a href="astronaut/prepared/review.html">review page</a>' in text
@@ -246,3 +245,58 @@ def test_the_landmark_line_says_what_was_reviewed(tmp_path):
     facts = PreparedFacts({"nasion": reviewed, "subnasale": reviewed}, {})
     assert landmark_origin(photo, facts).line() == "facial landmarks reviewed (2 confirmed)"
     assert landmark_origin(photo, None) is None
+
+
+@needs_litert
+def test_an_sfo_without_a_chin_pair_or_curve_says_the_chin_is_unconstrained(
+    standin, prepared, tmp_path, capsys
+):
+    """Issue 25 item 6: with only the midface points (the chin points left unconfirmed, as
+    before they were tracked) the overlay's chin can lie anywhere: result.json, the console
+    and the report say so; P_pll's chin-jaw curve or a chin pair lifts it."""
+    midface = tmp_path / "midface"
+    shutil.copytree(prepared, midface)
+
+    def chin_as_template(data):
+        for name in ("pogonion", "gnathion"):
+            data["landmark_sources"][name]["quality"] = "template"
+
+    _edit_json(midface / "photo.json", chin_as_template)
+    skull = tmp_path / "skull"  # the stand-in with the landmarks that cut P_pll's region
+    shutil.copytree(standin, skull)
+
+    def mandible(data):
+        from standin_case import SKULL_RADII_MM, _direction, _surface_point
+
+        for name, az in (("infradentale", 0), ("mental_foramen_l", 25), ("mental_foramen_r", -25)):
+            data["landmarks"][name] = _surface_point(_direction(az, -40), SKULL_RADII_MM)[
+                0
+            ].tolist()
+
+    _edit_json(skull / "cranial_landmarks.json", mandible)
+    out = tmp_path / "out"
+    argv = ["case", "--skull", skull, "--photo", midface, "--method", "posest-sfo"]
+    argv += ["--method", "lilium", "--variant", "pll", *SMALL_DE, "--out", out]
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    posest = _result(out, "midface", "posest-sfo")
+    assert not {"pogonion", "gnathion"} & set(posest["landmark_error"]["per_landmark_px"])
+    (chin,) = [w for w in posest["warnings"] if w["code"] == "chin_unconstrained"]
+    assert "no chin-jaw curve (P_pll off)" in chin["message"]
+    assert "confirmed in review.html" in chin["message"] and "--variant pll" in chin["message"]
+    assert "warning chin_unconstrained: the chin is unconstrained" in stdout
+    report = (out / "report.html").read_text()
+    assert "<code>chin_unconstrained</code>: the chin is unconstrained" in report
+    # Lilium with the chin-jaw curve of face_curve.json: P_pll holds the chin.
+    pll = _result(out, "midface", "lilium-pll")
+    assert pll["terms"]["p_pll"] is not None
+    assert "chin_unconstrained" not in [w["code"] for w in pll["warnings"]]
+    # The folder as lilium photo wrote it: pogonion and gnathion are tracked and pair.
+    out = tmp_path / "out2"
+    argv = ["case", "--skull", skull, "--photo", prepared, "--method", "posest-sfo"]
+    code, stdout, err = _run(argv + ["--out", out], capsys)
+    assert code == 0, err
+    result = _result(out, "astro", "posest-sfo")
+    assert {"pogonion", "gnathion"} <= set(result["landmark_error"]["per_landmark_px"])
+    assert "chin_unconstrained" not in [w["code"] for w in result["warnings"]]
+    assert "chin_unconstrained" not in stdout

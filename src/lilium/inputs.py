@@ -27,8 +27,9 @@ class CaseWarning:
     ----------
     code : str
         ``view_mismatch``, ``no_focal_prior``, ``no_scd_prior``, ``outside_prior``,
-        ``exif_focal_unusable``, ``implausible_prior``, ``focal_cap``, ``unknown_key`` (a key of
-        ``photo.json`` that Lilium does not read).
+        ``exif_focal_unusable``, ``implausible_prior``, ``focal_cap``, ``chin_unconstrained``
+        (no chin pair and no chin-jaw curve), ``unknown_key`` (a key of ``photo.json`` that
+        Lilium does not read).
     message : str
         What is wrong and what fixes it.
     """

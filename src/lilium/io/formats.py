@@ -23,7 +23,11 @@ Sides are the *subject's* left and right, written as a suffix or prefix in any o
 A bilateral landmark without a side is an error (the side cannot be guessed).
 
 Slicer coordinate systems: markups stored in RAS are converted to LPS (Slicer's file default,
-also the frame Slicer writes meshes in) unless told otherwise; see :func:`read_landmarks`.
+also the frame Slicer writes meshes in) unless told otherwise; see :func:`read_landmarks`. The
+rule is ``lilium import-ct``'s: a file that states no system is LPS (Slicer's default since
+4.11, and the ``.mrk.json`` schema's); a stated system Slicer does not write (neither ``LPS``,
+``RAS`` nor the old ``1``/``0``) is refused with a one-line error naming the file, the value and
+the fix, since its points would be read in a frame nobody stated.
 """
 
 import csv
@@ -439,35 +443,76 @@ def _json_entries(path, data):
     return [(name, value, where) for name, value in data.items()]
 
 
-def _slicer_system(value):
-    """Slicer writes the frame as ``LPS``/``RAS`` or, in old files, ``0`` (RAS) / ``1`` (LPS)."""
-    value = str(value).strip().upper()
-    return {"0": "RAS", "1": "LPS", "RAS": "RAS", "LPS": "LPS"}.get(value)
+#: What 3D Slicer writes as a markup's coordinate system (``0`` = RAS, ``1`` = LPS in old files).
+SLICER_SYSTEMS = {"LPS": "LPS", "RAS": "RAS", "1": "LPS", "0": "RAS"}
+
+#: The system of a Slicer markup that states none (Slicer's default since 4.11).
+SLICER_DEFAULT_SYSTEM = "LPS"
+
+
+def _slicer_system(path, value):
+    """``LPS`` or ``RAS`` from a stated Slicer coordinate system; an empty value is the default.
+
+    Raises
+    ------
+    ValueError
+        A value Slicer does not write (``XYZ``, ``2``, ...), naming the file and the fix.
+    """
+    text = str(value).strip()
+    if not text:
+        return SLICER_DEFAULT_SYSTEM
+    system = SLICER_SYSTEMS.get(text.upper())
+    if system is None:
+        example = (
+            '"coordinateSystem": "LPS"'
+            if str(path).lower().endswith(".json")
+            else "'# CoordinateSystem = LPS'"
+        )
+        raise ValueError(
+            f"{path}: coordinate system {text!r} is not one 3D Slicer writes; state LPS or "
+            f"RAS (the frame the points were placed in), e.g. {example}"
+        )
+    return system
 
 
 def _slicer_json_entries(path, data):
     markups = data.get("markups") if isinstance(data, dict) else None
     if not isinstance(markups, list) or not markups:
         raise ValueError(f"{path}: no 'markups' list; export the markups from 3D Slicer again")
-    entries, system = [], None
+    entries, systems = [], {}
     for m, markup in enumerate(markups):
-        system = _slicer_system(markup.get("coordinateSystem", "LPS")) or system
+        if not isinstance(markup, dict):
+            raise ValueError(f"{path}: markups[{m}] is not an object; export the markups again")
+        system = _slicer_system(path, markup.get("coordinateSystem", SLICER_DEFAULT_SYSTEM))
+        systems.setdefault(system, m)
         units = markup.get("coordinateUnits", "mm")
         if units not in ("mm", ["mm"]):
             raise ValueError(
                 f"{path}: markups[{m}].coordinateUnits is {units!r}; save the points in mm"
             )
-        for k, point in enumerate(markup.get("controlPoints") or []):
+        points = markup.get("controlPoints") or []
+        if not isinstance(points, list) or not all(isinstance(p, dict) for p in points):
+            raise ValueError(
+                f"{path}: markups[{m}].controlPoints is not a list of points; export the "
+                "markups from 3D Slicer again"
+            )
+        for k, point in enumerate(points):
             status = point.get("positionStatus", "defined")
             if status != "defined" or "position" not in point:
                 continue  # an unplaced or skipped point
             label = point.get("label") or point.get("id") or f"point {k + 1}"
             entries.append((label, point["position"], f"markups[{m}].controlPoints[{k}]"))
-    return entries, system
+    if len(systems) > 1:
+        (a, i), (b, j) = sorted(systems.items(), key=lambda item: item[1])
+        raise ValueError(
+            f"{path}: markups[{i}] is in {a} and markups[{j}] in {b}; save the points as one "
+            "point list (one coordinate system) from 3D Slicer"
+        )
+    return entries, next(iter(systems), SLICER_DEFAULT_SYSTEM)
 
 
 def _fcsv_entries(path, text):
-    system, columns, entries = "LPS", None, []
+    system, columns, entries = SLICER_DEFAULT_SYSTEM, None, []
     for number, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
         if not stripped:
@@ -475,7 +520,7 @@ def _fcsv_entries(path, text):
         if stripped.startswith("#"):
             key, _, value = stripped.lstrip("#").partition("=")
             if key.strip().lower() == "coordinatesystem":
-                system = _slicer_system(value) or system
+                system = _slicer_system(path, value)
             elif key.strip().lower() == "columns":
                 columns = [c.strip().lower() for c in value.split(",")]
             continue

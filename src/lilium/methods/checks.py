@@ -28,7 +28,11 @@ Rules (each one skipped, never guessed, when the landmarks it needs are absent):
   :data:`~lilium.constants.VIEW_SPLIT_DEG` from the anterior direction, lateral = at least
   that, on the declared side (``lateral_left``: the face points to the image's left, so the
   camera sees the subject's left side); otherwise warning ``view_mismatch``;
-- **priors** (:func:`prior_warnings`): ``no_focal_prior``, ``no_scd_prior``, ``outside_prior``.
+- **priors** (:func:`prior_warnings`): ``no_focal_prior``, ``no_scd_prior``, ``outside_prior``;
+- **chin** (:func:`chin_warning`): an SFO with no landmark pair on the chin or the mandible
+  (:data:`CHIN_LANDMARKS`) and no chin-jaw curve term (P_pll on a frontal photo) fits the
+  midface alone; warning ``chin_unconstrained`` (issue 25: on a face of another size the skull's
+  chin then lies anywhere).
 
 :func:`landmark_error` is the comparable error of every result (pixels and millimetres at each
 landmark's depth). :func:`finish_result` attaches the warnings, the priors' provenance and the
@@ -54,6 +58,10 @@ ANTERIOR_PAIRS = ("dacryon", "ectoconchion", "alare")
 #: Upper and lower midline landmarks of the superior direction's fallback.
 UPPER_MIDLINE = ("nasion", "glabella", "metopion", "bregma")
 LOWER_MIDLINE = ("prosthion", "subspinale", "infradentale", "pogonion", "gnathion")
+
+#: Landmarks on the chin and the mandible (facial names, the same as the cranial ones): an SFO
+#: with a pair among them, or with P_pll's chin-jaw curve, constrains the chin.
+CHIN_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r")
 
 #: Options that give each prior, for the messages.
 PRIOR_OPTIONS = {
@@ -450,6 +458,49 @@ def prior_warnings(photo, camera=None, facial_landmarks_mm=None):
     return out
 
 
+def chin_warning(skull, photo, result):
+    """Warning ``chin_unconstrained`` when nothing in the SFO holds the chin, else None.
+
+    Nothing holds it when no landmark of :data:`CHIN_LANDMARKS` is both on the skull and in the
+    photo, and the SFO ran no chin-jaw curve term (P_pll on a frontal photo; a lateral photo's
+    curve is the forehead).
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    result : SfoResult
+
+    Returns
+    -------
+    CaseWarning or None
+    """
+    if any(n in skull.landmarks_mm and n in photo.landmarks_uv for n in CHIN_LANDMARKS):
+        return None
+    if photo.view == "frontal" and result.terms.get("p_pll") is not None:
+        return None
+    on_skull = [n for n in CHIN_LANDMARKS if n in skull.landmarks_mm]
+    if not on_skull:
+        why = f"skull {skull.id!r} has none of them in its cranial landmarks (no mandible?)"
+    else:
+        why = f"photo {photo.id!r} has none of {', '.join(on_skull)}"
+        if set(photo.landmark_sources.values()) & {"tracked", "template"}:
+            why += " (automatic template points count only once confirmed in review.html)"
+    curve = (
+        "no chin-jaw curve (P_pll off)"
+        if photo.view == "frontal"
+        else "a lateral photo's curve (P_pll) follows the forehead"
+    )
+    return CaseWarning(
+        "chin_unconstrained",
+        f"the chin is unconstrained: no landmark pair on the chin or mandible "
+        f"({', '.join(CHIN_LANDMARKS)}) and {curve}; {why}. Only the landmarks down to the "
+        "upper lip place the skull, so on a face of another size its chin and jaw can lie "
+        "anywhere in the overlay; mark pogonion or gnathion on the photo and the skull, or run "
+        "Lilium with --variant pll (or skof+pll) and a chin-jaw curve",
+    )
+
+
 def landmark_error(camera, facial_landmarks_mm, photo):
     """Reprojection error of the estimated facial landmarks, in pixels and millimetres.
 
@@ -492,7 +543,8 @@ def finish_result(result, skull, photo):
     """A result with its warnings, priors' provenance and landmark error attached.
 
     Warnings, in order: the photo's own (read with it, e.g. ``exif_focal_unusable``), the
-    method's (e.g. ``focal_cap``), the missing or violated priors, ``view_mismatch``.
+    method's (e.g. ``focal_cap``), the missing or violated priors, ``chin_unconstrained``,
+    ``view_mismatch``.
 
     Parameters
     ----------
@@ -508,6 +560,9 @@ def finish_result(result, skull, photo):
     warnings += prior_warnings(photo, result.camera, result.facial_landmarks_mm)
     error = None
     if result:
+        chin = chin_warning(skull, photo, result)
+        if chin is not None:
+            warnings.append(chin)
         view = view_warning(skull, photo, result.camera)
         if view is not None:
             warnings.append(view)

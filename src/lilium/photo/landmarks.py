@@ -3,10 +3,11 @@
 Each landmark is one mesh vertex, chosen by where the vertex lies on the mesh's own topology
 and checked on real portraits against points placed by hand (``tests/test_photo_accuracy.py``,
 ``docs/photo.md``). ``"tracked"`` points sit on image evidence the model follows (eye
-corners, the alar wings, the nostril base, the lip border, the mouth corners);
-``"template"`` points are where the model's face template puts them (nasion, glabella and
-the forehead, the chin, the cheek and jaw contour): plausible, not measured, and not used by
-an SFO until the user confirms them (SPEC section 11).
+corners, the alar wings, the nostril base, the lip border, the mouth corners, the chin: pogonion
+and gnathion, within 5 % of the eye-corner distance of hand marks on every portrait where the
+chin is visible); ``"template"`` points are where the model's face template puts them (nasion,
+glabella and the forehead, the cheek and jaw contour): plausible, not within that bound, and
+not used by an SFO until the user confirms them (SPEC section 11).
 """
 
 import numpy as np
@@ -27,11 +28,11 @@ MESH_LANDMARKS = {
     "labiale_superius": (0, TRACKED),
     "cheilion_r": (61, TRACKED),
     "cheilion_l": (291, TRACKED),
+    "pogonion": (200, TRACKED),
+    "gnathion": (152, TRACKED),
     "nasion": (168, TEMPLATE),
     "glabella": (9, TEMPLATE),
     "metopion": (151, TEMPLATE),
-    "pogonion": (175, TEMPLATE),
-    "gnathion": (152, TEMPLATE),
     "zygion_r": (234, TEMPLATE),
     "zygion_l": (454, TEMPLATE),
     "gonion_r": (172, TEMPLATE),
