@@ -43,6 +43,13 @@ from .store import COLUMNS, ResultStore
 TERMS_KEY = "identification_terms"
 
 
+#: Cohort terms of the photos a worker process has scored (they describe the photo; an
+#: experiment scores every skull against each photo), emptied when it reaches
+#: :data:`COHORT_CACHE` entries.
+_COHORT_TERMS = {}
+COHORT_CACHE = 4096
+
+
 def with_terms(row, skull, photos, singles, facial_landmarks_mm, rows, key=TERMS_KEY):
     """Add the identification terms of one decision to a row's ``result`` JSON (under
     ``key``; nothing for a failed SFO): ``lilium calibrate`` and ``lilium report`` read them
@@ -61,7 +68,10 @@ def with_terms(row, skull, photos, singles, facial_landmarks_mm, rows, key=TERMS
         facial_landmarks_mm,
         image=[row_image(r, skull, p, c) for r, p, c in zip(rows, photos, cameras, strict=True)],
         cohort=shipped_cohort(),
+        cohort_cache=_COHORT_TERMS,
     )
+    if len(_COHORT_TERMS) >= COHORT_CACHE:
+        _COHORT_TERMS.clear()
     row["result"] = json.dumps(data)
     return row
 

@@ -92,9 +92,9 @@ def identification_terms(
         Other people's skulls (:mod:`lilium.identification.cohort`): without it
         ``cohort_mean`` and ``cohort_sd`` are None.
     cohort_cache : dict, optional
-        Cohort terms already computed, by the photos and their landmark names: the cohort
-        terms describe the photos, so scoring many skulls against one photo computes them
-        once (the first skull's camera starts the cohort's fits).
+        Cohort terms already computed, by the photos' landmarks (names and positions): the
+        cohort terms describe the photos, so scoring many skulls against one photo computes
+        them once (the first skull's camera starts the cohort's fits).
 
     Returns
     -------
@@ -118,7 +118,7 @@ def identification_terms(
     chi2, nll = landmark_chi2(views)
     cohort_mean = cohort_sd = None
     if cohort is not None and np.isfinite(chi2):
-        key = tuple((id(p), v.names) for p, v in zip(photos, views, strict=True))
+        key = tuple((v.names, v.uv_px.tobytes()) for v in views)
         cache = {} if cohort_cache is None else cohort_cache
         if key not in cache:
             cache[key] = cohort_terms(views, cohort)
