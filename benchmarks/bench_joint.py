@@ -89,10 +89,16 @@ def run_pair(task):
             | _metrics(result, skull, photo, truth)
         )
     for design in designs:
-        weighting, factor = design.split(":")
+        weighting, factor, camera = parse_design(design)
         t0 = time.perf_counter()
         joint = joint_lilium_sfo(
-            skull, photos, options, seed, weighting=weighting, generations_factor=float(factor)
+            skull,
+            photos,
+            options,
+            seed,
+            weighting=weighting,
+            generations_factor=factor,
+            camera=camera,
         )
         seconds = time.perf_counter() - t0
         for result, photo, truth in zip(joint.photos, photos, truths, strict=True):
@@ -109,6 +115,20 @@ def run_pair(task):
                 | _metrics(result, skull, photo, truth)
             )
     return rows
+
+
+#: Short names of the joint SFO's camera fits in a design (``lilium.methods.joint.CAMERAS``).
+DESIGN_CAMERAS = {"priors": "priors", "ls": "least_squares"}
+
+
+def parse_design(design):
+    """``WEIGHTING:FACTOR[:CAMERA]`` -> ``(weighting, factor, camera)``; CAMERA ``priors``
+    (default) or ``ls`` (least squares, as a single SFO)."""
+    parts = design.split(":")
+    if len(parts) not in (2, 3) or (len(parts) == 3 and parts[2] not in DESIGN_CAMERAS):
+        raise ValueError(f"design {design!r}: use WEIGHTING:FACTOR[:priors|ls]")
+    camera = DESIGN_CAMERAS[parts[2] if len(parts) == 3 else "priors"]
+    return parts[0], float(parts[1]), camera
 
 
 def pairs_of(index, n_subjects):
