@@ -24,6 +24,13 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   times as much. Equal-scale photos get ``w_p = 1``, the plain sum; ``weighting="sum"`` is
   the plain sum always. ``result.json`` gives each photo's own (unweighted) fitness and its
   ``weight``; the total is the weighted sum DE ranked.
+- **Camera fit.** ``camera="priors"`` (the default, :data:`DEFAULT_CAMERA`): each photo's
+  least-squares camera is refined further on that photo's MSE_pix + P_cam
+  (:func:`camera_on_priors`). A single SFO fits its camera to the landmarks alone and lets its
+  soft tissue bend until that camera lands inside the priors; one shared soft tissue cannot do
+  that for every photo at once, so the joint SFO with least-squares cameras
+  (``camera="least_squares"``, as before issue 27) ended with cameras outside the priors and
+  worse BPE than the independent SFOs on real anatomy (docs/method.md, "Real anatomy").
 - **Early exit.** A trial's image penalties of photo ``p`` are skipped when the partial sum
   over all photos already exceeds its threshold (the other photos' partial sums are the
   offset): the run is the same, with fewer P_skof/P_pll evaluations.
