@@ -6,7 +6,9 @@ variant and seeds, in one run:
 
 - the two independent Lilium SFOs (``lilium.methods.run_sfo``, one per photo);
 - one joint SFO per design (``lilium.methods.joint.joint_lilium_sfo``): a design is
-  ``WEIGHTING:GENERATIONS_FACTOR`` (``sum:1``, ``scale:1.25``, ...).
+  ``WEIGHTING:GENERATIONS_FACTOR[:CAMERA]`` (``sum:1``, ``scale:1.25``, ``scale:1:ls``, ...);
+  CAMERA ``priors`` (the default: cameras refined on MSE_pix + P_cam) or ``ls`` (least-squares
+  cameras, as a single SFO and as the joint SFO before issue 27).
 
 It prints, per method: the mean BPE (mm) of the frontal and the lateral photos and of both, the
 failures (no camera), the implausible SFOs (any skull pixel outside the face mask,
@@ -15,7 +17,7 @@ design's ratios against the independent runs (mean BPE, and time against the two
 SFOs together), with the issue's targets (BPE <= 0.9 x, no more failures, time <= 1.25 x).
 
     python benchmarks/bench_joint.py --subjects 8 --jobs 2
-    python benchmarks/bench_joint.py --dataset DIR --generations 150 --designs sum:1 scale:1
+    python benchmarks/bench_joint.py --dataset DIR --generations 150 --designs scale:1:ls scale:1
 
 ``--headsq DIR`` adds the headsq real-anatomy case (issue 27, ``benchmarks/headsq_case.py``; its
 dataset built in DIR when absent): each frontal photo paired with the lateral one of the same
