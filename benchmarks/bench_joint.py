@@ -7,8 +7,8 @@ variant and seeds, in one run:
 - the two independent Lilium SFOs (``lilium.methods.run_sfo``, one per photo);
 - one joint SFO per design (``lilium.methods.joint.joint_lilium_sfo``): a design is
   ``WEIGHTING:GENERATIONS_FACTOR[:CAMERA]`` (``sum:1``, ``scale:1.25``, ``scale:1:ls``, ...);
-  CAMERA ``priors`` (the default: cameras refined on MSE_pix + P_cam) or ``ls`` (least-squares
-  cameras, as a single SFO and as the joint SFO before issue 27).
+  CAMERA ``ls`` (least-squares cameras, as a single SFO; the library's default) or ``priors``
+  (cameras refined on MSE_pix + P_cam, ``camera="priors"``).
 
 It prints, per method: the mean BPE (mm) of the frontal and the lateral photos and of both, the
 failures (no camera), the implausible SFOs (any skull pixel outside the face mask,
@@ -39,7 +39,7 @@ from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions, run_sfo
-from lilium.methods.joint import joint_lilium_sfo
+from lilium.methods.joint import DEFAULT_CAMERA, joint_lilium_sfo
 from lilium.optimisation import DEOptions
 
 #: Issue 16's targets for the joint SFO against the independent ones.
@@ -124,12 +124,12 @@ DESIGN_CAMERAS = {"priors": "priors", "ls": "least_squares"}
 
 
 def parse_design(design):
-    """``WEIGHTING:FACTOR[:CAMERA]`` -> ``(weighting, factor, camera)``; CAMERA ``priors``
-    (default) or ``ls`` (least squares, as a single SFO)."""
+    """``WEIGHTING:FACTOR[:CAMERA]`` -> ``(weighting, factor, camera)``; CAMERA ``priors`` or
+    ``ls`` (least squares, as a single SFO), the library's default when omitted."""
     parts = design.split(":")
     if len(parts) not in (2, 3) or (len(parts) == 3 and parts[2] not in DESIGN_CAMERAS):
         raise ValueError(f"design {design!r}: use WEIGHTING:FACTOR[:priors|ls]")
-    camera = DESIGN_CAMERAS[parts[2] if len(parts) == 3 else "priors"]
+    camera = DESIGN_CAMERAS[parts[2]] if len(parts) == 3 else DEFAULT_CAMERA
     return parts[0], float(parts[1]), camera
 
 

@@ -24,13 +24,14 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   times as much. Equal-scale photos get ``w_p = 1``, the plain sum; ``weighting="sum"`` is
   the plain sum always. ``result.json`` gives each photo's own (unweighted) fitness and its
   ``weight``; the total is the weighted sum DE ranked.
-- **Camera fit.** ``camera="priors"`` (the default, :data:`DEFAULT_CAMERA`): each photo's
-  least-squares camera is refined further on that photo's MSE_pix + P_cam
-  (:func:`camera_on_priors`). A single SFO fits its camera to the landmarks alone and lets its
-  soft tissue bend until that camera lands inside the priors; one shared soft tissue cannot do
-  that for every photo at once, so the joint SFO with least-squares cameras
-  (``camera="least_squares"``, as before issue 27) ended with cameras outside the priors and
-  worse BPE than the independent SFOs on real anatomy (docs/method.md, "Real anatomy").
+- **Camera fit.** ``camera="least_squares"`` (the default, :data:`DEFAULT_CAMERA`): each
+  photo's camera is fitted to the landmarks alone, as in a single SFO; P_cam judges it. A
+  single SFO lets its soft tissue bend until that camera lands inside the priors; one shared
+  soft tissue cannot do that for every photo at once, which is why the joint SFO loses to the
+  independent ones on the mandible-less headsq head (docs/method.md, "Real anatomy").
+  ``camera="priors"`` refines each least-squares camera further on that photo's MSE_pix + P_cam
+  (:func:`camera_on_priors`): better at 150 generations, worse than least squares at the full
+  budget on generated and complete headsq subjects, and 3-6 x slower, so not the default.
 - **Early exit.** A trial's image penalties of photo ``p`` are skipped when the partial sum
   over all photos already exceeds its threshold (the other photos' partial sums are the
   offset): the run is the same, with fewer P_skof/P_pll evaluations.
@@ -58,7 +59,7 @@ WEIGHTINGS = ("sum", "scale")
 
 #: How each photo's camera is fitted to a member's soft tissue (see the module notes).
 CAMERAS = ("priors", "least_squares")
-DEFAULT_CAMERA = "priors"
+DEFAULT_CAMERA = "least_squares"
 
 #: The default weighting and DE budget factor, chosen by ``benchmarks/bench_joint.py`` (8
 #: generated Exp. C frontal + lateral pairs, DE 30 x 750, skof+pll; docs/method.md): mean BPE
