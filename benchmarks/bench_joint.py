@@ -6,7 +6,9 @@ variant and seeds, in one run:
 
 - the two independent Lilium SFOs (``lilium.methods.run_sfo``, one per photo);
 - one joint SFO per design (``lilium.methods.joint.joint_lilium_sfo``): a design is
-  ``WEIGHTING:GENERATIONS_FACTOR`` (``sum:1``, ``scale:1.25``, ...).
+  ``WEIGHTING:GENERATIONS_FACTOR[:CAMERA]`` (``sum:1``, ``scale:1.25``, ``scale:1:ls``, ...);
+  CAMERA ``ls`` (least-squares cameras, as a single SFO; the library's default) or ``priors``
+  (cameras refined on MSE_pix + P_cam, ``camera="priors"``).
 
 It prints, per method: the mean BPE (mm) of the frontal and the lateral photos and of both, the
 failures (no camera), the implausible SFOs (any skull pixel outside the face mask,
@@ -15,7 +17,7 @@ design's ratios against the independent runs (mean BPE, and time against the two
 SFOs together), with the issue's targets (BPE <= 0.9 x, no more failures, time <= 1.25 x).
 
     python benchmarks/bench_joint.py --subjects 8 --jobs 2
-    python benchmarks/bench_joint.py --dataset DIR --generations 150 --designs sum:1 scale:1
+    python benchmarks/bench_joint.py --dataset DIR --generations 150 --designs scale:1:ls scale:1
 
 ``--headsq DIR`` adds the headsq real-anatomy case (issue 27, ``benchmarks/headsq_case.py``; its
 dataset built in DIR when absent): each frontal photo paired with the lateral one of the same
@@ -37,7 +39,7 @@ from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions, run_sfo
-from lilium.methods.joint import joint_lilium_sfo
+from lilium.methods.joint import DEFAULT_CAMERA, joint_lilium_sfo
 from lilium.optimisation import DEOptions
 
 #: Issue 16's targets for the joint SFO against the independent ones.
@@ -89,10 +91,16 @@ def run_pair(task):
             | _metrics(result, skull, photo, truth)
         )
     for design in designs:
-        weighting, factor = design.split(":")
+        weighting, factor, camera = parse_design(design)
         t0 = time.perf_counter()
         joint = joint_lilium_sfo(
-            skull, photos, options, seed, weighting=weighting, generations_factor=float(factor)
+            skull,
+            photos,
+            options,
+            seed,
+            weighting=weighting,
+            generations_factor=factor,
+            camera=camera,
         )
         seconds = time.perf_counter() - t0
         for result, photo, truth in zip(joint.photos, photos, truths, strict=True):
@@ -109,6 +117,20 @@ def run_pair(task):
                 | _metrics(result, skull, photo, truth)
             )
     return rows
+
+
+#: Short names of the joint SFO's camera fits in a design (``lilium.methods.joint.CAMERAS``).
+DESIGN_CAMERAS = {"priors": "priors", "ls": "least_squares"}
+
+
+def parse_design(design):
+    """``WEIGHTING:FACTOR[:CAMERA]`` -> ``(weighting, factor, camera)``; CAMERA ``priors`` or
+    ``ls`` (least squares, as a single SFO), the library's default when omitted."""
+    parts = design.split(":")
+    if len(parts) not in (2, 3) or (len(parts) == 3 and parts[2] not in DESIGN_CAMERAS):
+        raise ValueError(f"design {design!r}: use WEIGHTING:FACTOR[:priors|ls]")
+    camera = DESIGN_CAMERAS[parts[2]] if len(parts) == 3 else DEFAULT_CAMERA
+    return parts[0], float(parts[1]), camera
 
 
 def pairs_of(index, n_subjects):

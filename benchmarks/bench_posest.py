@@ -43,9 +43,16 @@ f > 10,000 px), for ``pycolmap`` (``estimate_and_refine_absolute_pose``: LO-RANS
 12 px threshold, focal refined, its default refinement: Cauchy loss of scale 1 px) and POSEST
 with the settings of :data:`SFO_VARIANTS` (prototypes of decisions, through the public
 ``PosestOptions`` / ``RansacOptions``; ``posest`` is the settings before the defaults changed, the
-package's defaults now are the ``rel0.1f6+cand16+lo1`` row)::
+package's defaults now are the ``rel0.1f6+cand16+lo1`` row, ``...+msac`` the same before issue 27
+changed how the refined hypothesis is chosen)::
 
     .venv/bin/python benchmarks/bench_posest.py --sfo --subjects 12 --photos 4 --seed 0
+
+``--no-mandible``: the same subjects' skulls without the mandible (its landmarks absent, as
+``lilium synth --no-mandible-share 1`` writes them; POSEST never sees the mesh), frontal photos
+only (issue 27: the near-planar midface)::
+
+    .venv/bin/python benchmarks/bench_posest.py --sfo --no-mandible --subjects 8 --photos 2
 
 ``--headsq DIR`` adds the same table for the headsq real-anatomy case (issue 27;
 ``benchmarks/headsq_case.py``, its dataset built in DIR when absent): its complete skull and its
@@ -263,6 +270,15 @@ SFO_VARIANTS = {
     # The recommendation (docs/experiments.md): threshold max(6 px, 0.1 x spread), 16 refined
     # hypotheses, one refinement each.
     "rel0.1f6+cand16+lo1": {"rel": 0.1, "floor": 6.0, "n_candidates": 16, "local_rounds": 1},
+    # The package's defaults before issue 27 (the refined hypothesis with the lowest MSAC cost
+    # wins); every other row picks the one with the most inliers, as the package now does.
+    "rel0.1f6+cand16+lo1+msac": {
+        "rel": 0.1,
+        "floor": 6.0,
+        "n_candidates": 16,
+        "local_rounds": 1,
+        "select": "msac",
+    },
 }
 
 
@@ -309,17 +325,21 @@ def run_pycolmap_sfo(problem, seed):
     return Camera.from_rt(M[:, :3], M[:, 3], f, c)
 
 
-def sfo_benchmark(n_subjects, n_photos, seed, headsq=None):
+def sfo_benchmark(n_subjects, n_photos, seed, headsq=None, mandible=True):
     """Print the SFO-problem table (BPE and failures per method and view); with ``headsq`` (a
     folder, built there by ``headsq_case`` when it holds no dataset yet) the same table for the
-    headsq real-anatomy case after it, its complete and its mandible-less skull apart."""
+    headsq real-anatomy case after it, its complete and its mandible-less skull apart;
+    ``mandible=False``: the generated skulls without the mandible, frontal photos only."""
     from sfo_problems import sfo_problems
 
     if n_subjects > 0:
         start = time.perf_counter()
-        problems = sfo_problems(n_subjects, n_photos, seed)
+        views = None if mandible else {"frontal"}
+        problems = sfo_problems(n_subjects, n_photos, seed, mandible=mandible, views=views)
+        kind = f"{n_photos} frontal + {n_photos} lateral" if mandible else f"{n_photos} frontal"
+        skulls = "" if mandible else ", skulls without the mandible"
         print(
-            f"SFO problems: {n_subjects} subjects x ({n_photos} frontal + {n_photos} lateral), "
+            f"SFO problems: {n_subjects} subjects x ({kind}){skulls}, "
             f"seed {seed}, Exp. C (+-5 px, axes set C1), generated in "
             f"{time.perf_counter() - start:.0f} s; {_points_range(problems)}"
         )
@@ -412,9 +432,15 @@ def main(argv=None):
         help="--sfo: also the headsq real-anatomy case (its dataset in DIR, built there if "
         "absent; benchmarks/headsq_case.py); --subjects 0 for headsq alone",
     )
+    parser.add_argument(
+        "--no-mandible",
+        action="store_true",
+        help="--sfo: the generated skulls without the mandible (as --no-mandible-share 1), "
+        "frontal photos only",
+    )
     args = parser.parse_args(argv)
     if args.sfo:
-        sfo_benchmark(args.subjects, args.photos, args.seed, args.headsq)
+        sfo_benchmark(args.subjects, args.photos, args.seed, args.headsq, not args.no_mandible)
         return
 
     methods = {"posest": lambda p, i: run_posest(p), "opencv": lambda p, i: run_opencv(p)}

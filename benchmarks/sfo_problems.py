@@ -24,7 +24,7 @@ from lilium.methods.posest_sfo import mean_depth_landmarks
 from lilium.synthetic import noise as _noise
 from lilium.synthetic import photos as _photos
 from lilium.synthetic.dataset import subject_ids
-from lilium.synthetic.subjects import make_subject
+from lilium.synthetic.subjects import MANDIBLE_LANDMARKS, make_subject
 
 
 @dataclass(frozen=True)
@@ -74,7 +74,7 @@ class SfoProblem:
         return back_projection_error(self.facial_true_mm, self.uv_true_px, camera)
 
 
-def sfo_problems(n_subjects, n_photos, seed=0, axes_set=1):
+def sfo_problems(n_subjects, n_photos, seed=0, axes_set=1, mandible=True, views=None):
     """The positive Exp. C POSEST-SFO problems of a generated dataset, in memory.
 
     Parameters
@@ -85,6 +85,12 @@ def sfo_problems(n_subjects, n_photos, seed=0, axes_set=1):
     seed : int
     axes_set : int
         Which of the five perturbed axes sets (1-based) the methods are given.
+    mandible : bool
+        False: every skull without its mandible (the problems of ``lilium synth
+        --no-mandible-share 1``: the same photos, the :data:`MANDIBLE_LANDMARKS` absent from the
+        skull, so they pair with nothing; POSEST never sees the mesh).
+    views : collection of {"frontal", "lateral"}, optional
+        Only these views (default both).
 
     Returns
     -------
@@ -96,18 +102,23 @@ def sfo_problems(n_subjects, n_photos, seed=0, axes_set=1):
         subject_seq, axes_seq, photos_seq = seq.spawn(3)
         subject = make_subject(sid, np.random.default_rng(subject_seq))
         sets = _noise.perturbed_axes_sets(subject.soft_tissue_axes, np.random.default_rng(axes_seq))
+        cranial = dict(subject.cranial_landmarks)
+        if not mandible:
+            cranial = {k: v for k, v in cranial.items() if k not in MANDIBLE_LANDMARKS}
         skull = Skull(
             id=sid,
             vertices_mm=subject.skull_vertices_mm,
             faces=subject.skull_faces,
-            landmarks_mm=subject.cranial_landmarks,
+            landmarks_mm=cranial,
             axes=sets[axes_set - 1],
         )
         names = sorted(subject.facial_landmarks)
         facial_true = np.array([subject.facial_landmarks[n] for n in names])
         head = _photos.prepare_head(subject)
-        views = _photos.photo_views(n_photos)
-        for k, (view, pseq) in enumerate(zip(views, photos_seq.spawn(len(views)), strict=True)):
+        kinds = _photos.photo_views(n_photos)
+        for k, (view, pseq) in enumerate(zip(kinds, photos_seq.spawn(len(kinds)), strict=True)):
+            if views is not None and ("frontal" if view == "frontal" else "lateral") not in views:
+                continue
             camera_seq, noise_seq = pseq.spawn(2)
             photo = _photos.make_photo(head, view, np.random.default_rng(camera_seq))
             noisy = _noise.perturb_landmarks(photo.landmarks_uv, np.random.default_rng(noise_seq))

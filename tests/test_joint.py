@@ -9,7 +9,12 @@ import pytest
 from lilium.cli.main import main
 from lilium.io.case import read_photo, read_skull
 from lilium.methods import SfoOptions, run_joint_sfo, run_sfo
-from lilium.methods.joint import JointLiliumProblem, joint_lilium_sfo, photo_scale_px_per_mm
+from lilium.methods.joint import (
+    JointLiliumProblem,
+    camera_on_priors,
+    joint_lilium_sfo,
+    photo_scale_px_per_mm,
+)
 from lilium.optimisation import DEOptions
 from lilium.report.html import relative_href
 from lilium.synthetic import dataset as ds
@@ -72,9 +77,12 @@ def test_genes_span_the_union_of_the_photos_landmarks(pair):
         assert shared[:, rows].shape == (5, len(rows), 3)
 
 
-def test_fitness_is_the_sum_of_the_photos_fitnesses(pair):
+@pytest.mark.parametrize("camera", ["least_squares", "priors"])
+def test_fitness_is_the_sum_of_the_photos_fitnesses(pair, camera):
     skull, photos, _, _ = pair
-    problem = JointLiliumProblem(skull, photos, SfoOptions("skof+pll", TINY_DE), weighting="sum")
+    problem = JointLiliumProblem(
+        skull, photos, SfoOptions("skof+pll", TINY_DE), weighting="sum", camera=camera
+    )
     assert list(problem.weights) == [1.0, 1.0]
     rng = np.random.default_rng(1)
     members = problem.evaluate(rng.random((6, problem.n_genes)))
@@ -87,8 +95,29 @@ def test_fitness_is_the_sum_of_the_photos_fitnesses(pair):
     shared = problem.facial_landmarks(genes)
     for p, single in enumerate(problem.problems):
         mine = {k: members[k][:, p] for k in ("R", "t", "focal_px", "success")}
-        alone = single.add_image_terms(single.camera_terms(shared[:, problem.rows[p]], mine))
+        alone = single.camera_terms(shared[:, problem.rows[p]], mine)
+        if camera == "priors":
+            least_squares = alone["fitness"].copy()
+            camera_on_priors(single, shared[:, problem.rows[p]], alone, mine)
+            assert np.all(alone["fitness"] <= least_squares)
+        alone = single.add_image_terms(alone)
         np.testing.assert_allclose(terms["photo_fitness"][:, p], alone["fitness"], rtol=1e-9)
+
+
+def test_camera_on_priors_lowers_only_what_p_cam_charges(pair):
+    """A camera outside its photo's priors moves to a lower MSE_pix + P_cam; one inside stays."""
+    skull, photos, _, _ = pair
+    problem = JointLiliumProblem(skull, photos, SfoOptions("base", TINY_DE), camera="priors")
+    single = problem.problems[0]
+    genes = np.random.default_rng(4).random((12, problem.n_genes))
+    facial = problem.facial_landmarks(genes)[:, problem.rows[0]]
+    before = single.camera_terms(facial)
+    after = camera_on_priors(single, facial, {k: v.copy() for k, v in before.items()})
+    inside = before["success"] & (before["p_cam"] == 0)
+    np.testing.assert_array_equal(after["focal_px"][inside], before["focal_px"][inside])
+    assert np.all(after["fitness"] <= before["fitness"])
+    moved = after["fitness"] < before["fitness"]
+    assert moved.any() and np.all(after["p_cam"][moved] < before["p_cam"][moved])
 
 
 def test_early_exit_skips_only_trials_that_lose(pair):

@@ -221,3 +221,21 @@ def test_unknown_refine_on_is_a_value_error():
     points, _, _, uv = head_scene(np.random.default_rng(32))
     with pytest.raises(ValueError, match="refine_on must be 'inliers' or 'all'"):
         posest(uv, points, PRINCIPAL_POINT_PX, PosestOptions(refine_on="best"))
+
+
+def test_unknown_select_is_a_value_error():
+    points, _, _, uv = head_scene(np.random.default_rng(32))
+    with pytest.raises(ValueError, match="select must be 'inliers' or 'msac'"):
+        posest(uv, points, PRINCIPAL_POINT_PX, PosestOptions(select="best"))
+
+
+@pytest.mark.parametrize("select", ["inliers", "msac"])
+def test_either_selection_recovers_with_gross_outliers(select):
+    rng = np.random.default_rng(11)
+    points, _, focal, uv = head_scene(rng, n=30)
+    bad = rng.choice(30, size=9, replace=False)
+    corrupted = uv.copy()
+    corrupted[bad] += rng.uniform(60.0, 400.0, (9, 2)) * rng.choice([-1.0, 1.0], (9, 2))
+    result = posest(corrupted, points, PRINCIPAL_POINT_PX, PosestOptions(select=select), rng=3)
+    assert result and abs(result.camera.focal_px - focal) / focal < EXACT_FOCAL_REL
+    assert result.inliers.sum() == 21

@@ -24,6 +24,14 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   times as much. Equal-scale photos get ``w_p = 1``, the plain sum; ``weighting="sum"`` is
   the plain sum always. ``result.json`` gives each photo's own (unweighted) fitness and its
   ``weight``; the total is the weighted sum DE ranked.
+- **Camera fit.** ``camera="least_squares"`` (the default, :data:`DEFAULT_CAMERA`): each
+  photo's camera is fitted to the landmarks alone, as in a single SFO; P_cam judges it. A
+  single SFO lets its soft tissue bend until that camera lands inside the priors; one shared
+  soft tissue cannot do that for every photo at once, which is why the joint SFO loses to the
+  independent ones on the mandible-less headsq head (docs/method.md, "Real anatomy").
+  ``camera="priors"`` refines each least-squares camera further on that photo's MSE_pix + P_cam
+  (:func:`camera_on_priors`): better at 150 generations, worse than least squares at the full
+  budget on generated and complete headsq subjects, and 3-6 x slower, so not the default.
 - **Early exit.** A trial's image penalties of photo ``p`` are skipped when the partial sum
   over all photos already exceeds its threshold (the other photos' partial sums are the
   offset): the run is the same, with fewer P_skof/P_pll evaluations.
@@ -38,6 +46,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..optimisation.de import DifferentialEvolution
+from ..pose.prior_refine import refine_with_priors
+from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from .lilium import LiliumProblem, build_cones, de_extra, photo_outcome
@@ -46,6 +56,10 @@ from .result import SfoResult, finite_or_none
 
 #: How the photos' fitnesses are summed (see the module notes).
 WEIGHTINGS = ("sum", "scale")
+
+#: How each photo's camera is fitted to a member's soft tissue (see the module notes).
+CAMERAS = ("priors", "least_squares")
+DEFAULT_CAMERA = "least_squares"
 
 #: The default weighting and DE budget factor, chosen by ``benchmarks/bench_joint.py`` (8
 #: generated Exp. C frontal + lateral pairs, DE 30 x 750, skof+pll; docs/method.md): mean BPE
@@ -98,15 +112,26 @@ class JointLiliumProblem:
     rng : seed or numpy Generator
         For the RANSAC of the initial and fallback POSEST runs (shared by the photos).
     weighting : {"sum", "scale"}
+    camera : {"priors", "least_squares"}
+        ``"priors"``: each photo's least-squares camera is refined further on its MSE_pix +
+        P_cam (:func:`camera_on_priors`); ``"least_squares"``: as a single SFO.
 
     Raises
     ------
     ValueError
-        Fewer than two photos, repeated photo ids, an unknown weighting, or what a single
-        :class:`LiliumProblem` refuses (an unknown variant, too few landmarks in a photo).
+        Fewer than two photos, repeated photo ids, an unknown weighting or camera, or what a
+        single :class:`LiliumProblem` refuses (an unknown variant, too few landmarks in a photo).
     """
 
-    def __init__(self, skull, photos, options=SfoOptions(), rng=0, weighting=DEFAULT_WEIGHTING):
+    def __init__(
+        self,
+        skull,
+        photos,
+        options=SfoOptions(),
+        rng=0,
+        weighting=DEFAULT_WEIGHTING,
+        camera=DEFAULT_CAMERA,
+    ):
         photos = list(photos)
         if len(photos) < 2:
             raise ValueError(f"a joint SFO needs two or more photos, got {len(photos)}")
@@ -117,6 +142,9 @@ class JointLiliumProblem:
             )
         if weighting not in WEIGHTINGS:
             raise ValueError(f"unknown weighting {weighting!r}; use one of {', '.join(WEIGHTINGS)}")
+        if camera not in CAMERAS:
+            raise ValueError(f"unknown camera {camera!r}; use one of {', '.join(CAMERAS)}")
+        self.camera = camera
         self.rng = np.random.default_rng(rng)
         self.skull, self.photos, self.options = skull, photos, options
         self.problems = [LiliumProblem(skull, p, options, rng=self.rng) for p in photos]
@@ -172,7 +200,10 @@ class JointLiliumProblem:
             mine = None
             if members is not None:
                 mine = {k: np.asarray(members[k])[:, p] for k in ("R", "t", "focal_px", "success")}
-            per.append(problem.camera_terms(facial[:, self.rows[p]], mine))
+            terms = problem.camera_terms(facial[:, self.rows[p]], mine)
+            if self.camera == "priors":
+                camera_on_priors(problem, facial[:, self.rows[p]], terms, mine)
+            per.append(terms)
         w = self.weights
         # Fitnesses of hopeless trials reach 1e60 and more (P_cam of a run-off camera); their
         # weighted sums may overflow to inf, which ranks them last as it should.
@@ -192,6 +223,81 @@ class JointLiliumProblem:
         """DE's objective: ``(fitness (S,), payload)``."""
         terms = self.evaluate(genes, members, thresholds)
         return terms["fitness"], terms
+
+
+#: Levenberg-Marquardt iterations of :func:`camera_on_priors` (it starts near its optimum).
+PRIOR_CAMERA_ITERATIONS = 5
+
+
+def camera_on_priors(problem, facial_mm, terms, members=None):
+    """Move the cameras of members outside a photo's priors to the minimum of MSE_pix + P_cam.
+
+    :meth:`LiliumProblem.camera_terms` fits each camera to the landmarks alone; P_cam then
+    only judges it. A single SFO lives with that: its soft tissue bends until the
+    least-squares camera lands inside the priors. A joint SFO's soft tissue is shared, so it
+    cannot do that for every photo at once (docs/method.md, "Joint SFO on real anatomy"); here
+    the camera itself takes the priors into account
+    (:func:`~lilium.pose.prior_refine.refine_with_priors`, :data:`PRIOR_CAMERA_ITERATIONS`
+    iterations, started from the camera of the member the trial competes with, the previous
+    such refinement, where it has a valid one, else from the least-squares camera). A member
+    whose least-squares camera is valid and inside every prior (P_cam = 0) keeps it; a refined
+    camera replaces it only when it is valid and lowers MSE_pix + P_cam.
+
+    Parameters
+    ----------
+    problem : LiliumProblem
+        The photo's problem.
+    facial_mm : ndarray of shape (S, N, 3)
+        The photo's rows of the members' facial landmarks.
+    terms : dict
+        :meth:`LiliumProblem.camera_terms`' dictionary, updated in place (cameras, ``mse_pix``,
+        ``p_cam``, ``fitness``, ``success``).
+    members : dict, optional
+        This photo's cameras of the members the trials compete with (``R``, ``t``,
+        ``focal_px``, ``success``); None for the initial population.
+
+    Returns
+    -------
+    dict
+        ``terms``.
+    """
+    need = np.flatnonzero(terms["success"] & (terms["p_cam"] > 0.0))
+    if len(need) == 0:
+        return terms
+    priors = problem.photo.priors
+    head = priors.uses_head
+    points = facial_mm[need]
+    R0, t0, f0 = (np.array(terms[k][need]) for k in ("R", "t", "focal_px"))
+    if members is not None:
+        own = np.asarray(members["success"])[need]
+        R0[own] = np.asarray(members["R"])[need][own]
+        t0[own] = np.asarray(members["t"])[need][own]
+        f0[own] = np.asarray(members["focal_px"])[need][own]
+    ref = refine_with_priors(
+        problem.uv_c,
+        points,
+        R0,
+        t0,
+        f0,
+        points[:, problem.scd_index].mean(axis=1),
+        focal_interval_px=priors.focal_px,
+        scd_interval_mm=priors.scd_mm,
+        head_rotation=priors.head_rotation_skull2cam if head else None,
+        head_tolerance_deg=priors.head_tolerance_deg if head else None,
+        max_iterations=PRIOR_CAMERA_ITERATIONS,
+    )
+    R, t, f = ref.R, ref.t, ref.focal_px
+    # LiliumProblem's own validity rule and terms (focal range, skull front seen).
+    ok = problem._valid(R, t, f)
+    sq = reprojection_sq_errors(problem.uv_c, points, R, t, np.where(ok, f, 1.0))
+    ok &= np.all(np.isfinite(sq), axis=1)
+    sq[~ok] = np.inf
+    new = problem._terms(points, R, t, f, ok, sq)
+    take = ok & (new["fitness"] < terms["fitness"][need])
+    rows = need[take]
+    for key in ("fitness", "mse_pix", "p_cam", "R", "t", "focal_px", "success"):
+        terms[key][rows] = new[key][take]
+    return terms
 
 
 @dataclass(frozen=True)
@@ -221,7 +327,7 @@ class JointSfoResult:
         ``w_p`` of each photo (all 1 for ``weighting="sum"``).
     extra : dict
         ``history``, ``generations``, ``evaluations``, ``stop``, ``genes``, ``fallbacks``,
-        ``weighting``.
+        ``weighting``, ``camera_fit`` (how the cameras were fitted, :data:`CAMERAS`).
     """
 
     method: str
@@ -301,6 +407,7 @@ def joint_lilium_sfo(
     seed=0,
     weighting=DEFAULT_WEIGHTING,
     generations_factor=DEFAULT_GENERATIONS_FACTOR,
+    camera=DEFAULT_CAMERA,
 ):
     """Run one joint Lilium SFO of a skull against several photos of one person.
 
@@ -317,6 +424,8 @@ def joint_lilium_sfo(
         How the photos' fitnesses are summed (module notes).
     generations_factor : float
         DE generations = ``round(factor x options.de.max_generations)``.
+    camera : {"priors", "least_squares"}
+        How each photo's camera is fitted (:class:`JointLiliumProblem`).
 
     Returns
     -------
@@ -326,7 +435,9 @@ def joint_lilium_sfo(
     """
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
-    problem = JointLiliumProblem(skull, photos, options, rng=rng, weighting=weighting)
+    problem = JointLiliumProblem(
+        skull, photos, options, rng=rng, weighting=weighting, camera=camera
+    )
     de_options = options.de
     if generations_factor != 1.0:
         generations = max(1, round(generations_factor * de_options.max_generations))
@@ -379,5 +490,5 @@ def joint_lilium_sfo(
         seconds=seconds,
         weights=tuple(float(w) for w in problem.weights),
         extra=de_extra(de, sum(pr.n_fallbacks for pr in problem.problems))
-        | {"weighting": weighting},
+        | {"weighting": weighting, "camera_fit": problem.camera},
     )

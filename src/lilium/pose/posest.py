@@ -3,7 +3,8 @@
 As in Lourakis & Terzakis' POSEST: MSAC over P4Pf samples, then Levenberg-Marquardt over the
 seven parameters on the inliers. The few best MSAC hypotheses are refined together (one batched
 call), each re-fitted to its own inlier set until that set settles (local optimisation, as in
-LO-RANSAC), and the refined camera with the lowest MSAC cost wins. A failure (fewer than four
+LO-RANSAC), and the refined camera with the most inliers wins (ties: the lowest MSAC cost;
+``PosestOptions.select``). A failure (fewer than four
 points, no real sample, focal length out of range, a point behind the camera, a camera the
 caller's ``camera_check`` rejects) is a falsy :class:`PoseResult` carrying a message and a
 code, not an exception.
@@ -42,12 +43,24 @@ class PosestOptions:
         of ``ransac.threshold_px``: a fixed 12 px is loose for a small face and tight for a
         large one.
     threshold_floor_px : float
+    select : {"inliers", "msac"}
+        How the refined hypothesis is chosen: ``"inliers"`` the one with the most inliers, ties
+        broken by the lowest MSAC cost (the support COLMAP's RANSAC ranks by); ``"msac"`` the
+        lowest MSAC cost (truncated squared error). See the notes below.
 
     Defaults chosen by measurement on SFO problems (``benchmarks/bench_posest.py --sfo``:
     generated Exp. C positive pairs, 12 subjects x 8 photos, seeds 0 and 1, against pycolmap's
     LO-RANSAC P4Pf with focal refinement): a threshold of max(6 px, 0.1 x spread), 16 refined
     hypotheses and one refinement each gave 0.62-0.85 x pycolmap's mean BPE with no more
     failures, where the fixed 12 px, 4 hypotheses and 4 rounds gave 0.76-1.12 x.
+
+    ``select="inliers"`` (issue 27, docs/method.md): on near-planar landmark sets (frontal
+    photos of a skull without the mandible) the focal length is barely determined, and the
+    lowest truncated cost often belongs to a camera far too close to the face (a focal length
+    0.1-0.2 x the truth) that fits a few landmarks tightly and leaves the others outside the
+    threshold; the camera that keeps the most landmarks within it is nearer the truth. On 48
+    generated mandible-less frontal photos the mean BPE fell from 4.79 to 4.05 mm and on the
+    headsq CT's mandible-less frontal photos from 8.59 to 5.49 mm.
     """
 
     ransac: RansacOptions = field(
@@ -59,6 +72,7 @@ class PosestOptions:
     local_rounds: int = 1
     threshold_spread_fraction: float | None = 0.1
     threshold_floor_px: float = 6.0
+    select: str = "inliers"
 
     def ransac_for(self, uv_px):
         """:attr:`ransac` with the inlier threshold for these image points ``(N, 2)``."""
@@ -175,6 +189,8 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0,
         return failure(f"{len(uv)} correspondences, POSEST needs at least 4")
     if options.refine_on not in ("inliers", "all"):
         raise ValueError(f"refine_on must be 'inliers' or 'all', got {options.refine_on!r}")
+    if options.select not in ("inliers", "msac"):
+        raise ValueError(f"select must be 'inliers' or 'msac', got {options.select!r}")
     uv_c = uv - c
     ransac = options.ransac_for(uv)
     hyp = msac(uv_c, X, ransac, rng)
@@ -202,6 +218,12 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0,
         if len(todo) == 0:
             break
     score = cost if not on_inliers else np.minimum(sq, tau_sq).sum(axis=1)
+    if options.select == "inliers":
+        # Most inliers first; among equal counts the MSAC cost (it is below tau_sq per point,
+        # so the count dominates), COLMAP's InlierSupportMeasurer order.
+        with np.errstate(invalid="ignore"):
+            count = (sq < tau_sq).sum(axis=1)
+        score = (len(uv) - count) * tau_sq * (len(uv) + 1) + np.minimum(score, tau_sq * len(uv))
     # check_camera's rules, vectorised; its messages are needed only when every camera fails.
     with np.errstate(invalid="ignore"):
         fine = np.isfinite(f) & (f >= FOCAL_MIN_PX) & (f <= options.focal_max_px)
