@@ -16,6 +16,7 @@ from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_cameras
 from ..geometry.camera import principal_point_of
+from .working_level import WorkingPll, WorkingSkof
 
 
 class SkofTerm:
@@ -160,9 +161,13 @@ class PllTerm:
 
     def __call__(self, cameras):
         """P_pll under ``cameras`` (:class:`Cameras`), ``(S,)``."""
+        return self.parts(cameras).total
+
+    def parts(self, cameras):
+        """:class:`~lilium.fitness.pll.PllTerms` (fields ``(S,)``) under ``cameras``."""
         uv = cameras.project(self.region_vertices_mm)
         span_v = None if self.span_mm is None else cameras.project(self.span_mm)[..., 1]
-        return self.context.evaluate_batch(uv, span_v)
+        return self.context.terms_batch(uv, span_v)
 
     def curves(self, camera):
         """Skull and face curves ``(K, 2)``, ``(M, 2)`` under one :class:`Camera` (overlays)."""
@@ -199,11 +204,13 @@ def prior_terms_off(priors):
     return off
 
 
-def image_terms(skull, photo, centre, use_skof, use_pll):
+def image_terms(skull, photo, centre, use_skof, use_pll, level=None):
     """The image penalties an SFO asks for, each built or switched off.
 
     An asked-for term whose inputs are missing (:class:`TermOff`) is switched off, not an
-    error (SPEC section 5): the SFO runs with the other terms.
+    error (SPEC section 5): the SFO runs with the other terms. With a working ``level``
+    (:mod:`lilium.methods.working_level`) the terms are built on its skull and photo and take
+    full-resolution cameras (their values in full-resolution units).
 
     Parameters
     ----------
@@ -213,23 +220,30 @@ def image_terms(skull, photo, centre, use_skof, use_pll):
         Principal point (pixels).
     use_skof, use_pll : bool
         Whether the variant asks for P_skof / P_pll.
+    level : WorkingLevel, optional
+        None or a full level: the terms at the photo's resolution on the full mesh.
 
     Returns
     -------
-    skof : SkofTerm or None
-    pll : PllTerm or None
+    skof : SkofTerm, WorkingSkof or None
+    pll : PllTerm, WorkingPll or None
     terms_off : dict of str -> str
         ``{"p_skof": why, "p_pll": why}`` for the asked-for terms that cannot apply.
     """
     skof = pll = None
     off = {}
+    working = level is not None and not level.is_full
+    if working:
+        skull, photo, centre = level.skull, level.photo, level.centre(centre)
     if use_skof:
         off["p_skof"] = skof_off_reason(photo)
         if not off["p_skof"]:
             skof = SkofTerm(skull, photo, centre)
+            skof = WorkingSkof(skof, level) if working else skof
     if use_pll:
         try:
             pll = PllTerm(skull, photo, centre)
+            pll = WorkingPll(pll, level) if working else pll
         except TermOff as exc:
             off["p_pll"] = str(exc)
     return skof, pll, {k: v for k, v in off.items() if v}
@@ -262,3 +276,37 @@ def planned_terms_off(skull, photo, variant_terms):
         except TermOff as exc:
             off["p_pll"] = str(exc)
     return {**off, **prior_terms_off(photo.priors)}
+
+
+def full_image_terms(skull, photo, camera, use_skof, use_pll):
+    """P_skof and P_pll of one camera at the photo's resolution on the full mesh.
+
+    What an SFO's result reports when its DE ran at a working level
+    (:mod:`lilium.methods.working_level`): the exact terms of the best camera.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    camera : Camera
+    use_skof, use_pll : bool
+        Which terms to compute (those that ran in the DE).
+
+    Returns
+    -------
+    terms : dict of str -> float
+        ``p_skof`` and/or ``p_pll`` (those asked for).
+    outside : ImplausibleSFO or None
+        The skull pixels outside the face mask (:func:`lilium.evaluation.metrics.outside_face`),
+        when P_skof was asked for.
+    """
+    from ..evaluation.metrics import outside_face
+
+    terms, outside = {}, None
+    if use_skof:
+        outside = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
+        terms["p_skof"] = float(skof_penalty(outside.outside_px))
+    if use_pll:
+        pll = PllTerm(skull, photo, camera.principal_point_px)
+        terms["p_pll"] = float(pll(camera.as_batch())[0])
+    return terms, outside
