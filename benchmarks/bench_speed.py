@@ -49,7 +49,8 @@ class TermClock:
         "setup": (lilium_method.LiliumProblem, "__init__"),
         "cameras": (lilium_method.LiliumProblem, "cameras"),
         "p_skof": (lilium_terms.SkofTerm, "__call__"),
-        "p_pll": (lilium_terms.PllTerm, "__call__"),
+        "p_pll": (lilium_terms.PllTerm, "parts"),
+        "final": (lilium_method, "full_image_terms"),
     }
 
     def __init__(self):

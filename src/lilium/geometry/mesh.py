@@ -65,3 +65,71 @@ def decimate(vertices, faces, target_faces):
         target_reduction=reduction,
     )
     return compact(np.asarray(v, dtype=float), np.asarray(f, dtype=np.int64))
+
+
+def cluster_vertices(vertices_mm, faces, cell_mm):
+    """Vertex clustering: merge the vertices of each cubic cell into their mean.
+
+    Parameters
+    ----------
+    vertices_mm : ndarray of shape (V, 3)
+    faces : ndarray of shape (F, 3)
+    cell_mm : float
+
+    Returns
+    -------
+    vertices_mm : ndarray of shape (V', 3)
+    faces : ndarray of shape (F', 3), int64
+        The faces whose corners stay in three different cells (orientation kept).
+    """
+    v = np.asarray(vertices_mm, float)
+    key = np.floor((v - v.min(axis=0)) / cell_mm).astype(np.int64)
+    dims = key.max(axis=0) + 1
+    flat = (key[:, 0] * dims[1] + key[:, 1]) * dims[2] + key[:, 2]
+    if np.prod(dims.astype(float)) <= 4 * len(v) + 1e6:
+        # Dense cells: ids in cell order without sorting.
+        used = np.zeros(int(np.prod(dims)), bool)
+        used[flat] = True
+        ids = np.cumsum(used) - 1
+        inverse = ids[flat]
+        n = int(used.sum())
+    else:
+        _, inverse = np.unique(flat, return_inverse=True)
+        n = int(inverse.max()) + 1
+    count = np.bincount(inverse, minlength=n).astype(float)
+    merged = np.stack([np.bincount(inverse, weights=v[:, k], minlength=n) for k in range(3)], 1)
+    merged /= count[:, None]
+    g = inverse[np.asarray(faces)]
+    keep = (g[:, 0] != g[:, 1]) & (g[:, 1] != g[:, 2]) & (g[:, 0] != g[:, 2])
+    return merged, np.ascontiguousarray(g[keep], dtype=np.int64)
+
+
+#: Cell of the mesh a picture is shaded from, in pixels of that picture (:func:`display_mesh`).
+DISPLAY_CELL_PX = 1.0
+
+
+def display_mesh(vertices_mm, faces, camera, cell_px=DISPLAY_CELL_PX):
+    """The mesh a picture under ``camera`` is shaded from: vertices clustered in cells of about
+    ``cell_px`` pixels at the mesh's nearest depth (:func:`cluster_vertices`).
+
+    For the eye only (shading, which triangle a pixel shows): silhouettes and counts are
+    rasterised from the full mesh. A mesh whose triangles are larger than the cells comes back
+    almost unchanged.
+
+    Parameters
+    ----------
+    vertices_mm : ndarray of shape (V, 3)
+    faces : ndarray of shape (F, 3)
+    camera : Camera
+
+    Returns
+    -------
+    vertices_mm : ndarray of shape (V', 3)
+    faces : ndarray of shape (F', 3), int64
+    """
+    vertices_mm = np.asarray(vertices_mm, dtype=float)
+    depth = camera.to_camera_frame(vertices_mm)[:, 2]
+    depth = depth[np.isfinite(depth) & (depth > 0)]
+    if len(depth) == 0 or len(faces) == 0:
+        return vertices_mm, np.asarray(faces, dtype=np.int64)
+    return cluster_vertices(vertices_mm, faces, cell_px * float(depth.min()) / camera.focal_px)

@@ -6,6 +6,7 @@ Pure functions returning ``(H, W, 3)`` uint8 RGB arrays; writing them is :mod:`l
 import cv2
 import numpy as np
 
+from ..geometry.mesh import display_mesh
 from .raster import skull_raster
 
 #: Colours (RGB).
@@ -46,8 +47,10 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh, *, topology=No
     """
     width, height = (int(s) for s in image_size_wh)
     faces = np.asarray(faces, dtype=np.int64)
+    covered = skull_raster(camera.project(vertices_mm), faces, (height, width), topology=topology)
+    # The shading comes from the mesh clustered at one pixel (the silhouette above is exact).
+    vertices_mm, faces = display_mesh(vertices_mm, faces, camera)
     uv_vertices = camera.project(vertices_mm)
-    covered = skull_raster(uv_vertices, faces, (height, width), topology=topology)
     X = camera.to_camera_frame(vertices_mm)
     tri = X[faces]
     keep = np.all(np.isfinite(uv_vertices[faces]), axis=(1, 2))

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from ..geometry.mesh import display_mesh
 from .raster import skull_raster
 
 #: Direction towards the key light in the camera frame (x right, y down, z forward): upper
@@ -112,8 +113,10 @@ def render_surface(vertices_mm, faces, camera, image_size_wh, *, topology=None):
     width, height = (int(s) for s in image_size_wh)
     vertices_mm = np.asarray(vertices_mm, dtype=float)
     faces = np.asarray(faces, dtype=np.int64)
+    covered = skull_raster(camera.project(vertices_mm), faces, (height, width), topology=topology)
+    # The shading comes from the mesh clustered at one pixel (the silhouette above is exact).
+    vertices_mm, faces = display_mesh(vertices_mm, faces, camera)
     uv = camera.project(vertices_mm)
-    covered = skull_raster(uv, faces, (height, width), topology=topology)
     X = camera.to_camera_frame(vertices_mm)
     normals_cam = vertex_normals(vertices_mm, faces) @ camera.R.T
     tri_uv = uv[faces]
