@@ -105,12 +105,13 @@ def cluster_vertices(vertices_mm, faces, cell_mm):
 
 
 #: Cell of the mesh a picture is shaded from, in pixels of that picture (:func:`display_mesh`).
-DISPLAY_CELL_PX = 1.0
+DISPLAY_CELL_PX = 2.0
 
 
 def display_mesh(vertices_mm, faces, camera, cell_px=DISPLAY_CELL_PX):
     """The mesh a picture under ``camera`` is shaded from: vertices clustered in cells of about
-    ``cell_px`` pixels at the mesh's nearest depth (:func:`cluster_vertices`).
+    ``cell_px`` pixels at the mesh's nearest depth (:func:`cluster_vertices`; 2 px: a 600k-face
+    CT skull in a 0.8 MP photo shades from about a fifth of its faces, at the same look).
 
     For the eye only (shading, which triangle a pixel shows): silhouettes and counts are
     rasterised from the full mesh. A mesh whose triangles are larger than the cells comes back

@@ -242,8 +242,10 @@ def image_terms(skull, photo, centre, use_skof, use_pll, level=None):
             skof = WorkingSkof(skof, level) if working else skof
     if use_pll:
         try:
-            pll = PllTerm(skull, photo, centre)
-            pll = WorkingPll(pll, level) if working else pll
+            if working:
+                pll = WorkingPll(PllTerm(level.pll_skull or skull, photo, centre), level)
+            else:
+                pll = PllTerm(skull, photo, centre)
         except TermOff as exc:
             off["p_pll"] = str(exc)
     return skof, pll, {k: v for k, v in off.items() if v}

@@ -12,9 +12,10 @@ scores its populations at a *working level*, one rule for both:
   landmarks, the facial curve and the mask (area-resampled, a working pixel is face when at least
   half of it is);
 - **mesh**: the skull's vertices are clustered in cubic cells of :data:`WORKING_CELL_PX` working
-  pixels (converted to millimetres by the landmarks' own image scale, :func:`px_per_mm`); each
-  cell's vertices merge into their mean and the faces that collapse are dropped. Not done when
-  the cells would be smaller than the mesh's median edge (nothing to merge).
+  pixels for P_skof and :data:`WORKING_PLL_CELL_PX` for P_pll's region (converted to millimetres
+  by the landmarks' own image scale, :func:`px_per_mm`); each cell's vertices merge into their
+  mean and the faces that collapse are dropped. Not done when the cells would be smaller than
+  the mesh's median edge (nothing to merge).
 
 The terms come back in full-resolution units: P_skof's count divided by ``scale^2``, P_pll's
 distances (``Delta_d``, ``P_conv``) by ``scale``, ``P_int``'s count unchanged. The result of an
@@ -35,8 +36,11 @@ from ..geometry.mesh import cluster_vertices
 #: across at the working resolution; photos where it is smaller are not resampled.
 WORKING_FACE_PX = 400.0
 
-#: Vertex-clustering cell of the working mesh, in working pixels.
+#: Vertex-clustering cell of the working mesh P_skof counts on, in working pixels.
 WORKING_CELL_PX = 8.0
+
+#: The same for P_pll's region (its curve is the region's outline: a finer cell).
+WORKING_PLL_CELL_PX = 2.0
 
 
 @dataclass(frozen=True)
@@ -48,18 +52,21 @@ class WorkingLevel:
     scale : float
         Working pixels per photo pixel (<= 1).
     skull : Skull
-        The working mesh (the same landmarks).
+        The working mesh of P_skof (the same landmarks).
     photo : Photo
         Resampled: ``image_size_wh``, landmarks, mask and facial curve in working pixels;
         the pixels of the picture itself dropped.
     cell_mm : float
         Vertex-clustering cell (0: the full mesh).
+    pll_skull : Skull or None
+        The working mesh of P_pll (cells of :data:`WORKING_PLL_CELL_PX`); None = ``skull``.
     """
 
     scale: float
     skull: object
     photo: object
     cell_mm: float = 0.0
+    pll_skull: object = None
 
     @property
     def is_full(self):
@@ -163,14 +170,18 @@ def working_level(skull, photo, corr, face_px=WORKING_FACE_PX, cell_px=WORKING_C
     scale = min(1.0, face_px / extent) if extent > 0 else 1.0
     work_photo = photo if scale == 1.0 else resample_photo(photo, scale)
     density = px_per_mm(corr.uv_px, corr.cranial_mm) * scale
-    cell_mm = cell_px / density if density > 0 else 0.0
-    work_skull = skull
-    if cell_mm > median_edge_mm(skull.vertices_mm, skull.faces):
+    edge_mm = median_edge_mm(skull.vertices_mm, skull.faces)
+
+    def clustered(cell):
+        cell_mm = cell / density if density > 0 else 0.0
+        if cell_mm <= edge_mm:
+            return skull, 0.0
         vertices, faces = cluster_vertices(skull.vertices_mm, skull.faces, cell_mm)
-        work_skull = replace(skull, vertices_mm=vertices, faces=faces)
-    else:
-        cell_mm = 0.0
-    return WorkingLevel(scale, work_skull, work_photo, cell_mm)
+        return replace(skull, vertices_mm=vertices, faces=faces), cell_mm
+
+    work_skull, cell_mm = clustered(cell_px)
+    pll_skull, _ = clustered(cell_px * WORKING_PLL_CELL_PX / WORKING_CELL_PX)
+    return WorkingLevel(scale, work_skull, work_photo, cell_mm, pll_skull)
 
 
 class WorkingSkof:
