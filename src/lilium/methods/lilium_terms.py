@@ -16,6 +16,7 @@ from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_cameras
 from ..geometry.camera import principal_point_of
+from ..geometry.mesh import decimate
 from .working_level import WorkingPll, WorkingSkof
 
 
@@ -120,6 +121,16 @@ class PllTerm:
     The skull region is cut once per SFO (:mod:`lilium.fitness.regions`); the facial curve is the
     photo's ``face_curve.json`` or, when absent, derived from the face mask and landmarks.
 
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    centre : ndarray of shape (2,)
+        Principal point (pixels).
+    region_fraction : float
+        Keep about this fraction of the region's faces (quadric decimation; the DE's working
+        level, :mod:`lilium.methods.working_level`); 1 = the region as cut.
+
     Raises
     ------
     TermOff
@@ -127,7 +138,7 @@ class PllTerm:
         empty; the skull's landmarks cannot orient the head); the message says why.
     """
 
-    def __init__(self, skull, photo, centre):
+    def __init__(self, skull, photo, centre, region_fraction=1.0):
         reason = pll_off_reason(skull, photo)
         if reason:
             raise TermOff(reason)
@@ -152,9 +163,12 @@ class PllTerm:
                 f"photo {photo.id!r}: the facial {region_name} curve is empty (check "
                 "face_mask.png and the landmarks, or give face_curve.json)"
             )
-        self.region_vertices_mm = skull.vertices_mm[region.vertex_index]
+        vertices_mm, faces = skull.vertices_mm[region.vertex_index], region.faces
+        if region_fraction < 1.0 and len(faces) * region_fraction >= 4:
+            vertices_mm, faces = decimate(vertices_mm, faces, len(faces) * region_fraction)
+        self.region_vertices_mm = vertices_mm
         self.context = PllContext.build(
-            region.faces, face_curve, view, image_shape=photo.image_size_wh[::-1]
+            faces, face_curve, view, image_shape=photo.image_size_wh[::-1]
         )
         self.span_mm = None if view == "frontal" else np.array([lm["glabella"], lm["metopion"]])
         self.centre = centre
@@ -233,17 +247,17 @@ def image_terms(skull, photo, centre, use_skof, use_pll, level=None):
     skof = pll = None
     off = {}
     working = level is not None and not level.is_full
-    if working:
-        skull, photo, centre = level.skull, level.photo, level.centre(centre)
     if use_skof:
         off["p_skof"] = skof_off_reason(photo)
-        if not off["p_skof"]:
+        if not off["p_skof"] and working:
+            skof = WorkingSkof(SkofTerm(level.skull, level.photo, level.centre(centre)), level)
+        elif not off["p_skof"]:
             skof = SkofTerm(skull, photo, centre)
-            skof = WorkingSkof(skof, level) if working else skof
     if use_pll:
         try:
-            if working:
-                pll = WorkingPll(PllTerm(level.pll_skull or skull, photo, centre), level)
+            if working:  # the region cut from the full mesh, then decimated
+                term = PllTerm(skull, level.photo, level.centre(centre), level.pll_fraction)
+                pll = WorkingPll(term, level)
             else:
                 pll = PllTerm(skull, photo, centre)
         except TermOff as exc:

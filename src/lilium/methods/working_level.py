@@ -11,11 +11,12 @@ scores its populations at a *working level*, one rule for both:
   ``(scale f, (c + 1/2) scale - 1/2)`` (pixel centres at integer coordinates), and so are the
   landmarks, the facial curve and the mask (area-resampled, a working pixel is face when at least
   half of it is);
-- **mesh**: the skull's vertices are clustered in cubic cells of :data:`WORKING_CELL_PX` working
-  pixels for P_skof and :data:`WORKING_PLL_CELL_PX` for P_pll's region (converted to millimetres
-  by the landmarks' own image scale, :func:`px_per_mm`); each cell's vertices merge into their
-  mean and the faces that collapse are dropped. Not done when the cells would be smaller than
-  the mesh's median edge (nothing to merge).
+- **mesh**: for P_skof the skull's vertices are clustered in cubic cells of
+  :data:`WORKING_CELL_PX` working pixels (converted to millimetres by the landmarks' own image
+  scale, :func:`px_per_mm`); each cell's vertices merge into their mean and the faces that
+  collapse are dropped (not done when the cells would be smaller than the mesh's median edge).
+  P_pll's region is cut from the full mesh and quadric-decimated to a median edge of about
+  :data:`WORKING_PLL_EDGE_PX` working pixels (not when its edges are longer already).
 
 The terms come back in full-resolution units: P_skof's count divided by ``scale^2``, P_pll's
 distances (``Delta_d``, ``P_conv``) by ``scale``, ``P_int``'s count unchanged. The result of an
@@ -39,8 +40,9 @@ WORKING_FACE_PX = 400.0
 #: Vertex-clustering cell of the working mesh P_skof counts on, in working pixels.
 WORKING_CELL_PX = 8.0
 
-#: The same for P_pll's region (its curve is the region's outline: a finer cell).
-WORKING_PLL_CELL_PX = 2.0
+#: P_pll's region (cut from the full mesh) is quadric-decimated to a median edge of about this
+#: many working pixels (its curve is the region's outline: a shape-keeping decimation).
+WORKING_PLL_EDGE_PX = 8.0
 
 
 @dataclass(frozen=True)
@@ -58,20 +60,20 @@ class WorkingLevel:
         the pixels of the picture itself dropped.
     cell_mm : float
         Vertex-clustering cell (0: the full mesh).
-    pll_skull : Skull or None
-        The working mesh of P_pll (cells of :data:`WORKING_PLL_CELL_PX`); None = ``skull``.
+    pll_fraction : float
+        The fraction of P_pll's region faces kept (:data:`WORKING_PLL_EDGE_PX`; 1 = all).
     """
 
     scale: float
     skull: object
     photo: object
     cell_mm: float = 0.0
-    pll_skull: object = None
+    pll_fraction: float = 1.0
 
     @property
     def is_full(self):
         """True when the working level is the full one (no resampling, the full mesh)."""
-        return self.scale == 1.0 and self.cell_mm == 0.0
+        return self.scale == 1.0 and self.cell_mm == 0.0 and self.pll_fraction == 1.0
 
     def centre(self, centre_px):
         """The working principal point ``(2,)`` of a full-resolution one."""
@@ -180,8 +182,8 @@ def working_level(skull, photo, corr, face_px=WORKING_FACE_PX, cell_px=WORKING_C
         return replace(skull, vertices_mm=vertices, faces=faces), cell_mm
 
     work_skull, cell_mm = clustered(cell_px)
-    pll_skull, _ = clustered(cell_px * WORKING_PLL_CELL_PX / WORKING_CELL_PX)
-    return WorkingLevel(scale, work_skull, work_photo, cell_mm, pll_skull)
+    pll_fraction = min(1.0, (edge_mm * density / WORKING_PLL_EDGE_PX) ** 2)
+    return WorkingLevel(scale, work_skull, work_photo, cell_mm, pll_fraction)
 
 
 class WorkingSkof:
