@@ -102,35 +102,3 @@ def cluster_vertices(vertices_mm, faces, cell_mm):
     g = inverse[np.asarray(faces)]
     keep = (g[:, 0] != g[:, 1]) & (g[:, 1] != g[:, 2]) & (g[:, 0] != g[:, 2])
     return merged, np.ascontiguousarray(g[keep], dtype=np.int64)
-
-
-#: Cell of the mesh a picture is shaded from, in pixels of that picture (:func:`display_mesh`).
-DISPLAY_CELL_PX = 2.0
-
-
-def display_mesh(vertices_mm, faces, camera, cell_px=DISPLAY_CELL_PX):
-    """The mesh a picture under ``camera`` is shaded from: vertices clustered in cells of about
-    ``cell_px`` pixels at the mesh's nearest depth (:func:`cluster_vertices`; 2 px: a 600k-face
-    CT skull in a 0.8 MP photo shades from about a fifth of its faces, at the same look).
-
-    For the eye only (shading, which triangle a pixel shows): silhouettes and counts are
-    rasterised from the full mesh. A mesh whose triangles are larger than the cells comes back
-    almost unchanged.
-
-    Parameters
-    ----------
-    vertices_mm : ndarray of shape (V, 3)
-    faces : ndarray of shape (F, 3)
-    camera : Camera
-
-    Returns
-    -------
-    vertices_mm : ndarray of shape (V', 3)
-    faces : ndarray of shape (F', 3), int64
-    """
-    vertices_mm = np.asarray(vertices_mm, dtype=float)
-    depth = camera.to_camera_frame(vertices_mm)[:, 2]
-    depth = depth[np.isfinite(depth) & (depth > 0)]
-    if len(depth) == 0 or len(faces) == 0:
-        return vertices_mm, np.asarray(faces, dtype=np.int64)
-    return cluster_vertices(vertices_mm, faces, cell_px * float(depth.min()) / camera.focal_px)
