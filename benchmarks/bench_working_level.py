@@ -2,8 +2,10 @@
 against the working level, on identical seeds (issue 26).
 
 For every Exp. C photo of a generated dataset (each on its own skull, axes set C1), Lilium
-skof+pll at ``--generations`` x 30, seed 1, twice: with ``working_face_px=None`` (the full level,
-the path before issue 26) and with the default working level. Optionally the same at real size
+skof+pll at ``--generations`` x 30, for each seed of ``--seeds`` (the spread between seeds of
+one path is the noise the difference between the paths is measured against), twice: with
+``working_face_px=None`` (the full level, the path before issue 26) and with the default
+working level. Optionally the same at real size
 (``--faces``, ``--megapixels``: the skull subdivided, the photo resampled, :mod:`real_size`).
 Prints per photo and in total: BPE (mm), the result's skull pixels outside the face mask (full
 mesh, full resolution; "implausible" when > 0), fitness and CPU seconds.
@@ -17,6 +19,7 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_name, "1")
 
 import argparse  # noqa: E402
+import itertools  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -68,6 +71,7 @@ def main(argv=None):
     p.add_argument("--generations", type=int, default=300)
     p.add_argument("--faces", type=int, default=0, help="subdivide each skull to this many")
     p.add_argument("--megapixels", type=float, default=0.0, help="resample each photo")
+    p.add_argument("--seeds", default="1", help="comma-separated DE seeds")
     args = p.parse_args(argv)
     root = args.dataset
     if root is None or not (root / "dataset.json").exists():
@@ -78,22 +82,26 @@ def main(argv=None):
     base = SfoOptions("skof+pll").with_de(max_generations=args.generations, max_seconds=1e9)
     paths = {"full": SfoOptions(**{**base.__dict__, "working_face_px": None}), "working": base}
     rows = []
-    print(f"{'photo':<10} {'path':<8} {'BPE mm':>7} {'outside px':>10} {'fitness':>9} {'s':>6}")
+    print(
+        f"{'photo':<10} {'path':<8} {'seed':>4} {'BPE mm':>7} {'outside px':>10} "
+        f"{'fitness':>9} {'s':>6}"
+    )
+    seeds = [int(s) for s in args.seeds.split(",")]
     for label, skull, photo, truth, scale in cases(root, args.faces, args.megapixels):
-        for name, options in paths.items():
+        for (name, options), seed in itertools.product(paths.items(), seeds):
             t0 = time.process_time()
-            result = run_sfo("lilium", skull, photo, options, 1)
+            result = run_sfo("lilium", skull, photo, options, seed)
             seconds = time.process_time() - t0
             bpe = scaled_truth_bpe(result, truth, scale)
             outside = score(result, skull=skull, face_mask=photo.face_mask).implausible
             out_px = outside.outside_px if outside is not None else -1
-            rows.append((label, name, bpe, out_px, result.fitness, seconds))
+            rows.append((label, name, bpe, out_px, result.fitness, seconds, seed))
             print(
-                f"{label:<10} {name:<8} {bpe:7.3f} {out_px:10d} {result.fitness:9.2f} "
+                f"{label:<10} {name:<8} {seed:4d} {bpe:7.3f} {out_px:10d} {result.fitness:9.2f} "
                 f"{seconds:6.2f}",
                 flush=True,
             )
-    print(f"\n{len(rows) // 2} photos, {args.generations} generations, seed 1")
+    print(f"\n{len(rows) // 2 // len(seeds)} photos, {args.generations} generations, seeds {seeds}")
     for name in paths:
         mine = [r for r in rows if r[1] == name]
         bpe = np.array([r[2] for r in mine])
@@ -102,6 +110,9 @@ def main(argv=None):
             f"{name:<8} BPE mean {np.nanmean(bpe):.3f} median {np.nanmedian(bpe):.3f} mm; "
             f"implausible {implausible}/{len(mine)}; CPU {sum(r[5] for r in mine):.1f} s"
         )
+        for seed in seeds:
+            bpe = np.array([r[2] for r in mine if r[6] == seed])
+            print(f"  seed {seed}: BPE mean {np.nanmean(bpe):.3f} mm")
 
 
 if __name__ == "__main__":

@@ -8,7 +8,8 @@ this module renders per pixel:
 - **surface buffers** (:func:`render_surface`): the exact silhouette (the one mesh raster,
   :func:`lilium.imaging.raster.skull_raster`), and inside it each pixel's nearest triangle
   (a compiled depth buffer, :mod:`lilium.imaging._paint_kernels`), its depth (mm, camera
-  frame) and its normal, interpolated from area-weighted vertex normals with the pixel centre's barycentric coordinates;
+  frame) and its normal, interpolated from area-weighted vertex normals with the pixel
+  centre's barycentric coordinates;
 - **shade** (:func:`shade_surface`): a key light from the upper left and a fill light from the
   camera (two-sided, a mesh may be wound either way), darkened where the surface lies deeper
   than its neighbourhood (unsharp masking of the depth buffer, Luft, Colditz & Deussen 2006: a
