@@ -410,7 +410,7 @@ def check_topology(faces, topology):
 
 
 #: Meshes whose :class:`EdgeTopology` :func:`cached_topology` keeps (the most recent ones).
-TOPOLOGY_CACHE_SIZE = 2
+TOPOLOGY_CACHE_SIZE = 4
 
 _topologies = {}
 

@@ -85,9 +85,14 @@ def vertex_normals(vertices_mm, faces):
     """Area-weighted unit vertex normals ``(V, 3)`` (0 for an unused vertex)."""
     tri = vertices_mm[faces]
     face_n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])  # length = 2 x area
-    normals = np.zeros_like(vertices_mm, dtype=float)
-    for k in range(3):
-        np.add.at(normals, faces[:, k], face_n)
+    n = len(vertices_mm)
+    normals = np.stack(
+        [
+            sum(np.bincount(faces[:, k], weights=face_n[:, j], minlength=n) for k in range(3))
+            for j in range(3)
+        ],
+        axis=1,
+    )
     norm = np.linalg.norm(normals, axis=1, keepdims=True)
     return np.divide(normals, norm, out=np.zeros_like(normals), where=norm > 1e-12)
 
@@ -115,13 +120,12 @@ def render_surface(vertices_mm, faces, camera, image_size_wh, *, topology=None):
     covered = skull_raster(uv, faces, (height, width), topology=topology)
     X = camera.to_camera_frame(vertices_mm)
     normals_cam = vertex_normals(vertices_mm, faces) @ camera.R.T
-    tri_uv = uv[faces]
     # The nearest triangle at each pixel centre (a compiled depth buffer).
-    depth_key = X[faces, 2].mean(axis=1)
+    depth_key = X[:, 2][faces].mean(axis=1)
     face_index = nearest_face_index(uv, faces, depth_key, (height, width), covered=covered)
     rows, cols = np.nonzero(face_index >= 0)
     f = face_index[rows, cols]
-    a, b, c = (tri_uv[f, k] for k in range(3))
+    a, b, c = (uv[faces[f, k]] for k in range(3))
     p = np.stack([cols, rows], axis=1).astype(float)
     # Barycentric coordinates of the pixel centre (clipped: a gap pixel shows a neighbour).
     d = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])

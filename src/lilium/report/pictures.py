@@ -363,13 +363,13 @@ def skull_view_pictures(skull, views, key_prefix="skv"):
         Empty when the landmarks cannot orient the skull (too few of them).
     """
     from ..fitness.regions import anatomical_frame
-    from ..imaging.raster import mesh_edge_topology
+    from ..imaging.raster import cached_topology
 
     try:
         frame = anatomical_frame(skull.landmarks_mm)
     except ValueError:
         return ()
-    topology = mesh_edge_topology(skull.faces)
+    topology = cached_topology(skull.faces)
     pictures = []
     for view in views:
         sv = skull_view(
