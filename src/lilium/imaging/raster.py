@@ -409,6 +409,15 @@ def check_topology(faces, topology):
     return cached_topology(faces)
 
 
+def content_key(*arrays):
+    """A key that identifies arrays by their dtype, shape and content (BLAKE2 digests)."""
+    key = []
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        key += [a.dtype.str, a.shape, hashlib.blake2b(a.data, digest_size=16).digest()]
+    return tuple(key)
+
+
 #: Meshes whose :class:`EdgeTopology` :func:`cached_topology` keeps (the most recent ones).
 TOPOLOGY_CACHE_SIZE = 4
 
@@ -424,7 +433,7 @@ def cached_topology(faces):
     the identification terms and the report: the topology is built once for them.
     """
     faces = check_faces(faces)
-    key = (faces.shape, hashlib.blake2b(np.ascontiguousarray(faces).data, digest_size=16).digest())
+    key = content_key(faces)
     topology = _topologies.pop(key, None)
     if topology is None:
         topology = mesh_edge_topology(faces)

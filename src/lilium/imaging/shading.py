@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 
 from ._paint_kernels import nearest_face_index
-from .raster import skull_raster
+from .raster import content_key, skull_raster
 
 #: Direction towards the key light in the camera frame (x right, y down, z forward): upper
 #: left, in front of the face.
@@ -81,6 +81,18 @@ class SurfaceRender:
         return float(length_mm * self.focal_px / depth)
 
 
+_normals = {}
+
+
+def cached_vertex_normals(vertices_mm, faces):
+    """:func:`vertex_normals`, kept for the last mesh (a report shades one skull three times)."""
+    key = content_key(vertices_mm, faces)
+    if key not in _normals:
+        _normals.clear()
+        _normals[key] = vertex_normals(vertices_mm, faces)
+    return _normals[key]
+
+
 def vertex_normals(vertices_mm, faces):
     """Area-weighted unit vertex normals ``(V, 3)`` (0 for an unused vertex)."""
     tri = vertices_mm[faces]
@@ -119,7 +131,7 @@ def render_surface(vertices_mm, faces, camera, image_size_wh, *, topology=None):
     uv = camera.project(vertices_mm)
     covered = skull_raster(uv, faces, (height, width), topology=topology)
     X = camera.to_camera_frame(vertices_mm)
-    normals_cam = vertex_normals(vertices_mm, faces) @ camera.R.T
+    normals_cam = cached_vertex_normals(vertices_mm, faces) @ camera.R.T
     # The nearest triangle at each pixel centre (a compiled depth buffer).
     depth_key = X[:, 2][faces].mean(axis=1)
     face_index = nearest_face_index(uv, faces, depth_key, (height, width), covered=covered)
