@@ -408,13 +408,17 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     Returns
     -------
     SfoResult
-        The best member DE ranked: its camera, fitness and terms as DE evaluated them
-        (``fitness`` equals the last value of ``history``); ``terms_off`` names the terms the
-        variant asks for that could not apply, and the P_cam parts without a prior. ``extra``
+        The best member DE ranked: its camera, and its terms and fitness at full level (with
+        the DE at a working level, :mod:`~lilium.methods.working_level`, the image terms are
+        recomputed at the photo's resolution on the full mesh, and ``fitness``, their sum, may
+        differ from the last value of ``history``; at full level it equals it); ``terms_off``
+        names the terms the variant asks for that could not apply, and the P_cam parts without
+        a prior. ``extra``
         holds ``history`` (best fitness per generation), ``generations``, ``evaluations``,
         ``stop``, ``genes``, ``fallbacks``, ``no_camera_evaluations`` (population evaluations
-        where no member had a camera and each took its own POSEST) and ``rescued`` (the initial
-        population got POSEST-SFO's soft tissue and camera, :func:`rescue_population`).
+        where no member had a camera and each took its own POSEST), ``rescued`` (the initial
+        population got POSEST-SFO's soft tissue and camera, :func:`rescue_population`) and the
+        working level's (:meth:`LiliumProblem.level_extra`).
     """
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
