@@ -195,8 +195,9 @@ def view_box(size_wh, covered=None, mask=None, points_uv=()):
             vs += [rows.min(), rows.max()]
     pts = np.asarray(points_uv, dtype=float).reshape(-1, 2)
     pts = pts[np.all(np.isfinite(pts), axis=1)]
-    us += list(pts[:, 0])
-    vs += list(pts[:, 1])
+    if len(pts):  # the extremes only (a skull's projected vertices are hundreds of thousands)
+        us += [pts[:, 0].min(), pts[:, 0].max()]
+        vs += [pts[:, 1].min(), pts[:, 1].max()]
     if not us:
         return 0, 0, w, h
     margin = VIEW_MARGIN * max(max(us) - min(us), max(vs) - min(vs))
