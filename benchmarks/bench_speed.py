@@ -11,6 +11,13 @@ compiled kernels replaced: it gives the same numbers (``tests/test_kernels.py``)
 
     python benchmarks/bench_speed.py                       # generated Exp. C photos
     python benchmarks/bench_speed.py --dataset DIR --dataset DIR2   # e.g. a 150k-face skull
+    python benchmarks/bench_speed.py --real-size                    # issue 26's real sizes
+
+``--real-size`` times, on the first frontal photo of the dataset, Lilium skof+pll and base with
+the DE's working level (``after``, the default) and without it (``before``: every evaluation at
+the photo's resolution on the full mesh, ``working_face_px=None``), in the same run, at real
+sizes (:mod:`real_size`): the skull subdivided to 150k, 600k and 1.2M faces at 2 MP, and the
+600k-face skull with the photo resampled to 1, 12 and 24 MP; with the per-term profile of each.
 
 Each SFO is seeded (seed 1, perturbed axes set C1) and runs on one core. Times are the process's
 CPU time (``time.process_time``, single-threaded BLAS), not wall time: on a shared machine the
@@ -49,7 +56,8 @@ class TermClock:
         "setup": (lilium_method.LiliumProblem, "__init__"),
         "cameras": (lilium_method.LiliumProblem, "cameras"),
         "p_skof": (lilium_terms.SkofTerm, "__call__"),
-        "p_pll": (lilium_terms.PllTerm, "__call__"),
+        "p_pll": (lilium_terms.PllTerm, "parts"),
+        "final": (lilium_method, "full_image_terms"),
     }
 
     def __init__(self):
@@ -103,6 +111,7 @@ def main(argv=None):
     p.add_argument("--population", type=int, default=DEOptions().population_size)
     p.add_argument("--reference-generations", type=int, default=40)
     p.add_argument("--posest-repeats", type=int, default=30)
+    p.add_argument("--real-size", action="store_true", help="issue 26's real-size table")
     args = p.parse_args(argv)
     if not jit.NUMBA_AVAILABLE:
         p.error("numba is not installed: nothing to compare (pip install 'numba==0.68.1')")
@@ -113,6 +122,8 @@ def main(argv=None):
         root = Path(tempfile.mkdtemp(prefix="lilium-speed-"))
         generate_dataset(root, 1, 1, seed=0, experiments=("C",), workers=1)
         roots = [root]
+    if args.real_size:
+        return real_size_table(roots[0], args)
     variants = [v for v in args.variants.split(",") if v]
     full = SfoOptions().with_de(
         population_size=args.population, max_generations=args.generations, max_seconds=1e9
@@ -177,6 +188,76 @@ def main(argv=None):
         rest = seconds - setup - cams - skof - pll
         print(f"{label:<22} {variant:<9} {seconds:7.2f} {setup:7.2f} {cams:8.2f} ", end="")
         print(f"{skof:7.2f} {pll:7.2f} {rest:7.2f}")
+
+
+#: (faces, megapixels) of the real-size table.
+REAL_SIZES = (
+    (150_000, 2.0),
+    (600_000, 2.0),
+    (1_200_000, 2.0),
+    (600_000, 1.0),
+    (600_000, 12.0),
+    (600_000, 24.0),
+)
+
+
+def real_size_table(root, args):
+    """Issue 26: s per SFO before / after the working level at real sizes, one run."""
+    from real_size import photo_at, skull_at
+
+    label, skull, photo = next(c for c in photos_of(root) if " frontal " in c[0])
+    full = SfoOptions().with_de(
+        population_size=args.population, max_generations=args.generations, max_seconds=1e9
+    )
+    rows = []
+    for faces, megapixels in REAL_SIZES:
+        big, image = skull_at(skull, faces), photo_at(photo, megapixels)
+        run_sfo("lilium", big, image, SfoOptions("skof+pll").with_de(max_generations=2), 0)
+        for variant in ("base", "skof+pll"):
+            for path, face_px in (("after", full.working_face_px), ("before", None)):
+                if variant == "base" and path == "before":
+                    continue  # base has no image terms: no working level
+                options = replace(full, variant=variant, working_face_px=face_px)
+                with TermClock() as clock:
+                    seconds, result = time_sfo("lilium", big, image, options)
+                rows.append(
+                    (
+                        len(big.faces),
+                        image.image_size_wh,
+                        variant,
+                        path,
+                        seconds,
+                        dict(clock.seconds),
+                        result,
+                    )
+                )
+                print(
+                    f"  {len(big.faces):>8} {megapixels:5.1f} MP {variant:<9} {path:<6} "
+                    f"{seconds:7.2f} s",
+                    flush=True,
+                )
+    print(
+        f"\n{label}: CPU s per SFO, one core, {args.generations} x {args.population}; "
+        "'final' = the result's terms at full level"
+    )
+    print(
+        f"{'faces':>9} {'photo':>11} {'variant':<9} {'path':<6} {'total':>7} {'setup':>6} "
+        f"{'cams':>6} {'p_skof':>7} {'p_pll':>6} {'final':>6} {'rest':>6} {'ratio':>6} "
+        f"{'work faces':>10} {'scale':>6}"
+    )
+    before = {(r[0], r[1]): r[4] for r in rows if r[3] == "before"}
+    for faces, size, variant, path, seconds, parts, result in rows:
+        setup, cams, skof, pll, final = (
+            parts.get(k, 0.0) for k in ("setup", "cameras", "p_skof", "p_pll", "final")
+        )
+        rest = seconds - setup - cams - skof - pll - final
+        ratio = before.get((faces, size), float("nan")) / seconds if variant != "base" else 1.0
+        print(
+            f"{faces:>9} {size[0]:>5}x{size[1]:<5} {variant:<9} {path:<6} {seconds:7.2f} "
+            f"{setup:6.2f} {cams:6.2f} {skof:7.2f} {pll:6.2f} {final:6.2f} {rest:6.2f} "
+            f"{ratio:6.1f} {result.extra.get('working_faces', 0):>10} "
+            f"{result.extra.get('working_scale', 1.0):6.3f}"
+        )
 
 
 if __name__ == "__main__":

@@ -65,3 +65,40 @@ def decimate(vertices, faces, target_faces):
         target_reduction=reduction,
     )
     return compact(np.asarray(v, dtype=float), np.asarray(f, dtype=np.int64))
+
+
+def cluster_vertices(vertices_mm, faces, cell_mm):
+    """Vertex clustering: merge the vertices of each cubic cell into their mean.
+
+    Parameters
+    ----------
+    vertices_mm : ndarray of shape (V, 3)
+    faces : ndarray of shape (F, 3)
+    cell_mm : float
+
+    Returns
+    -------
+    vertices_mm : ndarray of shape (V', 3)
+    faces : ndarray of shape (F', 3), int64
+        The faces whose corners stay in three different cells (orientation kept).
+    """
+    v = np.asarray(vertices_mm, float)
+    key = np.floor((v - v.min(axis=0)) / cell_mm).astype(np.int64)
+    dims = key.max(axis=0) + 1
+    flat = (key[:, 0] * dims[1] + key[:, 1]) * dims[2] + key[:, 2]
+    if np.prod(dims.astype(float)) <= 4 * len(v) + 1e6:
+        # Dense cells: ids in cell order without sorting.
+        used = np.zeros(int(np.prod(dims)), bool)
+        used[flat] = True
+        ids = np.cumsum(used) - 1
+        inverse = ids[flat]
+        n = int(used.sum())
+    else:
+        _, inverse = np.unique(flat, return_inverse=True)
+        n = int(inverse.max()) + 1
+    count = np.bincount(inverse, minlength=n).astype(float)
+    merged = np.stack([np.bincount(inverse, weights=v[:, k], minlength=n) for k in range(3)], 1)
+    merged /= count[:, None]
+    g = inverse[np.asarray(faces)]
+    keep = (g[:, 0] != g[:, 1]) & (g[:, 1] != g[:, 2]) & (g[:, 0] != g[:, 2])
+    return merged, np.ascontiguousarray(g[keep], dtype=np.int64)

@@ -6,6 +6,7 @@ Pure functions returning ``(H, W, 3)`` uint8 RGB arrays; writing them is :mod:`l
 import cv2
 import numpy as np
 
+from ._paint_kernels import nearest_face_index
 from .raster import skull_raster
 
 #: Colours (RGB).
@@ -21,12 +22,12 @@ BLEND_BLOCK_PIXELS = 1 << 18
 
 
 def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh, *, topology=None):
-    """Lambert-shaded render of a mesh: the exact silhouette, shaded by the painter's algorithm.
+    """Lambert-shaded render of a mesh: the exact silhouette, shaded by a depth buffer.
 
     The silhouette ``covered`` is the one mesh raster (:func:`lilium.imaging.raster.mesh_mask`,
-    the exact union of the projected triangles, the ``S`` of P_skof); the shading inside it is
-    a painter's fill (far to near) of per-triangle intensities, which only decides which
-    triangle's intensity a covered pixel shows.
+    the exact union of the projected triangles, the ``S`` of P_skof); inside it each pixel shows
+    the intensity of the nearest triangle at its centre
+    (:func:`lilium.imaging._paint_kernels.nearest_face_index`).
 
     Parameters
     ----------
@@ -46,33 +47,18 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh, *, topology=No
     """
     width, height = (int(s) for s in image_size_wh)
     faces = np.asarray(faces, dtype=np.int64)
-    uv_vertices = camera.project(vertices_mm)
-    covered = skull_raster(uv_vertices, faces, (height, width), topology=topology)
-    X = camera.to_camera_frame(vertices_mm)
-    tri = X[faces]
-    keep = np.all(np.isfinite(uv_vertices[faces]), axis=(1, 2))
-    tri, faces = tri[keep], faces[keep]
-    uv = uv_vertices[faces]
+    uv = camera.project(vertices_mm)
+    covered = skull_raster(uv, faces, (height, width), topology=topology)
+    tri = camera.to_camera_frame(vertices_mm)[faces]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
     # Two-sided lighting: a skull mesh may be wound either way.
-    intensity = 0.25 + 0.75 * np.abs(normal @ LIGHT_DIR_CAM)
-    order = np.argsort(-tri[..., 2].mean(axis=1))  # far to near
-    shade = np.zeros((height, width), dtype=np.float32)
-    # Sub-pixel precision: coordinates in 1/16 px, shifted so pixel centres are integers.
-    shift = 4
-    pts_all = np.round(uv * (1 << shift)).astype(np.int64)
-    inside = (
-        (pts_all[..., 0].max(axis=1) >= 0)
-        & (pts_all[..., 1].max(axis=1) >= 0)
-        & (pts_all[..., 0].min(axis=1) < width << shift)
-        & (pts_all[..., 1].min(axis=1) < height << shift)
+    intensity = (0.25 + 0.75 * np.abs(normal @ LIGHT_DIR_CAM)).astype(np.float32)
+    # The nearest triangle at each pixel centre (a compiled depth buffer).
+    index = nearest_face_index(
+        uv, faces, tri[..., 2].mean(axis=1), (height, width), covered=covered
     )
-    for k in order:
-        if not inside[k]:
-            continue
-        pts = pts_all[k].astype(np.int32)
-        cv2.fillConvexPoly(shade, pts, float(intensity[k]), lineType=cv2.LINE_8, shift=shift)
+    shade = np.where(index >= 0, intensity[index], np.float32(0.0))
     shade[~covered] = 0.0
     return shade, covered
 

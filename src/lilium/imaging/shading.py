@@ -7,8 +7,9 @@ this module renders per pixel:
 
 - **surface buffers** (:func:`render_surface`): the exact silhouette (the one mesh raster,
   :func:`lilium.imaging.raster.skull_raster`), and inside it each pixel's nearest triangle
-  (painter's fill, far to near), its depth (mm, camera frame) and its normal, interpolated from
-  area-weighted vertex normals with the pixel centre's barycentric coordinates;
+  (a compiled depth buffer, :mod:`lilium.imaging._paint_kernels`), its depth (mm, camera
+  frame) and its normal, interpolated from area-weighted vertex normals with the pixel
+  centre's barycentric coordinates;
 - **shade** (:func:`shade_surface`): a key light from the upper left and a fill light from the
   camera (two-sided, a mesh may be wound either way), darkened where the surface lies deeper
   than its neighbourhood (unsharp masking of the depth buffer, Luft, Colditz & Deussen 2006: a
@@ -26,7 +27,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .raster import skull_raster
+from ._paint_kernels import nearest_face_index
+from .raster import content_key, skull_raster
 
 #: Direction towards the key light in the camera frame (x right, y down, z forward): upper
 #: left, in front of the face.
@@ -43,9 +45,6 @@ CAVITY_SCALES = ((9.0, 14.0, 0.62), (1.6, 2.5, 0.45))
 #: full line strength, and the line's darkening.
 CREASE_SLOPE, CREASE_FULL_SLOPE, CREASE_STRENGTH = 2.5, 7.0, 0.75
 
-#: Painter's fill precision: coordinates in 1/2**SHIFT pixel.
-_SHIFT = 4
-
 #: Largest Gaussian sigma (pixels) blurred at full resolution (wider: on a shrunk picture).
 _BLUR_SIGMA_PX = 6.0
 
@@ -59,7 +58,7 @@ class SurfaceRender:
     covered : ndarray of shape (H, W), bool
         The exact union of the projected triangles.
     face_index : ndarray of shape (H, W), int32
-        The nearest triangle under each pixel centre (painter's order), -1 where none.
+        The nearest triangle under each pixel centre (depth buffer), -1 where none.
     depth_mm : ndarray of shape (H, W), float32
         Camera-frame depth of the surface (mm), NaN off the mesh.
     normal_cam : ndarray of shape (H, W, 3), float32
@@ -82,13 +81,30 @@ class SurfaceRender:
         return float(length_mm * self.focal_px / depth)
 
 
+_normals = {}
+
+
+def cached_vertex_normals(vertices_mm, faces):
+    """:func:`vertex_normals`, kept for the last mesh (a report shades one skull three times)."""
+    key = content_key(vertices_mm, faces)
+    if key not in _normals:
+        _normals.clear()
+        _normals[key] = vertex_normals(vertices_mm, faces)
+    return _normals[key]
+
+
 def vertex_normals(vertices_mm, faces):
     """Area-weighted unit vertex normals ``(V, 3)`` (0 for an unused vertex)."""
     tri = vertices_mm[faces]
     face_n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])  # length = 2 x area
-    normals = np.zeros_like(vertices_mm, dtype=float)
-    for k in range(3):
-        np.add.at(normals, faces[:, k], face_n)
+    n = len(vertices_mm)
+    normals = np.stack(
+        [
+            sum(np.bincount(faces[:, k], weights=face_n[:, j], minlength=n) for k in range(3))
+            for j in range(3)
+        ],
+        axis=1,
+    )
     norm = np.linalg.norm(normals, axis=1, keepdims=True)
     return np.divide(normals, norm, out=np.zeros_like(normals), where=norm > 1e-12)
 
@@ -115,35 +131,15 @@ def render_surface(vertices_mm, faces, camera, image_size_wh, *, topology=None):
     uv = camera.project(vertices_mm)
     covered = skull_raster(uv, faces, (height, width), topology=topology)
     X = camera.to_camera_frame(vertices_mm)
-    normals_cam = vertex_normals(vertices_mm, faces) @ camera.R.T
-    tri_uv = uv[faces]
-    keep = np.all(np.isfinite(tri_uv), axis=(1, 2))
-    pts = np.round(tri_uv * (1 << _SHIFT)).astype(np.int64)
-    keep &= (
-        (pts[..., 0].max(axis=1) >= 0)
-        & (pts[..., 1].max(axis=1) >= 0)
-        & (pts[..., 0].min(axis=1) < width << _SHIFT)
-        & (pts[..., 1].min(axis=1) < height << _SHIFT)
-    )
-    index = np.flatnonzero(keep)
-    index = index[np.argsort(-X[faces[index], 2].mean(axis=1), kind="stable")]  # far to near
-    face_index = np.full((height, width), -1, dtype=np.int32)
-    pts32 = pts.astype(np.int32)
-    for k in index:
-        cv2.fillConvexPoly(face_index, pts32[k], int(k), lineType=cv2.LINE_8, shift=_SHIFT)
-    # Slivers the painter's fill missed inside the exact raster take a neighbour's triangle.
-    gaps = covered & (face_index < 0)
-    if gaps.any():
-        # OpenCV's dilate takes no int32: dilate the float32 copy (indices < 2^24 stay exact).
-        grown = cv2.dilate(face_index.astype(np.float32), np.ones((3, 3), np.uint8))
-        grown = grown.astype(np.int32)
-        face_index[gaps] = grown[gaps]
-    face_index[~covered] = -1
+    normals_cam = cached_vertex_normals(vertices_mm, faces) @ camera.R.T
+    # The nearest triangle at each pixel centre (a compiled depth buffer).
+    depth_key = X[:, 2][faces].mean(axis=1)
+    face_index = nearest_face_index(uv, faces, depth_key, (height, width), covered=covered)
     rows, cols = np.nonzero(face_index >= 0)
     f = face_index[rows, cols]
-    a, b, c = (tri_uv[f, k] for k in range(3))
+    a, b, c = (uv[faces[f, k]] for k in range(3))
     p = np.stack([cols, rows], axis=1).astype(float)
-    # Barycentric coordinates of the pixel centre (clipped: the painter's fill is not exact).
+    # Barycentric coordinates of the pixel centre (clipped: a gap pixel shows a neighbour).
     d = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])
     ok = np.abs(d) > 1e-9
     d = np.where(ok, d, 1.0)

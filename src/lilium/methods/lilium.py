@@ -40,7 +40,7 @@ from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode, encode_depth_only, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
 from .checks import facing_check, facing_failure
-from .lilium_terms import image_terms, prior_terms_off
+from .lilium_terms import full_image_terms, image_terms, prior_terms_off
 from .options import SfoOptions, with_focal_cap
 from .posest_sfo import (
     RUN_OFF_FACTOR,
@@ -50,6 +50,7 @@ from .posest_sfo import (
     mean_depth_landmarks,
 )
 from .result import SfoResult
+from .working_level import working_level
 
 #: POSEST-SFO's fixed RANSAC seed (:func:`~lilium.methods.posest_sfo.posest_sfo`'s default).
 POSEST_SFO_SEED = 0
@@ -112,15 +113,31 @@ class LiliumProblem:
         self.periodic = np.tile([False, False, True], len(self.corr.cranial_names))
         # Asked-for terms whose inputs are missing are switched off (SPEC section 5), and so is
         # each P_cam part without its prior: ``terms_off`` says which and why.
+        self.level = working_level(skull, photo, self.corr, options.working_face_px)
         self.skof, self.pll, self.terms_off = image_terms(
-            skull, photo, self.centre, self.use_skof, self.use_pll
+            skull, photo, self.centre, self.use_skof, self.use_pll, self.level
         )
         self.terms_off.update(prior_terms_off(photo.priors))
+        self.outside = None  # the result's ImplausibleSFO, once photo_outcome computed it
         self.n_fallbacks = 0  # statistics only
         # Evaluations where no member had a camera to lend and no fit found one (statistics).
         self.n_no_camera = 0
         # Lowest MSE (px^2) of a camera refused for the focal cap, and its focal length.
         self.capped_mse, self.capped_focal_px = np.inf, None
+
+    def level_extra(self):
+        """The working level of the DE and the result's outside count, for ``SfoResult.extra``:
+        ``working_scale``, ``working_faces``, ``working_cell_mm`` and, when the result's
+        P_skof was recomputed at full level, ``outside_px`` and ``skull_px``."""
+        extra = {
+            "working_scale": self.level.scale,
+            "working_faces": len(self.level.skull.faces),
+            "working_cell_mm": self.level.cell_mm,
+        }
+        if self.outside is not None:
+            extra["outside_px"] = self.outside.outside_px
+            extra["skull_px"] = self.outside.skull_px
+        return extra
 
     # -- evaluation -------------------------------------------------------------------------
     def facial_landmarks(self, genes):
@@ -391,13 +408,17 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     Returns
     -------
     SfoResult
-        The best member DE ranked: its camera, fitness and terms as DE evaluated them
-        (``fitness`` equals the last value of ``history``); ``terms_off`` names the terms the
-        variant asks for that could not apply, and the P_cam parts without a prior. ``extra``
+        The best member DE ranked: its camera, and its terms and fitness at full level (with
+        the DE at a working level, :mod:`~lilium.methods.working_level`, the image terms are
+        recomputed at the photo's resolution on the full mesh, and ``fitness``, their sum, may
+        differ from the last value of ``history``; at full level it equals it); ``terms_off``
+        names the terms the variant asks for that could not apply, and the P_cam parts without
+        a prior. ``extra``
         holds ``history`` (best fitness per generation), ``generations``, ``evaluations``,
         ``stop``, ``genes``, ``fallbacks``, ``no_camera_evaluations`` (population evaluations
-        where no member had a camera and each took its own POSEST) and ``rescued`` (the initial
-        population got POSEST-SFO's soft tissue and camera, :func:`rescue_population`).
+        where no member had a camera and each took its own POSEST), ``rescued`` (the initial
+        population got POSEST-SFO's soft tissue and camera, :func:`rescue_population`) and the
+        working level's (:meth:`LiliumProblem.level_extra`).
     """
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
@@ -409,6 +430,10 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     de = solver.solve()
     best = de.payload
     camera, terms, error, warnings = photo_outcome(problem, best, seed)
+    fitness = de.fun
+    if camera is not None and not problem.level.is_full:
+        # The DE's own fitness was at the working level; the result's is the full one.
+        fitness = sum(v for v in terms.values() if v is not None)
     facial = problem.facial_landmarks(de.x)[0]
     return SfoResult(
         method="lilium",
@@ -417,7 +442,7 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         skull_id=skull.id,
         photo_id=photo.id,
         camera=camera,
-        fitness=de.fun,
+        fitness=fitness,
         terms=terms,
         facial_landmarks_mm=dict(zip(problem.corr.facial_names, facial, strict=True)),
         seconds=time.perf_counter() - start,
@@ -428,6 +453,7 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
             **de_extra(de, problem.n_fallbacks),
             "no_camera_evaluations": problem.n_no_camera,
             "rescued": rescued,
+            **problem.level_extra(),
         },
     )
 
@@ -509,6 +535,10 @@ def photo_outcome(problem, best, seed):
     }
     error, warnings = "", ()
     photo, skull = problem.photo, problem.skull
+    if ok and not problem.level.is_full:
+        asked = (problem.skof is not None, problem.pll is not None)
+        exact, problem.outside = full_image_terms(skull, photo, camera, *asked)
+        terms.update(exact)
     if not ok:
         error = _failure_message(problem, best)
     elif photo.priors.focal_px is None:

@@ -16,6 +16,8 @@ from ..fitness.pll import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_cameras
 from ..geometry.camera import principal_point_of
+from ..geometry.mesh import decimate
+from .working_level import WorkingPll, WorkingSkof
 
 
 class SkofTerm:
@@ -119,6 +121,16 @@ class PllTerm:
     The skull region is cut once per SFO (:mod:`lilium.fitness.regions`); the facial curve is the
     photo's ``face_curve.json`` or, when absent, derived from the face mask and landmarks.
 
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    centre : ndarray of shape (2,)
+        Principal point (pixels).
+    region_fraction : float
+        Keep about this fraction of the region's faces (quadric decimation; the DE's working
+        level, :mod:`lilium.methods.working_level`); 1 = the region as cut.
+
     Raises
     ------
     TermOff
@@ -126,7 +138,7 @@ class PllTerm:
         empty; the skull's landmarks cannot orient the head); the message says why.
     """
 
-    def __init__(self, skull, photo, centre):
+    def __init__(self, skull, photo, centre, region_fraction=1.0):
         reason = pll_off_reason(skull, photo)
         if reason:
             raise TermOff(reason)
@@ -151,18 +163,25 @@ class PllTerm:
                 f"photo {photo.id!r}: the facial {region_name} curve is empty (check "
                 "face_mask.png and the landmarks, or give face_curve.json)"
             )
-        self.region_vertices_mm = skull.vertices_mm[region.vertex_index]
+        vertices_mm, faces = skull.vertices_mm[region.vertex_index], region.faces
+        if region_fraction < 1.0 and len(faces) * region_fraction >= 4:
+            vertices_mm, faces = decimate(vertices_mm, faces, len(faces) * region_fraction)
+        self.region_vertices_mm = vertices_mm
         self.context = PllContext.build(
-            region.faces, face_curve, view, image_shape=photo.image_size_wh[::-1]
+            faces, face_curve, view, image_shape=photo.image_size_wh[::-1]
         )
         self.span_mm = None if view == "frontal" else np.array([lm["glabella"], lm["metopion"]])
         self.centre = centre
 
     def __call__(self, cameras):
         """P_pll under ``cameras`` (:class:`Cameras`), ``(S,)``."""
+        return self.parts(cameras).total
+
+    def parts(self, cameras):
+        """:class:`~lilium.fitness.pll.PllTerms` (fields ``(S,)``) under ``cameras``."""
         uv = cameras.project(self.region_vertices_mm)
         span_v = None if self.span_mm is None else cameras.project(self.span_mm)[..., 1]
-        return self.context.evaluate_batch(uv, span_v)
+        return self.context.terms_batch(uv, span_v)
 
     def curves(self, camera):
         """Skull and face curves ``(K, 2)``, ``(M, 2)`` under one :class:`Camera` (overlays)."""
@@ -199,11 +218,13 @@ def prior_terms_off(priors):
     return off
 
 
-def image_terms(skull, photo, centre, use_skof, use_pll):
+def image_terms(skull, photo, centre, use_skof, use_pll, level=None):
     """The image penalties an SFO asks for, each built or switched off.
 
     An asked-for term whose inputs are missing (:class:`TermOff`) is switched off, not an
-    error (SPEC section 5): the SFO runs with the other terms.
+    error (SPEC section 5): the SFO runs with the other terms. With a working ``level``
+    (:mod:`lilium.methods.working_level`) the terms are built on its skull and photo and take
+    full-resolution cameras (their values in full-resolution units).
 
     Parameters
     ----------
@@ -213,23 +234,32 @@ def image_terms(skull, photo, centre, use_skof, use_pll):
         Principal point (pixels).
     use_skof, use_pll : bool
         Whether the variant asks for P_skof / P_pll.
+    level : WorkingLevel, optional
+        None or a full level: the terms at the photo's resolution on the full mesh.
 
     Returns
     -------
-    skof : SkofTerm or None
-    pll : PllTerm or None
+    skof : SkofTerm, WorkingSkof or None
+    pll : PllTerm, WorkingPll or None
     terms_off : dict of str -> str
         ``{"p_skof": why, "p_pll": why}`` for the asked-for terms that cannot apply.
     """
     skof = pll = None
     off = {}
+    working = level is not None and not level.is_full
     if use_skof:
         off["p_skof"] = skof_off_reason(photo)
-        if not off["p_skof"]:
+        if not off["p_skof"] and working:
+            skof = WorkingSkof(SkofTerm(level.skull, level.photo, level.centre(centre)), level)
+        elif not off["p_skof"]:
             skof = SkofTerm(skull, photo, centre)
     if use_pll:
         try:
-            pll = PllTerm(skull, photo, centre)
+            if working:  # the region cut from the full mesh, then decimated
+                term = PllTerm(skull, level.photo, level.centre(centre), level.pll_fraction)
+                pll = WorkingPll(term, level)
+            else:
+                pll = PllTerm(skull, photo, centre)
         except TermOff as exc:
             off["p_pll"] = str(exc)
     return skof, pll, {k: v for k, v in off.items() if v}
@@ -262,3 +292,37 @@ def planned_terms_off(skull, photo, variant_terms):
         except TermOff as exc:
             off["p_pll"] = str(exc)
     return {**off, **prior_terms_off(photo.priors)}
+
+
+def full_image_terms(skull, photo, camera, use_skof, use_pll):
+    """P_skof and P_pll of one camera at the photo's resolution on the full mesh.
+
+    What an SFO's result reports when its DE ran at a working level
+    (:mod:`lilium.methods.working_level`): the exact terms of the best camera.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    camera : Camera
+    use_skof, use_pll : bool
+        Which terms to compute (those that ran in the DE).
+
+    Returns
+    -------
+    terms : dict of str -> float
+        ``p_skof`` and/or ``p_pll`` (those asked for).
+    outside : ImplausibleSFO or None
+        The skull pixels outside the face mask (:func:`lilium.evaluation.metrics.outside_face`),
+        when P_skof was asked for.
+    """
+    from ..evaluation.metrics import outside_face
+
+    terms, outside = {}, None
+    if use_skof:
+        outside = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
+        terms["p_skof"] = float(skof_penalty(outside.outside_px))
+    if use_pll:
+        pll = PllTerm(skull, photo, camera.principal_point_px)
+        terms["p_pll"] = float(pll(camera.as_batch())[0])
+    return terms, outside

@@ -6,6 +6,7 @@ from ..constants import focal_cap_px
 from ..optimisation.de import DEOptions
 from ..pose.posest import PosestOptions
 from ..pose.refine import RefineOptions
+from .working_level import WORKING_FACE_PX
 
 
 @dataclass(frozen=True)
@@ -26,6 +27,10 @@ class SfoOptions:
     depth_table : dict or None
         A user's soft-tissue depth table (:func:`lilium.io.case.read_depth_table`); None = the
         built-in table.
+    working_face_px : float or None
+        Lilium's image terms inside the DE run at a working level where the face is about this
+        many pixels across (:mod:`lilium.methods.working_level`); the result's terms are
+        recomputed at full resolution on the full mesh. None = every evaluation at full level.
     """
 
     variant: str = "skof+pll"
@@ -35,6 +40,7 @@ class SfoOptions:
     )
     posest: PosestOptions = field(default_factory=PosestOptions)
     depth_table: dict | None = None
+    working_face_px: float | None = WORKING_FACE_PX
 
     def with_de(self, **changes):
         """A copy with the given :class:`DEOptions` fields changed (``None`` values ignored)."""

@@ -195,8 +195,9 @@ def view_box(size_wh, covered=None, mask=None, points_uv=()):
             vs += [rows.min(), rows.max()]
     pts = np.asarray(points_uv, dtype=float).reshape(-1, 2)
     pts = pts[np.all(np.isfinite(pts), axis=1)]
-    us += list(pts[:, 0])
-    vs += list(pts[:, 1])
+    if len(pts):  # the extremes only (a skull's projected vertices are hundreds of thousands)
+        us += [pts[:, 0].min(), pts[:, 0].max()]
+        vs += [pts[:, 1].min(), pts[:, 1].max()]
     if not us:
         return 0, 0, w, h
     margin = VIEW_MARGIN * max(max(us) - min(us), max(vs) - min(vs))
@@ -363,13 +364,13 @@ def skull_view_pictures(skull, views, key_prefix="skv"):
         Empty when the landmarks cannot orient the skull (too few of them).
     """
     from ..fitness.regions import anatomical_frame
-    from ..imaging.raster import mesh_edge_topology
+    from ..imaging.raster import cached_topology
 
     try:
         frame = anatomical_frame(skull.landmarks_mm)
     except ValueError:
         return ()
-    topology = mesh_edge_topology(skull.faces)
+    topology = cached_topology(skull.faces)
     pictures = []
     for view in views:
         sv = skull_view(

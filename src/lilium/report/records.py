@@ -188,10 +188,11 @@ def prior_rows(result):
 
 
 def _skull_uv_in_image(camera, skull, size_wh):
-    """Projected skull vertices (V, 2) clipped to the image: the skull's extent in the photo."""
+    """The corners ``(2, 2)`` (or ``(0, 2)``) of the box of the projected skull vertices clipped
+    to the image: the skull's extent in the photo."""
     uv = camera.project(skull.vertices_mm)
-    uv = uv[np.all(np.isfinite(uv), axis=1)]
-    return np.clip(uv, 0, np.array(size_wh, dtype=float) - 1)
+    uv = np.clip(uv[np.all(np.isfinite(uv), axis=1)], 0, np.array(size_wh, dtype=float) - 1)
+    return np.array([uv.min(axis=0), uv.max(axis=0)]) if len(uv) else uv
 
 
 def skull_views(skull, view, cache=None):

@@ -1,0 +1,92 @@
+"""Which triangle each pixel of a shaded picture shows: a compiled depth buffer (numba, see
+:mod:`lilium.jit`).
+
+The pictures' silhouettes are the exact union raster (:mod:`lilium.imaging.raster`); inside
+them the shading only needs, per pixel, the triangle nearest the camera. The painter's
+algorithm (OpenCV's ``fillConvexPoly`` far to near) paid about 2 us per triangle: seconds for a
+600k-face CT skull, three pictures per report. Here each triangle visits only the pixel centres
+of its bounding box and keeps those it covers where it is nearer than what is there (a
+triangle's depth is the mean of its corners', as the painter sorted them; on a tie the later
+triangle wins, as the painter's stable order painted it last). Triangles that hold no pixel
+centre paint nothing (the callers give the pixels of the silhouette left unpainted a neighbour's
+triangle).
+"""
+
+import cv2
+import numpy as np
+
+from ..jit import njit
+
+
+@njit
+def _paint(uv, faces, depth, order, height, width):
+    index = np.full((height, width), -1, np.int32)
+    nearest = np.full((height, width), np.inf)
+    for k in order:
+        a, b, c = faces[k, 0], faces[k, 1], faces[k, 2]
+        u0, v0, u1, v1, u2, v2 = uv[a, 0], uv[a, 1], uv[b, 0], uv[b, 1], uv[c, 0], uv[c, 1]
+        area = (u1 - u0) * (v2 - v0) - (u2 - u0) * (v1 - v0)
+        if not (area > 0.0 or area < 0.0):  # degenerate, or NaN (behind the camera)
+            continue
+        s = 1.0 if area > 0.0 else -1.0
+        c0 = max(0, int(np.ceil(min(u0, u1, u2))))
+        c1 = min(width - 1, int(np.floor(max(u0, u1, u2))))
+        r0 = max(0, int(np.ceil(min(v0, v1, v2))))
+        r1 = min(height - 1, int(np.floor(max(v0, v1, v2))))
+        z = depth[k]
+        for r in range(r0, r1 + 1):
+            for col in range(c0, c1 + 1):
+                if z > nearest[r, col]:
+                    continue
+                e0 = s * ((u1 - u0) * (r - v0) - (v1 - v0) * (col - u0))
+                e1 = s * ((u2 - u1) * (r - v1) - (v2 - v1) * (col - u1))
+                e2 = s * ((u0 - u2) * (r - v2) - (v0 - v2) * (col - u2))
+                if e0 >= 0.0 and e1 >= 0.0 and e2 >= 0.0:
+                    nearest[r, col] = z
+                    index[r, col] = k
+    return index
+
+
+def nearest_face_index(uv, faces, depth_mm, shape, keep=None, covered=None):
+    """Per pixel, the index of the nearest triangle covering its centre.
+
+    Parameters
+    ----------
+    uv : ndarray of shape (V, 2)
+        Projected vertices (u = column, v = row; pixel centres at integers), NaN behind the
+        camera.
+    faces : ndarray of shape (F, 3), int
+    depth_mm : ndarray of shape (F,)
+        Each triangle's depth key (smaller = nearer), e.g. its corners' mean camera z.
+    shape : (int, int)
+        ``(height, width)`` of the picture.
+    keep : ndarray of shape (F,) of bool, optional
+        Triangles to paint (default all).
+    covered : ndarray of shape (height, width) of bool, optional
+        The exact silhouette: its pixels that no triangle's centre test caught take a
+        neighbour's triangle (the largest index around), and pixels outside it get -1.
+
+    Returns
+    -------
+    index : ndarray of shape (height, width), int32
+        -1 where no triangle covers the pixel centre (outside ``covered`` when given).
+    """
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    order = np.arange(len(faces)) if keep is None else np.flatnonzero(keep)
+    height, width = (int(n) for n in shape)
+    index = _paint(
+        np.ascontiguousarray(uv, dtype=float),
+        faces,
+        np.ascontiguousarray(depth_mm, dtype=float),
+        order.astype(np.int64),
+        height,
+        width,
+    )
+    if covered is not None:
+        gaps = covered & (index < 0)
+        if gaps.any():
+            # OpenCV's dilate takes no int32: dilate a float32 copy (indices < 2^24 stay exact).
+            grown = cv2.dilate(index.astype(np.float32), np.ones((3, 3), np.uint8))
+            index[gaps] = grown.astype(np.int32)[gaps]
+        index[~covered] = -1
+    return index
