@@ -159,8 +159,8 @@ def single_terms(rows, inputs=None, cohort_cache=None):
             out.append(r["data"][TERMS_KEY])
         elif inputs is None:
             raise ValueError(
-                "the database has no identification terms stored and its dataset is missing; "
-                "give --dataset DIR"
+                "the database has no identification terms stored (or, from an older version, "
+                "not the cohort terms) and its dataset is missing; give --dataset DIR"
             )
         else:
             skull, photo = _inputs(r, inputs)
