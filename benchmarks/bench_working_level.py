@@ -8,7 +8,9 @@ one path is the noise the difference between the paths is measured against), twi
 working level. Optionally the same at real size
 (``--faces``, ``--megapixels``: the skull subdivided, the photo resampled, :mod:`real_size`).
 Prints per photo and in total: BPE (mm), the result's skull pixels outside the face mask (full
-mesh, full resolution; "implausible" when > 0), fitness and CPU seconds.
+mesh, full resolution; "implausible" when > 0), fitness and CPU seconds. With ``--identify``
+every photo also runs against every other skull of the dataset, and each path's photos rank
+their skulls by the shipped calibration's log10 LR (rank-1, per-photo AUC).
 
     python benchmarks/bench_working_level.py --subjects 4 --photos 2 --generations 300
 """
@@ -72,6 +74,7 @@ def main(argv=None):
     p.add_argument("--faces", type=int, default=0, help="subdivide each skull to this many")
     p.add_argument("--megapixels", type=float, default=0.0, help="resample each photo")
     p.add_argument("--seeds", default="1", help="comma-separated DE seeds")
+    p.add_argument("--identify", action="store_true", help="also rank every skull per photo")
     args = p.parse_args(argv)
     root = args.dataset
     if root is None or not (root / "dataset.json").exists():
@@ -113,6 +116,38 @@ def main(argv=None):
         for seed in seeds:
             bpe = np.array([r[2] for r in mine if r[6] == seed])
             print(f"  seed {seed}: BPE mean {np.nanmean(bpe):.3f} mm")
+    if args.identify:
+        identify_paths(root, paths, seeds[0])
+
+
+def identify_paths(root, paths, seed):
+    """Each path's identification: every photo against every skull, ranked by log10 LR."""
+    from lilium.casework.identify import Calibrations, identify
+
+    calibrations = Calibrations()
+    photos = [(label, photo, truth) for label, _, photo, truth, _ in cases(root, 0, 0.0)]
+    index = read_json(root / "dataset.json")
+    subject_of = {e["id"]: e["subject"] for e in index["photos"]}
+    skulls = {}
+    for sid in sorted(set(subject_of.values())):
+        folder = root / "subjects" / sid
+        skulls[sid] = read_skull(folder, axes_path=folder / "axes_C1.json")
+    print(f"\nidentification, {len(photos)} photos x {len(skulls)} skulls, seed {seed}")
+    for name, options in paths.items():
+        ranks, aucs = [], []
+        for label, photo, _ in photos:
+            lrs = {}
+            for sid, skull in skulls.items():
+                result = run_sfo("lilium", skull, photo, options, seed)
+                record = identify(skull, [photo], [result], calibrations) if result else {}
+                lr = record.get("log10_lr")
+                lrs[sid] = -np.inf if lr is None else lr
+            true = lrs[subject_of[label]]
+            others = np.array([v for k, v in lrs.items() if k != subject_of[label]])
+            ranks.append(1 + int(np.sum(others > true)))
+            aucs.append(float(np.mean((others < true) + 0.5 * (others == true))))
+        print(f"{name:<8} rank-1 {np.mean(np.array(ranks) == 1):.2f}, mean rank "
+              f"{np.mean(ranks):.2f}, AUC {np.mean(aucs):.3f}", flush=True)
 
 
 if __name__ == "__main__":
