@@ -33,9 +33,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..geometry.camera import Camera
+from ..geometry.camera import Camera, project_points, to_camera_frame
 from ..geometry.rotations import rotvec_to_matrix
-from .terms import landmark_chi2, landmark_sigma_px, soft_tissue_covariance
+from .terms import (
+    landmark_chi2,
+    landmark_sigma_px,
+    projection_jacobians,
+    soft_tissue_covariance,
+)
 
 #: Levenberg-Marquardt iterations of a camera refit.
 REFIT_ITERATIONS = 25
@@ -89,17 +94,9 @@ def _whitened(R, t, f, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
     f ``(K,)``); the marginal covariance ``S = J Sigma J^T + sigma^2 I`` of each landmark
     whitens its residual, so the squared norm is ``sum r^T S^-1 r``."""
     points = cranial + mean_mm[None, :, None] * axes
-    X = np.einsum("kij,knj->kni", R, points) + t[:, None, :]
-    z = X[..., 2]
-    bad = ~(z > 0).all(axis=1)
-    z = np.where(z > 0, z, np.nan)
-    fz = f[:, None] / z
-    r = uv[None] - (X[..., :2] * fz[..., None] + pp)
-    J = np.zeros(X.shape[:2] + (2, 3))
-    J[..., 0, 0] = J[..., 1, 1] = fz
-    J[..., 0, 2] = -fz * X[..., 0] / z
-    J[..., 1, 2] = -fz * X[..., 1] / z
-    J = J @ R[:, None]
+    r = uv[None] - project_points(points, R, t, f, pp)  # NaN behind a camera
+    bad = ~np.isfinite(r).all(axis=(1, 2))
+    J = projection_jacobians(to_camera_frame(points, R, t), R, f)
     sigma = soft_tissue_covariance(axes.reshape(-1, 3), np.tile(mean_mm, len(R)),
                                    np.tile(sd_mm, len(R))).reshape(J.shape[:2] + (3, 3))
     S = J @ sigma @ np.swapaxes(J, -1, -2)

@@ -173,14 +173,22 @@ def _mean_points_and_jacobians(view):
     mean_mm = view.cranial_mm + view.depth_mean_mm[:, None] * view.axes
     cam = view.camera
     X = cam.to_camera_frame(mean_mm)
-    z = X[:, 2]
-    f = cam.focal_px
-    jac_cam = np.zeros((len(X), 2, 3))
-    jac_cam[:, 0, 0] = jac_cam[:, 1, 1] = f / z
-    jac_cam[:, 0, 2] = -f * X[:, 0] / z**2
-    jac_cam[:, 1, 2] = -f * X[:, 1] / z**2
+    jac = projection_jacobians(X[None], cam.R[None], np.array([cam.focal_px]))[0]
     residual = view.uv_px - cam.project(mean_mm)
-    return residual, jac_cam @ cam.R, z
+    return residual, jac, X[:, 2]
+
+
+def projection_jacobians(X_cam_mm, R, focal_px):
+    """Jacobians ``(S, N, 2, 3)`` of the pinhole projection with respect to skull-frame points,
+    at points ``X_cam_mm`` ``(S, N, 3)`` already in the frames of S cameras (rotations ``R``
+    ``(S, 3, 3)``, ``focal_px`` ``(S,)``)."""
+    z = X_cam_mm[..., 2]
+    fz = np.asarray(focal_px, float)[:, None] / z
+    jac = np.zeros(X_cam_mm.shape[:2] + (2, 3))
+    jac[..., 0, 0] = jac[..., 1, 1] = fz
+    jac[..., 0, 2] = -fz * X_cam_mm[..., 0] / z
+    jac[..., 1, 2] = -fz * X_cam_mm[..., 1] / z
+    return jac @ np.asarray(R, float)[:, None]
 
 
 def landmark_sigma_px(view):
