@@ -18,40 +18,15 @@ the five prior residuals are differentiated analytically (focal length, distance
 numerically over the rotation (head angle); their kinks are where they switch on.
 """
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..constants import MIN_DEPTH_MM
 from ..geometry.rotations import geodesic_angle_deg, rotvec_to_matrix
-from .refine import _residuals_and_jacobian, _step_image_unknowns
+from .refine import BatchRefineResult, _residuals_and_jacobian, _step_image_unknowns
 from .residuals import reprojection_sq_errors
 
 #: Forward-difference step (rad) of the head-orientation residual.
 _ROTATION_STEP = 1e-6
-
-
-@dataclass(frozen=True)
-class PriorRefineResult:
-    """Refined cameras of S problems (as :class:`~lilium.pose.refine.BatchRefineResult`).
-
-    Attributes
-    ----------
-    R : ndarray of shape (S, 3, 3)
-    t : ndarray of shape (S, 3)
-    focal_px : ndarray of shape (S,)
-    sq_err_px2 : ndarray of shape (S, N)
-    cost : ndarray of shape (S,)
-        ``MSE_pix + P_cam`` (the prior terms that are on); ``inf`` behind the camera.
-    n_iterations : int
-    """
-
-    R: np.ndarray
-    t: np.ndarray
-    focal_px: np.ndarray
-    sq_err_px2: np.ndarray
-    cost: np.ndarray
-    n_iterations: int
 
 
 def _prior_residuals(R, c, log_f, scd_rel, focal_interval, scd_interval, head_rotation, tol):
@@ -143,8 +118,9 @@ def refine_with_priors(
 
     Returns
     -------
-    PriorRefineResult
-        A problem keeps its start unless a step lowers its cost.
+    BatchRefineResult
+        Its ``cost`` is ``MSE_pix + P_cam`` (the prior terms that are on; ``inf`` behind the
+        camera). A problem keeps its start unless a step lowers its cost.
     """
     R = np.array(R, dtype=float)
     S = len(R)
@@ -202,4 +178,4 @@ def refine_with_priors(
     t_out = c - np.einsum("sij,sj->si", R, m)
     f_out = np.exp(log_f)
     sq = reprojection_sq_errors(uv_c, P, R, t_out, f_out)
-    return PriorRefineResult(R, t_out, f_out, sq, cost, iteration)
+    return BatchRefineResult(R, t_out, f_out, sq, cost, iteration)
