@@ -2,6 +2,8 @@
 modules stay readable in one sitting."""
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
 import lilium
@@ -85,3 +87,30 @@ def test_modules_read_in_one_sitting():
         if (n := len(p.read_text().splitlines())) > MAX_MODULE_LINES
     }
     assert not long, long
+
+
+#: Libraries a ``lilium sfo`` process must not import before its SFO starts (issue 26: each
+#: costs 0.07-0.15 s of start-up; they are imported where first needed).
+LAZY_LIBRARIES = (
+    "trimesh",
+    "networkx",
+    "scipy.optimize",
+    "scipy.ndimage",
+    "scipy.sparse",
+    "matplotlib",
+    "dask",
+    "lilium.synthetic",
+)
+
+
+def test_sfo_command_imports_stay_light():
+    code = (
+        "import sys\n"
+        "import lilium.cli.main, lilium.cli.sfo, lilium.casework.folders\n"
+        "from lilium.cli.main import main\n"
+        f"print([m for m in {LAZY_LIBRARIES!r} if m in sys.modules])\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout
+    assert out.strip() == "[]", out

@@ -50,7 +50,6 @@ from pathlib import Path
 from ..constants import MAX_DE_POPULATION
 from ..methods.registry import METHODS
 from ..optimisation.de import DEOptions
-from ..synthetic.incomplete import check_fraction
 
 #: The experiments of SPEC section 7.
 EXPERIMENTS = ("A", "B", "C")
@@ -378,6 +377,8 @@ def config_from_dict(data, base_dir=Path("."), where="config"):
                 raise ValueError(
                     f"{where}: dataset.{key} must be a number in {span}, got {value!r}"
                 )
+            from ..synthetic.incomplete import check_fraction
+
             ds_changes[key] = check_fraction(value, f"{where}: dataset.{key}", closed)
     changes["dataset"] = replace(cfg.dataset, **ds_changes)
 

@@ -26,7 +26,6 @@ skips whole clusters of faces the same way before projecting them (compiled).
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from .. import jit
 from ..imaging.raster import (
@@ -109,6 +108,8 @@ def face_mask_index(face_mask):
         if jit.compiled():
             distance = np.sqrt(squared_distance_to_background(mask))
         else:
+            from scipy import ndimage  # the numpy reference path only
+
             distance = ndimage.distance_transform_edt(mask)
         clearance = np.maximum(distance - np.sqrt(0.5) - 1e-6, 0.0) ** 2
     return FaceMaskIndex(

@@ -33,7 +33,6 @@ import hashlib
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
 
 from .. import jit
 from ._raster_kernels import scan_kernel
@@ -78,7 +77,7 @@ class EdgeTopology:
 
     faces: np.ndarray
     edges: np.ndarray
-    incidence: sparse.csr_matrix
+    incidence: object  # scipy.sparse.csr_matrix (scipy imported with the first topology)
     corners: np.ndarray
     edges_a: np.ndarray
     edges_b: np.ndarray
@@ -134,6 +133,8 @@ def mesh_edge_topology(faces):
         edges = np.column_stack([keys // n_vertices, keys % n_vertices])
     else:
         edges, edge_of = np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
+    from scipy import sparse  # 0.07 s to import: once, with the first topology
+
     incidence = sparse.csr_matrix(
         (direction.astype(np.float64), (edge_of.reshape(-1), face_of)),
         shape=(len(edges), n_faces),
