@@ -24,16 +24,12 @@ from pathlib import Path
 from ..casework.case import run_case
 from ..constants import VIEWS
 from ..methods import METHODS
-from ..optimisation.de import DEOptions
-from .argtypes import output_folder, positive_float, seed
+from .argtypes import output_folder, positive_float
 from .sfo import (
     AXES_FILE,
     DEPTH_TABLE_FILE,
-    GENERATIONS,
-    MAX_SECONDS,
-    POPULATION,
-    VARIANTS,
     add_calibration_option,
+    add_lilium_options,
     options_from,
 )
 
@@ -161,16 +157,7 @@ def register(subparsers):
         default=[],
         help="method; repeat to run several (default lilium)",
     )
-    p.add_argument("--variant", default="skof+pll", choices=list(VARIANTS))
-    p.add_argument("--seed", type=seed, default=0, help="Lilium random seed (default 0)")
-    de = DEOptions()
-    p.add_argument(
-        "--generations", type=GENERATIONS, help=f"DE generations (default {de.max_generations})"
-    )
-    p.add_argument(
-        "--population", type=POPULATION, help=f"DE population (default {de.population_size})"
-    )
-    p.add_argument("--max-seconds", type=MAX_SECONDS, help=f"per SFO (default {de.max_seconds:g})")
+    add_lilium_options(p, de_defaults=False)
     p.add_argument("--focal-px", type=float, nargs=2, metavar=("LO", "HI"), help="focal prior")
     p.add_argument("--scd-mm", type=float, nargs=2, metavar=("LO", "HI"), help="SCD prior (mm)")
     p.add_argument(

@@ -3,14 +3,10 @@
 from pathlib import Path
 
 from ..methods import METHODS
-from ..optimisation.de import DEOptions
-from .argtypes import output_folder, seed
+from .argtypes import output_folder
 from .sfo import (
-    GENERATIONS,
-    MAX_SECONDS,
-    POPULATION,
-    VARIANTS,
     add_calibration_option,
+    add_lilium_options,
     options_from,
 )
 
@@ -45,12 +41,7 @@ def register(subparsers):
         default=[],
         help="method (repeatable; default lilium; the first one ranks)",
     )
-    p.add_argument("--variant", default="skof+pll", choices=list(VARIANTS))
-    p.add_argument("--seed", type=seed, default=0)
-    de = DEOptions()
-    p.add_argument("--generations", type=GENERATIONS, default=de.max_generations)
-    p.add_argument("--population", type=POPULATION, default=de.population_size)
-    p.add_argument("--max-seconds", type=MAX_SECONDS, default=de.max_seconds)
+    add_lilium_options(p)
     add_calibration_option(p)
     p.add_argument("--title", help="report title")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")

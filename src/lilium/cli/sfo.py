@@ -55,32 +55,7 @@ def register(subparsers):
     )
     p.add_argument("--out", required=True, type=output_folder, help="output folder")
     p.add_argument("--method", default="posest-sfo", choices=list(METHODS))
-    p.add_argument(
-        "--variant",
-        default="skof+pll",
-        choices=list(VARIANTS),
-        help="Lilium fitness variant (default skof+pll)",
-    )
-    p.add_argument("--seed", type=seed, default=0, help="Lilium random seed (default 0)")
-    de = DEOptions()
-    p.add_argument(
-        "--generations",
-        type=GENERATIONS,
-        default=de.max_generations,
-        help=f"Lilium: DE generations at most (default {de.max_generations})",
-    )
-    p.add_argument(
-        "--population",
-        type=POPULATION,
-        default=de.population_size,
-        help=f"Lilium: DE population size (default {de.population_size})",
-    )
-    p.add_argument(
-        "--max-seconds",
-        type=MAX_SECONDS,
-        default=de.max_seconds,
-        help=f"Lilium: wall-clock limit in seconds (default {de.max_seconds:g})",
-    )
+    add_lilium_options(p)
     p.add_argument(
         "--axes", type=AXES_FILE, help="soft-tissue axes JSON to use instead of the skull's"
     )
@@ -90,6 +65,32 @@ def register(subparsers):
     p.add_argument("--no-overlay", action="store_true", help="skip overlay.png")
     add_calibration_option(p)
     p.set_defaults(func=run)
+
+
+def add_lilium_options(parser, de_defaults=True):
+    """``--variant``, ``--seed`` and the DE options ``--generations``, ``--population`` and
+    ``--max-seconds`` (shared with ``lilium case`` and ``lilium lineup``). With
+    ``de_defaults=False`` the DE options stay None unless given (``lilium case`` writes only
+    the options given into its provenance); :func:`options_from` reads None as the default."""
+    parser.add_argument(
+        "--variant",
+        default="skof+pll",
+        choices=list(VARIANTS),
+        help="Lilium fitness variant (default skof+pll)",
+    )
+    parser.add_argument("--seed", type=seed, default=0, help="Lilium random seed (default 0)")
+    de = DEOptions()
+    for option, kind, value, what in (
+        ("--generations", GENERATIONS, de.max_generations, "DE generations at most"),
+        ("--population", POPULATION, de.population_size, "DE population size"),
+        ("--max-seconds", MAX_SECONDS, de.max_seconds, "wall-clock limit per SFO in seconds"),
+    ):
+        parser.add_argument(
+            option,
+            type=kind,
+            default=value if de_defaults else None,
+            help=f"Lilium: {what} (default {value:g})",
+        )
 
 
 def add_calibration_option(parser):
