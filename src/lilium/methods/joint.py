@@ -288,7 +288,7 @@ def camera_on_priors(problem, facial_mm, terms, members=None):
     )
     R, t, f = ref.R, ref.t, ref.focal_px
     # LiliumProblem's own validity rule and terms (focal range, skull front seen).
-    ok = problem._valid(R, t, f)
+    ok = problem._valid(f, problem._facing(R, t))
     sq = reprojection_sq_errors(problem.uv_c, points, R, t, np.where(ok, f, 1.0))
     ok &= np.all(np.isfinite(sq), axis=1)
     sq[~ok] = np.inf

@@ -202,6 +202,7 @@ class LiliumProblem:
         # Numerical failure (a point behind the camera): fall back to full POSEST.
         broken = ~np.isfinite(ref.cost) | ~np.all(np.isfinite(ref.sq_err_px2), axis=1)
         self._own_posest(facial_mm, R, t, f, broken, broken)
+        replaced = broken.copy()  # cameras no longer the refined ones
         # A camera out of range is that soft tissue's failure (C_INF) while some member has a
         # valid camera to lend. When none has (the initial population, or every member failed)
         # and no fit of this batch found one, the least-squares fits over all landmarks ran off
@@ -210,13 +211,23 @@ class LiliumProblem:
         # camera and run off again: each member takes its own POSEST, whose inliers fix a
         # finite focal length (docs/method.md, "No camera on a mandible-less frontal photo").
         lender = members is not None and np.any(members["success"])
-        invalid = ~self._valid(R, t, f)
-        if not lender and invalid.all():
+        facing = self._facing(R, t)
+        ok = self._valid(f, facing)
+        if not lender and not ok.any():
             self.n_no_camera += 1
-            self._own_posest(facial_mm, R, t, f, invalid & ~broken, np.zeros_like(broken))
-        ok = self._valid(R, t, f)
-        sq = reprojection_sq_errors(self.uv_c, facial_mm, R, t, np.where(ok, f, 1.0))
-        self._note_capped(facial_mm, R, t, f)
+            self._own_posest(facial_mm, R, t, f, ~ok & ~broken, np.zeros_like(broken))
+            replaced |= ~ok
+            facing = self._facing(R, t)
+            ok = self._valid(f, facing)
+        # The refinement's errors are those of its cameras (same projection, same inputs); only
+        # the replaced cameras need theirs (invalid ones end at inf below).
+        sq = ref.sq_err_px2
+        if replaced.any():
+            f_safe = np.where(ok, f, 1.0)
+            sq[replaced] = reprojection_sq_errors(
+                self.uv_c, facial_mm[replaced], R[replaced], t[replaced], f_safe[replaced]
+            )
+        self._note_capped(facial_mm, R, t, f, facing)
         sq[~ok] = np.inf
         return R, t, f, ok, sq
 
@@ -231,20 +242,20 @@ class LiliumProblem:
             elif lost[i]:
                 f[i] = np.nan
 
-    def _valid(self, R, t, f):
-        """``(S,)`` bool: focal length in ``[FOCAL_MIN_PX, cap]`` and the skull's front seen."""
-        with np.errstate(invalid="ignore"):
-            ok = (f >= FOCAL_MIN_PX) & (f <= self.focal_cap_px)
-        if self.facing is not None:
-            ok &= self.facing(R, t)
-        return ok
+    def _facing(self, R, t):
+        """``(S,)`` bool: the camera sees the skull's front (all True without the rule)."""
+        return np.ones(len(R), bool) if self.facing is None else self.facing(R, t)
 
-    def _note_capped(self, facial_mm, R, t, f):
+    def _valid(self, f, facing):
+        """``(S,)`` bool: focal length in ``[FOCAL_MIN_PX, cap]`` and the skull's front seen
+        (``facing``, :meth:`_facing`)."""
+        with np.errstate(invalid="ignore"):
+            return (f >= FOCAL_MIN_PX) & (f <= self.focal_cap_px) & facing
+
+    def _note_capped(self, facial_mm, R, t, f, facing):
         """Remember the best fit refused only for its focal length (the cap was hit; a fit
         that ran off towards an orthographic camera does not count)."""
-        capped = (f > self.focal_cap_px) & (f <= RUN_OFF_FACTOR * self.focal_cap_px)
-        if self.facing is not None:
-            capped &= self.facing(R, t)
+        capped = (f > self.focal_cap_px) & (f <= RUN_OFF_FACTOR * self.focal_cap_px) & facing
         if not capped.any():
             return
         sq = reprojection_sq_errors(self.uv_c, facial_mm[capped], R[capped], t[capped], f[capped])
@@ -349,7 +360,7 @@ class LiliumProblem:
         R, t = pose.camera.R[None], pose.camera.t[None]
         f = np.array([pose.camera.focal_px])
         sq = reprojection_sq_errors(self.uv_c, facial, R, t, f)
-        ok = self._valid(R, t, f) & np.all(np.isfinite(sq), axis=1)
+        ok = self._valid(f, self._facing(R, t)) & np.all(np.isfinite(sq), axis=1)
         sq[~ok] = np.inf
         return genes, self.add_image_terms(self._terms(facial, R, t, f, ok, sq))
 
