@@ -1,11 +1,12 @@
 """Identification on generated Exp. C photos: every method and Lilium variant, per view.
 
 Run: ``.venv/bin/python benchmarks/bench_identification.py [--out DIR] [--subjects 8]
-[--workers 2] [--generations 750]``. It generates (or reuses) a dataset of ``--subjects``
-subjects with one frontal and one lateral photo each (dataset seed ``--dataset-seed``), runs
-Exp. C (one axis set, one run, Lilium seed ``--seed``) for POSEST-SFO and the four Lilium
-variants against every skull with :func:`lilium.experiments.runner.run_experiment` (resumable:
-the same command again continues, or only prints when all is stored), and prints:
+[--workers 2] [--generations 750] [--joint-subjects 12]``. It generates (or reuses) a
+dataset of ``--subjects`` subjects with one frontal and one lateral photo each (dataset seeds
+``--dataset-seeds``; with ``--joint-subjects`` also a joint-SFO dataset), runs Exp. C (one axis
+set, one run, Lilium seed ``--seed``) for POSEST-SFO and the four Lilium variants against
+every skull with :func:`lilium.experiments.runner.run_experiment` (resumable: the same command
+again continues, or only prints when all is stored), and prints:
 
 1. per method, variant and view: mean rank of the true skull, rank-1 rate, ROC AUC per photo
    (:mod:`lilium.experiments.identification`), mean BPE of the positive pairs and the number of
@@ -96,15 +97,22 @@ def mean_depth_scores(rows, inputs):
     return out
 
 
-def config(args, dataset_seed):
+def config(args, dataset_seed, joint=False):
+    """The experiment of one dataset seed; ``joint``: the joint SFO's database instead
+    (``OUT/joint``: ``--joint-subjects`` subjects of ``--joint-dataset-seed``, Lilium skof+pll
+    and its joint SFO of each frontal + lateral pair)."""
     out = Path(args.out)
-    if len(args.dataset_seeds) > 1:
+    subjects, methods = args.subjects, args.methods
+    if joint:
+        out, subjects = out / "joint", args.joint_subjects
+        methods = "lilium:skof+pll,lilium-joint:skof+pll"
+    elif len(args.dataset_seeds) > 1:
         out = out / f"seed-{dataset_seed}"
     return ExperimentConfig(
         name="bench-identification",
-        dataset=DatasetConfig(out / "dataset", True, args.subjects, 1, dataset_seed),
+        dataset=DatasetConfig(out / "dataset", True, subjects, 1, dataset_seed),
         experiments=("C",),
-        methods=parse_methods(args.methods.split(",")) if args.methods else ALL_METHODS,
+        methods=parse_methods(methods.split(",")) if methods else ALL_METHODS,
         repetitions=1,
         axes_sets=1,
         runs_per_axes_set=1,
@@ -292,6 +300,13 @@ def main(argv=None):
     parser.add_argument(
         "--methods", default="", help="comma-separated, e.g. posest-sfo,lilium:skof (default all)"
     )
+    parser.add_argument(
+        "--joint-subjects",
+        type=int,
+        default=0,
+        help="also a joint-SFO database of this many subjects (OUT/joint), pooled in the LR tables",
+    )
+    parser.add_argument("--joint-dataset-seed", type=int, default=2)
     parser.add_argument("--print-only", action="store_true", help="only print the stored rows")
     parser.add_argument(
         "--db", action="append", default=[], help="more databases to pool in the LR tables"
@@ -301,8 +316,11 @@ def main(argv=None):
     )
     args = parser.parse_args(argv)
     dbs = []
-    for dataset_seed in args.dataset_seeds:
-        cfg = config(args, dataset_seed)
+    runs = [(seed, False) for seed in args.dataset_seeds]
+    if args.joint_subjects:
+        runs.append((args.joint_dataset_seed, True))
+    for dataset_seed, joint in runs:
+        cfg = config(args, dataset_seed, joint)
         if not args.print_only:
             run_experiment(cfg, progress=False)
         print(f"\n## Dataset seed {dataset_seed} ({cfg.db})\n")
