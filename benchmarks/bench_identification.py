@@ -315,6 +315,9 @@ def main(argv=None):
         "--headsq", action="store_true", help="also the headsq CT's conclusions (real anatomy)"
     )
     args = parser.parse_args(argv)
+    if args.joint_subjects and args.joint_dataset_seed in args.dataset_seeds:
+        # Pooled databases are taken as different people: the same seed twice would not be.
+        parser.error("--joint-dataset-seed must differ from every --dataset-seeds value")
     dbs = []
     runs = [(seed, False) for seed in args.dataset_seeds]
     if args.joint_subjects:
@@ -323,7 +326,7 @@ def main(argv=None):
         cfg = config(args, dataset_seed, joint)
         if not args.print_only:
             run_experiment(cfg, progress=False)
-        print(f"\n## Dataset seed {dataset_seed} ({cfg.db})\n")
+        print(f"\n## Dataset seed {dataset_seed}{' (joint SFO)' if joint else ''} ({cfg.db})\n")
         print_tables(load_rows(cfg.db))
         with ResultStore(cfg.db, read_only=True) as store:
             rescored = mean_depth_scores(

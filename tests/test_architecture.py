@@ -107,7 +107,8 @@ def test_sfo_command_imports_stay_light():
     code = (
         "import sys\n"
         "import lilium.cli.main, lilium.cli.sfo, lilium.casework.folders\n"
-        "from lilium.cli.main import main\n"
+        "from lilium.cli.main import build_parser\n"
+        "build_parser()\n"
         f"print([m for m in {LAZY_LIBRARIES!r} if m in sys.modules])\n"
     )
     out = subprocess.run(
