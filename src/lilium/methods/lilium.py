@@ -227,7 +227,7 @@ class LiliumProblem:
             sq[replaced] = reprojection_sq_errors(
                 self.uv_c, facial_mm[replaced], R[replaced], t[replaced], f_safe[replaced]
             )
-        self._note_capped(facial_mm, R, t, f, facing)
+        self._note_capped(facial_mm, R, t, f, facing, sq, replaced)
         sq[~ok] = np.inf
         return R, t, f, ok, sq
 
@@ -252,13 +252,20 @@ class LiliumProblem:
         with np.errstate(invalid="ignore"):
             return (f >= FOCAL_MIN_PX) & (f <= self.focal_cap_px) & facing
 
-    def _note_capped(self, facial_mm, R, t, f, facing):
+    def _note_capped(self, facial_mm, R, t, f, facing, sq_px2, stale):
         """Remember the best fit refused only for its focal length (the cap was hit; a fit
-        that ran off towards an orthographic camera does not count)."""
+        that ran off towards an orthographic camera does not count). ``sq_px2`` ``(S, N)``:
+        each member's squared errors under its camera, except the rows ``stale`` ``(S,)``
+        (computed here for the capped ones)."""
         capped = (f > self.focal_cap_px) & (f <= RUN_OFF_FACTOR * self.focal_cap_px) & facing
         if not capped.any():
             return
-        sq = reprojection_sq_errors(self.uv_c, facial_mm[capped], R[capped], t[capped], f[capped])
+        sq = sq_px2[capped]
+        redo = np.flatnonzero(capped & stale)
+        if len(redo):
+            sq[stale[capped]] = reprojection_sq_errors(
+                self.uv_c, facial_mm[redo], R[redo], t[redo], f[redo]
+            )
         mse = np.mean(sq, axis=1)
         k = int(np.argmin(mse))
         if mse[k] < self.capped_mse:
