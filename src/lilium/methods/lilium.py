@@ -220,14 +220,14 @@ class LiliumProblem:
             facing = self._facing(R, t)
             ok = self._valid(f, facing)
         # The refinement's errors are those of its cameras (same projection, same inputs); only
-        # the replaced cameras need theirs (invalid ones end at inf below).
+        # the replaced cameras need theirs (a run-off one overflows to inf: invalid, set below).
         sq = ref.sq_err_px2
         if replaced.any():
-            f_safe = np.where(ok, f, 1.0)
-            sq[replaced] = reprojection_sq_errors(
-                self.uv_c, facial_mm[replaced], R[replaced], t[replaced], f_safe[replaced]
-            )
-        self._note_capped(facial_mm, R, t, f, facing, sq, replaced)
+            with np.errstate(over="ignore", invalid="ignore"):
+                sq[replaced] = reprojection_sq_errors(
+                    self.uv_c, facial_mm[replaced], R[replaced], t[replaced], f[replaced]
+                )
+        self._note_capped(f, facing, sq)
         sq[~ok] = np.inf
         return R, t, f, ok, sq
 
@@ -252,21 +252,14 @@ class LiliumProblem:
         with np.errstate(invalid="ignore"):
             return (f >= FOCAL_MIN_PX) & (f <= self.focal_cap_px) & facing
 
-    def _note_capped(self, facial_mm, R, t, f, facing, sq_px2, stale):
+    def _note_capped(self, f, facing, sq_px2):
         """Remember the best fit refused only for its focal length (the cap was hit; a fit
         that ran off towards an orthographic camera does not count). ``sq_px2`` ``(S, N)``:
-        each member's squared errors under its camera, except the rows ``stale`` ``(S,)``
-        (computed here for the capped ones)."""
+        each member's squared errors under its camera."""
         capped = (f > self.focal_cap_px) & (f <= RUN_OFF_FACTOR * self.focal_cap_px) & facing
         if not capped.any():
             return
-        sq = sq_px2[capped]
-        redo = np.flatnonzero(capped & stale)
-        if len(redo):
-            sq[stale[capped]] = reprojection_sq_errors(
-                self.uv_c, facial_mm[redo], R[redo], t[redo], f[redo]
-            )
-        mse = np.mean(sq, axis=1)
+        mse = np.mean(sq_px2[capped], axis=1)
         k = int(np.argmin(mse))
         if mse[k] < self.capped_mse:
             self.capped_mse, self.capped_focal_px = float(mse[k]), float(f[capped][k])
