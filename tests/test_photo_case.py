@@ -232,7 +232,7 @@ def test_a_bare_photo_without_auto_landmarks_names_the_option(standin, tmp_path,
 def test_the_landmark_line_says_what_was_reviewed(tmp_path):
     from lilium.casework.prepared import landmark_origin
     from lilium.inputs import Photo
-    from lilium.io.case import PreparedFacts
+    from lilium.io.prepared import PreparedFacts
 
     photo = Photo("p", (640, 480), "frontal", {"nasion": np.zeros(2), "subnasale": np.ones(2)})
     reviewed = {"source": "reviewed", "quality": "template", "confirmed": True}

@@ -22,7 +22,6 @@ from ..io.case import (
     photo_from_files,
     read_mask,
     read_photo,
-    read_prepared,
     read_skull,
     skull_from_files,
     subject_files,
@@ -31,6 +30,7 @@ from ..io.curves import read_face_curve
 from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
 from ..io.paths import safe_id
+from ..io.prepared import read_prepared
 from ..validation import check_prior, fmt_range
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 
@@ -297,7 +297,7 @@ def _prepared_image(path, records, out, view, mask, sensor_width_mm, log):
     """``--auto-landmarks`` for one bare image: prepare, read back, keep the user's mask.
 
     Returns the photo (its id the image's stem, as for an image with a landmark file), its
-    labelled inputs and the folder's :class:`~lilium.io.case.PreparedFacts`.
+    labelled inputs and the folder's :class:`~lilium.io.prepared.PreparedFacts`.
     """
     if out is None:
         raise ValueError("--auto-landmarks needs the output folder (--out) to prepare photos in")

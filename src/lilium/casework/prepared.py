@@ -72,7 +72,7 @@ def landmark_origin(photo, facts):
     photo : Photo
         As read (unconfirmed template points already left out).
     facts : PreparedFacts or None
-        :func:`lilium.io.case.read_prepared` of its folder.
+        :func:`lilium.io.prepared.read_prepared` of its folder.
     """
     if facts is None or not facts.landmark_sources:
         return None

@@ -4,7 +4,6 @@ Every problem found is a ``ValueError`` whose message names the file, the field 
 """
 
 import csv
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +28,7 @@ from .jsonio import read_json
 from .keys import json_type, unknown_key_warnings
 from .mesh import MESH_SUFFIXES, read_mesh
 from .paths import path_id, safe_id
+from .prepared import _without_unconfirmed_templates, landmark_qualities, written_by_lilium_photo
 
 __all__ = [
     "IMAGE_NAMES",
@@ -41,7 +41,6 @@ __all__ = [
     "read_image",
     "read_mask",
     "read_photo",
-    "read_prepared",
     "read_skull",
     "skull_from_files",
 ]
@@ -317,167 +316,6 @@ def read_photo(folder, load_image=True):
         image,
         landmark_sources=sources,
         warnings=unknown_key_warnings(meta_path, meta),
-    )
-
-
-#: ``photo.json``'s ``"prepared_by"`` in a folder ``lilium photo`` wrote.
-PREPARED_BY = "lilium photo"
-
-
-def written_by_lilium_photo(meta):
-    """Whether a ``photo.json`` object was written by ``lilium photo`` (this or an older one,
-    recognised by its automatic ``landmark_sources`` and ``priors.sources``): its
-    ``face_mask.png`` is then a head mask, down to the neck (SPEC section 11)."""
-    if not isinstance(meta, dict):
-        return False
-    if meta.get("prepared_by") == PREPARED_BY:
-        return True
-    priors, sources = meta.get("priors"), meta.get("landmark_sources")
-    return (
-        isinstance(priors, dict)
-        and priors.get("source") == "automatic"
-        and isinstance(sources, dict)
-        and isinstance(priors.get("sources"), dict)
-    )
-
-
-def _without_unconfirmed_templates(landmarks, sources):
-    """Drop the landmarks ``lilium photo`` placed from its face template (SPEC section 11).
-
-    The rule: a landmark whose ``landmark_sources`` entry says ``"quality": "template"`` is
-    left out unless the entry also says ``"confirmed": true`` (the review page sets it).
-    """
-    if not isinstance(sources, dict):
-        return landmarks
-    return {
-        name: uv
-        for name, uv in landmarks.items()
-        if not (
-            isinstance(sources.get(name), dict)
-            and sources[name].get("quality") == "template"
-            and sources[name].get("confirmed") is not True
-        )
-    }
-
-
-def landmark_qualities(sources, landmarks):
-    """Who placed each landmark (:attr:`lilium.inputs.Photo.landmark_sources`).
-
-    An entry ``{"source": "automatic", "quality": "tracked" | "template"}`` keeps its quality;
-    a reviewed or confirmed point, or one without an entry, is ``manual``.
-    """
-    out = {}
-    for name in landmarks:
-        entry = sources.get(name) if isinstance(sources, dict) else None
-        quality = entry.get("quality") if isinstance(entry, dict) else None
-        automatic = isinstance(entry, dict) and entry.get("source") == "automatic"
-        reviewed = isinstance(entry, dict) and entry.get("confirmed") is True
-        tagged = automatic and not reviewed and quality in ("tracked", "template")
-        out[name] = quality if tagged else "manual"
-    return out
-
-
-@dataclass(frozen=True)
-class PreparedFacts:
-    """What ``lilium photo`` wrote into a photo folder beyond SPEC section 8 (SPEC section 11).
-
-    Attributes
-    ----------
-    landmark_sources : dict of str -> dict
-        ``photo.json``'s ``landmark_sources`` (every landmark written, used or not): ``{name:
-        {"source": "automatic" | "reviewed", "quality": "tracked" | "template" | "manual",
-        "confirmed": bool}}``.
-    automatic_priors : dict of str -> str
-        The priors ``lilium photo`` found (``focal_px``, ``scd_mm``, ``head_rotation_face2cam``)
-        and where from (its ``priors.sources`` text), when ``priors.source`` is
-        ``"automatic"``; a prior the user added to ``photo.json`` without a ``sources`` entry
-        is not in it.
-    head_rotation_face2cam : ndarray of shape (3, 3) or None
-        The face frame in the camera frame (:mod:`lilium.photo.headpose`).
-    head_tolerance_deg : float or None
-        ``priors.head_tolerance_face_deg``.
-    head_angles_deg : dict of str -> float
-        ``yaw``, ``pitch``, ``roll`` (degrees), for the report.
-    iris_diameter_px : float or None
-        Mean iris diameter (pixels), for the distance prior once a focal is known.
-    review_page : Path or None
-        The folder's ``review.html``.
-    """
-
-    landmark_sources: dict
-    automatic_priors: dict
-    head_rotation_face2cam: np.ndarray | None = None
-    head_tolerance_deg: float | None = None
-    head_angles_deg: dict = field(default_factory=dict)
-    iris_diameter_px: float | None = None
-    review_page: Path | None = None
-
-
-def read_prepared(folder):
-    """The facts of a photo folder written by ``lilium photo`` (:class:`PreparedFacts`).
-
-    Parameters
-    ----------
-    folder : str or Path
-        A photo folder (read it with :func:`read_photo` too: this reads only the extras).
-
-    Returns
-    -------
-    PreparedFacts or None
-        None for a folder without ``landmark_sources`` or automatic priors (a hand-made one).
-
-    Raises
-    ------
-    ValueError
-        Naming ``photo.json`` and the field, for an automatic head orientation that is not a
-        rotation, a tolerance outside (0, 180] degrees or an iris diameter that is not positive.
-    """
-    from ..geometry.rotations import check_rotation
-
-    meta_path = Path(folder) / "photo.json"
-    meta = read_json(meta_path)
-    sources = meta.get("landmark_sources") if isinstance(meta, dict) else None
-    priors = meta.get("priors") if isinstance(meta, dict) else None
-    sources = sources if isinstance(sources, dict) else {}
-    sources = {k: v for k, v in sources.items() if isinstance(v, dict)}
-    automatic = {}
-    if isinstance(priors, dict) and priors.get("source") == "automatic":
-        texts = priors.get("sources") if isinstance(priors.get("sources"), dict) else {}
-        automatic = {k: str(texts[k]) for k in texts if k in priors}
-    else:
-        priors = {}
-    if not sources and not automatic:
-        return None
-    face2cam = tolerance = iris = None
-    if "head_rotation_face2cam" in automatic:
-        try:
-            face2cam = check_rotation(
-                priors["head_rotation_face2cam"], name="priors.head_rotation_face2cam"
-            )
-        except (ValueError, TypeError) as exc:
-            raise ValueError(f"{meta_path}: {exc}") from None
-        tolerance = priors.get("head_tolerance_face_deg", 15.0)
-        if not (is_real(tolerance) and 0 < tolerance <= 180):
-            raise ValueError(
-                f"{meta_path}: priors.head_tolerance_face_deg must be in (0, 180] degrees"
-            )
-        tolerance = float(tolerance)
-    if priors.get("iris_diameter_px") is not None:
-        iris = priors["iris_diameter_px"]
-        if not (is_real(iris) and np.isfinite(iris) and iris > 0):
-            raise ValueError(f"{meta_path}: priors.iris_diameter_px must be a positive number")
-        iris = float(iris)
-    angles = priors.get("head_angles_deg") if face2cam is not None else None
-    angles = {k: float(v) for k, v in angles.items()} if isinstance(angles, dict) else {}
-    review = Path(folder) / "review.html"
-    return PreparedFacts(
-        sources,
-        automatic,
-        face2cam,
-        tolerance,
-        angles,
-        iris,
-        review if review.is_file() else None,
     )
 
 

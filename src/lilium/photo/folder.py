@@ -16,7 +16,7 @@ Rules (docs/photo.md):
 
 from pathlib import Path
 
-from ..io.case import PREPARED_BY, written_by_lilium_photo
+from ..io.prepared import PREPARED_BY, written_by_lilium_photo
 
 __all__ = ["IMAGE_FILES", "OWN_FILES", "PREPARED_BY", "check_image_path", "claim_folder"]
 
