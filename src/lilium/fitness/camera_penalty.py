@@ -135,27 +135,30 @@ def camera_penalty(
     ok = np.ones(f.shape, bool) if success is None else np.asarray(success, dtype=bool)
     if ok.shape != f.shape:
         raise ValueError(f"success has shape {ok.shape}, focal_px has shape {f.shape}")
+    focal_lo_hi = _interval(focal_interval_px, "focal_interval_px")
+    scd_lo_hi = _interval(scd_interval_mm, "scd_interval_mm")
+    tol = None if tolerance_deg is None else float(tolerance_deg)
+    for x, name, on in ((scd_mm, "scd_mm", scd_lo_hi), (dbeta_deg, "dbeta_deg", tol)):
+        if on is not None and x is None:
+            raise ValueError(f"{name} is needed when its prior is given")
+    return _penalty(f, scd_mm, dbeta_deg, ok, focal_lo_hi, scd_lo_hi, tol, focal_max_px)
+
+
+def _penalty(f, scd_mm, dbeta_deg, ok, focal_lo_hi, scd_lo_hi, tolerance_deg, focal_max_px):
+    """:func:`camera_penalty` of checked arguments (``f``, ``ok``: arrays of shape (S,); an
+    interval or tolerance that is None switches its term off)."""
     fail = ~ok | ~np.isfinite(f) | (f < FOCAL_MIN_PX) | (f > focal_max_px)
     terms = np.zeros(f.shape)
-
-    def add(x, name, penalty):
-        nonlocal fail, terms
-        if x is None:
-            raise ValueError(f"{name} is needed when its prior is given")
-        x = np.broadcast_to(np.asarray(x, dtype=float), f.shape)
-        value = penalty(x)
+    parts = ((f, focal_lo_hi, False), (scd_mm, scd_lo_hi, False), (dbeta_deg, tolerance_deg, True))
+    for x, prior, one_sided in parts:
+        if prior is None:
+            continue
+        x = np.asarray(x, dtype=float)
+        if x.shape != f.shape:
+            x = np.broadcast_to(x, f.shape)
+        value = np.maximum(0.0, x - prior) ** 2 if one_sided else _excess2(x, *prior)
         fail = fail | ~np.isfinite(x)
         terms = terms + np.where(np.isfinite(value), value, 0.0)
-
-    lo_hi = _interval(focal_interval_px, "focal_interval_px")
-    if lo_hi is not None:
-        add(f, "focal_px", lambda x: _excess2(x, *lo_hi))
-    scd_lo_hi = _interval(scd_interval_mm, "scd_interval_mm")
-    if scd_lo_hi is not None:
-        add(scd_mm, "scd_mm", lambda x: _excess2(x, *scd_lo_hi))
-    if tolerance_deg is not None:
-        tol = float(tolerance_deg)
-        add(dbeta_deg, "dbeta_deg", lambda x: np.maximum(0.0, x - tol) ** 2)
     return np.where(fail, C_INF, 0.0) + terms
 
 
@@ -175,16 +178,13 @@ def camera_penalty_from_priors(focal_px, scd_mm, R, success, priors):
     -------
     p_cam : ndarray of shape (S,)
     """
-    dbeta = None
-    if priors.uses_head:
-        dbeta = head_deviation_deg(R, priors.head_rotation_skull2cam)
-    return camera_penalty(
-        focal_px,
-        scd_mm,
-        dbeta,
-        success,
-        focal_interval_px=priors.focal_px,
-        scd_interval_mm=priors.scd_mm,
-        tolerance_deg=priors.head_tolerance_deg if priors.uses_head else None,
-        focal_max_px=focal_cap_px(priors.focal_px),
-    )
+    f = np.atleast_1d(np.asarray(focal_px, dtype=float))
+    ok = np.asarray(success, dtype=bool)
+    if ok.shape != f.shape:
+        raise ValueError(f"success has shape {ok.shape}, focal_px has shape {f.shape}")
+    # The priors' intervals were checked when they were made (CameraPriors).
+    head = priors.uses_head
+    dbeta = head_deviation_deg(R, priors.head_rotation_skull2cam) if head else None
+    tolerance = priors.head_tolerance_deg if head else None
+    cap = focal_cap_px(priors.focal_px)
+    return _penalty(f, scd_mm, dbeta, ok, priors.focal_px, priors.scd_mm, tolerance, cap)

@@ -113,7 +113,10 @@ class LiliumProblem:
         self.periodic = np.tile([False, False, True], len(self.corr.cranial_names))
         # Asked-for terms whose inputs are missing are switched off (SPEC section 5), and so is
         # each P_cam part without its prior: ``terms_off`` says which and why.
-        self.level = working_level(skull, photo, self.corr, options.working_face_px)
+        # Without image terms the DE scores nothing at a working level: none is built.
+        images = self.use_skof or self.use_pll
+        face_px = options.working_face_px if images else None
+        self.level = working_level(skull, photo, self.corr, face_px)
         self.skof, self.pll, self.terms_off = image_terms(
             skull, photo, self.centre, self.use_skof, self.use_pll, self.level
         )

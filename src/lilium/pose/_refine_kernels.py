@@ -195,11 +195,12 @@ def lm_kernel(
         while active and it < max_iterations:
             it += 1
             for i in range(7):
-                for j in range(7):
+                for j in range(i + 1):  # symmetric: J[k, i] J[k, j] == J[k, j] J[k, i] exactly
                     acc = 0.0
                     for k in range(2 * N):
                         acc += J[k, i] * J[k, j]
                     JtJ[i, j] = acc
+                    JtJ[j, i] = acc
                 acc = 0.0
                 for k in range(2 * N):
                     acc += J[k, i] * r[k]
@@ -265,3 +266,122 @@ def lm_kernel(
         cost[s] = cost_s
         iterations[s] = it
     return cost, iterations
+
+
+@njit
+def sq_errors_kernel(uv, P, R, t, f):
+    """Squared reprojection errors ``(S, N)`` of :func:`lilium.pose.residuals` (compiled).
+
+    The pinhole written out element by element (``X = R[0, 0] x + R[0, 1] y + R[0, 2] z + t[0]``,
+    ...), as numpy's ``einsum`` sums it; ``inf`` where a point is at or behind the camera or
+    the error is NaN.
+
+    Parameters
+    ----------
+    uv : ndarray of shape (S, N, 2)
+        Observed points minus the principal point (pixels).
+    P : ndarray of shape (S, N, 3)
+    R : ndarray of shape (S, 3, 3)
+    t : ndarray of shape (S, 3)
+    f : ndarray of shape (S,)
+    """
+    S, N = P.shape[0], P.shape[1]
+    out = np.empty((S, N))
+    for s in range(S):
+        for n in range(N):
+            x, y, z = P[s, n, 0], P[s, n, 1], P[s, n, 2]
+            X0 = R[s, 0, 0] * x + R[s, 0, 1] * y + R[s, 0, 2] * z + t[s, 0]
+            X1 = R[s, 1, 0] * x + R[s, 1, 1] * y + R[s, 1, 2] * z + t[s, 1]
+            X2 = R[s, 2, 0] * x + R[s, 2, 1] * y + R[s, 2, 2] * z + t[s, 2]
+            if X2 <= MIN_DEPTH_MM:
+                out[s, n] = np.inf
+                continue
+            scale = f[s] / X2
+            du = (X0 * scale + 0.0) - uv[s, n, 0]
+            dv = (X1 * scale + 0.0) - uv[s, n, 1]
+            sq = du * du + dv * dv
+            out[s, n] = np.inf if np.isnan(sq) else sq
+    return out
+
+
+@njit
+def refine_kernel(
+    uv,
+    P,
+    w,
+    R,
+    t,
+    focal,
+    min_rms_px,
+    max_iterations,
+    initial_lambda,
+    cost_tol,
+    gradient_tol,
+    max_lambda,
+    log_f_stop,
+):
+    """The whole of :func:`lilium.pose.refine.refine_batch`: ``R``, ``t``, ``focal`` in place.
+
+    Centres each problem on the weighted centroid ``m`` of its used points (``c = R m + t``),
+    runs :func:`lm_kernel` and returns to ``t = c - R m``, with the squared errors of the
+    refined cameras (:func:`sq_errors_kernel`).
+
+    Parameters
+    ----------
+    uv : ndarray of shape (S, N, 2)
+    P : ndarray of shape (S, N, 3)
+    w : ndarray of shape (S, N)
+        Weights (0 = unused).
+    R : ndarray of shape (S, 3, 3)
+    t : ndarray of shape (S, 3)
+    focal : ndarray of shape (S,)
+
+    Returns
+    -------
+    cost : ndarray of shape (S,)
+    iterations : ndarray of shape (S,) of int64
+    sq_err_px2 : ndarray of shape (S, N)
+    """
+    S, N = w.shape
+    ws = np.sqrt(w)
+    m = np.zeros((S, 3))
+    Pm = np.empty((S, N, 3))
+    c = np.empty((S, 3))
+    floor = np.empty(S)
+    log_f = np.log(focal)
+    for s in range(S):
+        w_sum = 0.0
+        used = 0
+        for n in range(N):
+            w_sum += w[s, n]
+            used += ws[s, n] != 0.0
+            for j in range(3):
+                m[s, j] += w[s, n] * P[s, n, j]
+        floor[s] = min_rms_px**2 * 2.0 * used
+        for j in range(3):
+            m[s, j] /= w_sum if w_sum > 0 else 1.0
+        for n in range(N):
+            for j in range(3):
+                Pm[s, n, j] = P[s, n, j] - m[s, j]
+        for i in range(3):
+            c[s, i] = R[s, i, 0] * m[s, 0] + R[s, i, 1] * m[s, 1] + R[s, i, 2] * m[s, 2] + t[s, i]
+    cost, iterations = lm_kernel(
+        uv,
+        Pm,
+        ws,
+        R,
+        c,
+        log_f,
+        floor,
+        max_iterations,
+        initial_lambda,
+        cost_tol,
+        gradient_tol,
+        max_lambda,
+        log_f_stop,
+    )
+    for s in range(S):
+        for i in range(3):
+            t[s, i] = c[s, i] - (R[s, i, 0] * m[s, 0] + R[s, i, 1] * m[s, 1] + R[s, i, 2] * m[s, 2])
+        focal[s] = np.exp(log_f[s])
+    return cost, iterations, sq_errors_kernel(uv, P, R, t, focal)

@@ -26,7 +26,7 @@ import numpy as np
 from .. import jit
 from ..constants import FOCAL_MAX_PX, MIN_DEPTH_MM
 from ..geometry.rotations import rotvec_to_matrix
-from ._refine_kernels import lm_kernel
+from ._refine_kernels import refine_kernel
 from .residuals import reprojection_sq_errors
 
 
@@ -194,8 +194,10 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
     N = P.shape[1]
     uv_c = np.broadcast_to(np.asarray(uv_centred_px, dtype=float), (S, N, 2))
     w = np.ones((S, N)) if weights is None else np.broadcast_to(np.asarray(weights, float), (S, N))
-    w_sqrt = np.sqrt(w)
     t = np.array(t, dtype=float)
+    if jit.compiled():  # the same iterations, compiled (pose/_refine_kernels.py)
+        return _refine_compiled(uv_c, P, w, R, t, focal_px, options)
+    w_sqrt = np.sqrt(w)
     log_f = np.log(np.asarray(focal_px, dtype=float))
 
     # Centre each problem on the weighted centroid of its used points.
@@ -203,8 +205,6 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
     m = np.einsum("sn,snj->sj", w, P) / np.where(w_sum > 0, w_sum, 1.0)
     Pm = P - m[:, None, :]
     c = np.einsum("sij,sj->si", R, m) + t
-    if jit.compiled():  # the same iterations, compiled (pose/_refine_kernels.py)
-        return _refine_compiled(uv_c, P, Pm, m, w_sqrt, R, c, log_f, options)
     r, cost, J = _residuals_and_jacobian(uv_c, Pm, w_sqrt, R, c, log_f)
     # The centroid of points in front of the camera is in front of it too.
     cost = np.where(c[:, 2] > MIN_DEPTH_MM, cost, np.inf)
@@ -267,21 +267,19 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
     return BatchRefineResult(R, t, np.exp(log_f), sq, cost, iteration)
 
 
-def _refine_compiled(uv_c, P, Pm, m, w_sqrt, R, c, log_f, options):
-    """The iterations of :func:`refine_batch` by :func:`~lilium.pose._refine_kernels.lm_kernel`."""
-    floor = options.min_rms_px**2 * 2.0 * np.count_nonzero(w_sqrt, axis=1)
-    R = np.ascontiguousarray(R)
-    c = np.ascontiguousarray(c)
-    log_f = np.ascontiguousarray(log_f)
+def _refine_compiled(uv_c, P, w, R, t, focal_px, options):
+    """:func:`refine_batch` by :func:`~lilium.pose._refine_kernels.refine_kernel` (``R`` and
+    ``t`` are the caller's copies, refined in place)."""
+    f = np.array(focal_px, dtype=float).reshape(-1)
     # Writeable C arrays (a broadcast view is read-only): one compiled signature, not two.
-    cost, iterations = lm_kernel(
+    cost, iterations, sq = refine_kernel(
         np.require(uv_c, float, ["C", "W"]),
-        np.require(Pm, float, ["C", "W"]),
-        np.require(w_sqrt, float, ["C", "W"]),
+        np.require(P, float, ["C", "W"]),
+        np.require(w, float, ["C", "W"]),
         R,
-        c,
-        log_f,
-        floor.astype(float),
+        t,
+        f,
+        float(options.min_rms_px),
         int(options.max_iterations),
         float(options.initial_lambda),
         float(options.cost_tol),
@@ -289,7 +287,5 @@ def _refine_compiled(uv_c, P, Pm, m, w_sqrt, R, c, log_f, options):
         float(options.max_lambda),
         float(np.log(options.focal_stop_px)),
     )
-    t = c - np.einsum("sij,sj->si", R, m)
-    sq = reprojection_sq_errors(uv_c, P, R, t, np.exp(log_f))
     n_iterations = int(iterations.max()) if len(iterations) else 0
-    return BatchRefineResult(R, t, np.exp(log_f), sq, cost, n_iterations)
+    return BatchRefineResult(R, t, f, sq, cost, n_iterations)

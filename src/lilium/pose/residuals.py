@@ -2,7 +2,9 @@
 
 import numpy as np
 
+from .. import jit
 from ..geometry.camera import project_points
+from ._refine_kernels import sq_errors_kernel
 
 
 def reprojection_sq_errors(uv_centred_px, points_mm, R, t, focal_px):
@@ -22,6 +24,18 @@ def reprojection_sq_errors(uv_centred_px, points_mm, R, t, focal_px):
     sq_err_px2 : ndarray of shape (K, N)
         ``inf`` where a point is at or behind the camera.
     """
+    if jit.compiled():  # the same formula, compiled (pose/_refine_kernels.py)
+        R = np.asarray(R, dtype=float)
+        S = len(R)
+        P = np.asarray(points_mm, dtype=float)
+        uv = np.asarray(uv_centred_px, dtype=float)
+        return sq_errors_kernel(
+            np.ascontiguousarray(np.broadcast_to(uv, (S,) + uv.shape[-2:])),
+            np.ascontiguousarray(np.broadcast_to(P, (S,) + P.shape[-2:])),
+            np.ascontiguousarray(R),
+            np.ascontiguousarray(t, dtype=float),
+            np.ascontiguousarray(focal_px, dtype=float),
+        )
     uv = project_points(points_mm, R, t, focal_px)  # centred: principal point (0, 0)
     sq = np.sum((uv - uv_centred_px) ** 2, axis=-1)
     return np.where(np.isnan(sq), np.inf, sq)

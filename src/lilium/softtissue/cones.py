@@ -13,7 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import jit
 from ..constants import BILATERAL_LEFT_WEIGHT, CONE_MAX_POLAR_DEG
+from ._cone_kernels import decode_kernel
 from .landmarks import MIDLINE_CRANIAL, bilateral_pairs, side, twin
 
 
@@ -183,6 +185,19 @@ def decode(genes, cones):
     """
     genes = np.asarray(genes, dtype=float)
     single = genes.ndim == 1
+    if jit.compiled():  # the same formulas, compiled (softtissue/_cone_kernels.py)
+        st = decode_kernel(
+            np.ascontiguousarray(np.atleast_2d(genes)),
+            cones.axes,
+            cones.u,
+            cones.v,
+            cones.depth_min_mm,
+            cones.depth_max_mm,
+            np.asarray(cones.pairs, np.int64).reshape(-1, 2),
+            BILATERAL_LEFT_WEIGHT,
+            float(np.radians(CONE_MAX_POLAR_DEG)),
+        )
+        return st[0] if single else st
     g = hybrid_genes(np.atleast_2d(genes), cones.pairs)
     depth = cones.depth_min_mm + g[..., 0] * (cones.depth_max_mm - cones.depth_min_mm)
     alpha = np.radians(CONE_MAX_POLAR_DEG) * g[..., 1]
