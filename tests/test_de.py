@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from lilium import jit
 from lilium.optimisation import DEOptions, DifferentialEvolution, differential_evolution
 from lilium.optimisation.de import distinct_others, exponential_crossover_mask, fold_into_cube
 
@@ -83,3 +84,23 @@ def test_stops_on_wall_clock_stagnation_and_callback():
 def test_too_small_population_is_rejected():
     with pytest.raises(ValueError, match="population_size must be at least 4"):
         DifferentialEvolution(sphere, 2, options=DEOptions(3))
+
+
+@pytest.mark.skipif(not jit.NUMBA_AVAILABLE, reason="numba is not installed")
+def test_compiled_trials_are_the_numpy_trials_bit_for_bit():
+    """Mutation, crossover, wrapping, reflection and the redraw of genes still outside the
+    cube (F = 1.5 throws many out): the compiled path gives the numpy path's populations."""
+
+    def bumpy(pop, parents, thresholds):
+        return np.sum((pop - 0.3) ** 2, axis=1) + np.sin(20 * pop).sum(axis=1)
+
+    periodic = np.tile([False, False, True], 7)
+    populations = []
+    for backend in ("numba", "numpy"):
+        with jit.kernels(backend):
+            options = DEOptions(30, F=1.5, max_generations=60)
+            solver = DifferentialEvolution(bumpy, 21, periodic, options, rng=3)
+            for _ in solver:
+                pass
+            populations.append(solver.population.copy())
+    np.testing.assert_array_equal(populations[0], populations[1])

@@ -302,3 +302,39 @@ def test_distance_to_background_is_scipys_exactly():
     with jit.kernels("numpy"):
         reference = face_mask_index(face_mask())
     np.testing.assert_array_equal(compiled.clearance2, reference.clearance2)
+
+
+@needs_numba
+def test_reprojection_errors_and_decoding_kernels_match_numpy():
+    """The squared reprojection errors (shared and per-camera points, cameras behind the points)
+    and the genes' decoding (bilateral hybrids included) agree with numpy to rounding."""
+    from lilium.pose.residuals import reprojection_sq_errors
+    from lilium.softtissue.cones import decode, make_cones
+    from lilium.softtissue.landmarks import CRANIAL_NAMES
+
+    rng = np.random.default_rng(4)
+    S = 200
+    R = np.array([rotvec_to_matrix(v) for v in rng.normal(size=(S, 3))])
+    t = np.column_stack([rng.normal(scale=20.0, size=(S, 2)), rng.uniform(-100.0, 1500.0, S)])
+    f = rng.uniform(1000.0, 4000.0, S)
+    for X in (rng.normal(scale=60.0, size=(18, 3)), rng.normal(scale=60.0, size=(S, 18, 3))):
+        uv = rng.normal(scale=300.0, size=(18, 2))
+        compiled = reprojection_sq_errors(uv, X, R, t, f)
+        with jit.kernels("numpy"), np.errstate(invalid="ignore"):
+            reference = reprojection_sq_errors(uv, X, R, t, f)
+        behind = np.isinf(reference)
+        assert behind.any() and np.array_equal(np.isinf(compiled), behind)
+        np.testing.assert_allclose(compiled[~behind], reference[~behind], rtol=1e-12)
+
+    names = list(CRANIAL_NAMES)
+    axes = rng.normal(size=(len(names), 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    low = rng.uniform(2.0, 8.0, len(names))
+    cones = make_cones(names, axes, low, low + rng.uniform(3.0, 10.0, len(names)))
+    assert len(cones.pairs)
+    genes = rng.random((300, cones.n_genes))
+    compiled = decode(genes, cones)
+    with jit.kernels("numpy"):
+        reference = decode(genes, cones)
+    np.testing.assert_allclose(compiled, reference, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(decode(genes[0], cones), compiled[0])

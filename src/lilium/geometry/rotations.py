@@ -79,12 +79,9 @@ def geodesic_angle_deg(R_a, R_b):
     R_b = np.asarray(R_b, dtype=float)
     Q = R_a @ np.swapaxes(R_b, -1, -2)
     # atan2(sin, cos) keeps full precision near 0 and 180 degrees, unlike arccos(cos).
-    cos = (np.trace(Q, axis1=-2, axis2=-1) - 1.0) / 2.0
-    vee = np.stack(
-        [Q[..., 2, 1] - Q[..., 1, 2], Q[..., 0, 2] - Q[..., 2, 0], Q[..., 1, 0] - Q[..., 0, 1]],
-        axis=-1,
-    )
-    sin = np.linalg.norm(vee, axis=-1) / 2.0
+    cos = (Q[..., 0, 0] + Q[..., 1, 1] + Q[..., 2, 2] - 1.0) / 2.0
+    x, y, z = Q[..., 2, 1] - Q[..., 1, 2], Q[..., 0, 2] - Q[..., 2, 0], Q[..., 1, 0] - Q[..., 0, 1]
+    sin = np.sqrt(x * x + y * y + z * z) / 2.0
     return np.degrees(np.arctan2(sin, cos))
 
 

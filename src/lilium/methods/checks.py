@@ -179,11 +179,15 @@ def facing_angle_deg(directions, R, t):
         About 0 for a frontal camera, 90 for a lateral one, 180 behind the head; NaN for a
         camera that is not finite.
     """
+    return np.degrees(np.arccos(np.clip(_facing_cos(directions, R, t), -1.0, 1.0)))
+
+
+def _facing_cos(directions, R, t):
+    """Cosine ``(S,)`` of :func:`facing_angle_deg` (NaN for a camera that is not finite)."""
     d = camera_centres_mm(R, t) - directions.origin_mm
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         d = d / np.max(np.abs(d), axis=1, keepdims=True)  # run-off cameras: no overflow
-        cos = (d @ directions.anterior) / np.linalg.norm(d, axis=1)
-    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+        return (d @ directions.anterior) / np.sqrt(np.einsum("si,si->s", d, d))
 
 
 def facing_check(skull):
@@ -200,9 +204,12 @@ def facing_check(skull):
     if directions is None:
         return None
 
+    # angle > FACING_MAX_DEG compared as cosines (the DE asks every generation): the same
+    # rule but for rounding at the boundary itself.
+    cos_max = np.cos(np.radians(FACING_MAX_DEG))
+
     def check(R, t):
-        angle = facing_angle_deg(directions, R, t)
-        return ~(angle > FACING_MAX_DEG)
+        return ~(_facing_cos(directions, R, t) < cos_max)
 
     return check
 

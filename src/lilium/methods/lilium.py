@@ -316,7 +316,8 @@ class LiliumProblem:
         S = len(R)
         mse = np.where(ok, np.mean(sq, axis=1), C_INF)
         mse = np.where(np.isfinite(mse), mse, C_INF)
-        centre = facial_mm[:, self.scd_index].mean(axis=1)
+        i = self.scd_index
+        centre = facial_mm[:, i[0]] if len(i) == 1 else facial_mm[:, i].mean(axis=1)
         # Cameras that ran off (huge focal and depth) overflow here; P_cam gives them C_INF.
         with np.errstate(over="ignore", invalid="ignore"):
             scd = np.linalg.norm(np.einsum("sij,sj->si", R, centre) + t, axis=1)

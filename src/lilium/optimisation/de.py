@@ -28,6 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import jit
+from ._de_kernels import trial_kernel
+
 
 @dataclass(frozen=True)
 class DEOptions:
@@ -114,15 +117,25 @@ def _split(output):
 
 
 def select_payload(accepted, trial, current):
-    """Member payloads after selection: ``trial[k][i]`` where ``accepted[i]``, else ``current``."""
+    """Member payloads after selection: ``trial[k][i]`` where ``accepted[i]``, else ``current``
+    (``current``'s arrays are updated in place and returned)."""
     if current is None:
         return None
-    out = {}
-    for key, old in current.items():
-        new = np.asarray(trial[key])
-        shape = (-1,) + (1,) * (new.ndim - 1)
-        out[key] = np.where(np.reshape(accepted, shape), new, old)
-    return out
+    if np.any(accepted):
+        for key, old in current.items():
+            old[accepted] = np.asarray(trial[key])[accepted]
+    return current
+
+
+def crossover_runs(n_members, n_genes, CR, rng):
+    """Exponential crossover's first gene and run length ``(S,)`` of each member (cyclic)."""
+    start = rng.integers(n_genes, size=n_members)
+    length = (
+        np.minimum(rng.geometric(1.0 - CR, size=n_members), n_genes)
+        if CR < 1
+        else np.full(n_members, n_genes)
+    )
+    return start, length
 
 
 def exponential_crossover_mask(n_members, n_genes, CR, rng):
@@ -133,24 +146,23 @@ def exponential_crossover_mask(n_members, n_genes, CR, rng):
     mask : ndarray of shape (S, D), bool
         At least one gene per row.
     """
-    start = rng.integers(n_genes, size=n_members)
-    length = (
-        np.minimum(rng.geometric(1.0 - CR, size=n_members), n_genes)
-        if CR < 1
-        else np.full(n_members, n_genes)
-    )
+    start, length = crossover_runs(n_members, n_genes, CR, rng)
     offset = (np.arange(n_genes)[None, :] - start[:, None]) % n_genes
     return offset < length[:, None]
 
 
-def distinct_others(n_members, k, rng):
+def distinct_others(n_members, k, rng=None, keys=None):
     """For each member i, k distinct indices of other members.
+
+    The ``k`` smallest of ``keys[i]`` (uniform draws, ``(S, S - 1)``; drawn from ``rng`` when
+    not given) pick them.
 
     Returns
     -------
     ndarray of shape (S, k), int
     """
-    picks = np.argsort(rng.random((n_members, n_members - 1)), axis=1)[:, :k]
+    keys = rng.random((n_members, n_members - 1)) if keys is None else keys
+    picks = np.argsort(keys, axis=1)[:, :k]
     return picks + (picks >= np.arange(n_members)[:, None])
 
 
@@ -241,11 +253,7 @@ class DifferentialEvolution:
         """Run one generation: mutation, crossover, fold into the cube, evaluation, selection."""
         S, D = self.population.shape
         o = self.options
-        r = distinct_others(S, 3, self.rng)
-        pop = self.population
-        mutant = pop[r[:, 0]] + o.F * (pop[r[:, 1]] - pop[r[:, 2]])
-        take = exponential_crossover_mask(S, D, o.CR, self.rng)
-        trial = fold_into_cube(np.where(take, mutant, pop), self.periodic, self.rng)
+        trial = self._trials(S, D)
         trial_fitness, trial_payload = _split(
             self.objective(trial, self.payload, self.fitness.copy())
         )
@@ -260,6 +268,23 @@ class DifferentialEvolution:
         improved = best < before - o.stagnation_tol * max(abs(before), 1e-300)
         self._since_improvement = 0 if improved else self._since_improvement + 1
         self.history.append(float(best))
+
+    def _trials(self, S, D):
+        """Mutation, crossover and folding into the cube: the generation's trials ``(S, D)``."""
+        o, pop = self.options, self.population
+        keys = self.rng.random((S, S - 1))
+        if jit.compiled():  # the same trials, compiled (optimisation/_de_kernels.py)
+            start, length = crossover_runs(S, D, o.CR, self.rng)
+            trial, outside = trial_kernel(
+                pop, keys, start.astype(np.int64), length.astype(np.int64), o.F, self.periodic
+            )
+            if outside.any():
+                trial[outside] = self.rng.random(int(outside.sum()))
+            return trial
+        r = distinct_others(S, 3, keys=keys)
+        mutant = pop[r[:, 0]] + o.F * (pop[r[:, 1]] - pop[r[:, 2]])
+        take = exponential_crossover_mask(S, D, o.CR, self.rng)
+        return fold_into_cube(np.where(take, mutant, pop), self.periodic, self.rng)
 
     def solve(self):
         """Run to termination and return a :class:`DEResult`."""
