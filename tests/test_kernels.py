@@ -338,3 +338,23 @@ def test_reprojection_errors_and_decoding_kernels_match_numpy():
         reference = decode(genes, cones)
     np.testing.assert_allclose(compiled, reference, rtol=0, atol=1e-12)
     np.testing.assert_array_equal(decode(genes[0], cones), compiled[0])
+
+
+@needs_numba
+def test_projection_kernel_matches_numpy():
+    """project_points, shared and per-camera points, some behind the camera: NaN in the same
+    places, the same pixels to rounding."""
+    from lilium.geometry.camera import project_points
+
+    rng = np.random.default_rng(5)
+    S = 50
+    R = np.array([rotvec_to_matrix(v) for v in rng.normal(size=(S, 3))])
+    t = np.column_stack([rng.normal(scale=20.0, size=(S, 2)), rng.uniform(-100.0, 1500.0, S)])
+    f = rng.uniform(1000.0, 4000.0, S)
+    for X in (rng.normal(scale=60.0, size=(40, 3)), rng.normal(scale=60.0, size=(S, 40, 3))):
+        compiled = project_points(X, R, t, f, CENTRE)
+        with jit.kernels("numpy"):
+            reference = project_points(X, R, t, f, CENTRE)
+        behind = np.isnan(reference)
+        assert behind.any() and np.array_equal(np.isnan(compiled), behind)
+        np.testing.assert_allclose(compiled[~behind], reference[~behind], rtol=1e-12)

@@ -17,7 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import jit
 from ..constants import MIN_DEPTH_MM
+from ._projection_kernels import project_each_kernel, project_shared_kernel
 from .rotations import check_rotation
 
 
@@ -93,6 +95,14 @@ def project_points(points_mm, R, t, focal_px, principal_point_px=(0.0, 0.0)):
     uv : ndarray of shape (S, N, 2)
         Pixel coordinates; NaN for points with camera depth <= ``MIN_DEPTH_MM``.
     """
+    if jit.compiled():  # the same projection, compiled (geometry/_projection_kernels.py)
+        P = np.ascontiguousarray(points_mm, dtype=float)
+        R = np.ascontiguousarray(R, dtype=float)
+        kernel = project_shared_kernel if P.ndim == 2 else project_each_kernel
+        c = np.asarray(principal_point_px, dtype=float)
+        f = np.ascontiguousarray(np.broadcast_to(np.asarray(focal_px, dtype=float), len(R)))
+        t = np.ascontiguousarray(t, dtype=float).reshape(len(R), 3)
+        return kernel(P, R, t, f, float(c[0]), float(c[1]))
     X = to_camera_frame(points_mm, R, t)
     z = X[..., 2]
     behind = z <= MIN_DEPTH_MM
