@@ -19,13 +19,13 @@ from lilium.fitness.curves import (
 )
 from lilium.fitness.pll import (
     PLL_NO_CURVE,
-    PllContext,
     convergence_penalties,
     face_curve_index,
     pair_curves_batch,
     pll_penalty,
     trim_curves_batch,
 )
+from lilium.fitness.pll_context import PllContext
 from lilium.imaging.raster import mesh_edge_topology
 
 # A rectangle of pixel centres u = 11..30, v = 21..40.

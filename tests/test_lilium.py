@@ -9,7 +9,8 @@ from lilium.inputs import CameraPriors
 from lilium.io.case import read_photo, read_skull
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions
-from lilium.methods.lilium import LiliumProblem, _failure_message, lilium_sfo
+from lilium.methods.lilium import LiliumProblem, lilium_sfo
+from lilium.methods.lilium_outcome import _failure_message
 from lilium.optimisation import DEOptions
 
 

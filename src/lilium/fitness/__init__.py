@@ -26,7 +26,6 @@ from .curves import (
 from .pll import (
     FaceCurveIndex,
     PairBatch,
-    PllContext,
     PllTerms,
     convergence_penalties,
     face_curve_index,
@@ -37,6 +36,7 @@ from .pll import (
     trim_curves_batch,
     wrong_side,
 )
+from .pll_context import PllContext
 from .regions import (
     AnatomicalFrame,
     Region,

@@ -4,8 +4,9 @@ One implementation, over a population: the skull curves of ``S`` cameras
 (:class:`lilium.fitness.curves.CurveBatch`, pixel polylines in ``uv`` ordered as in
 :mod:`lilium.fitness.curves`) against the one facial curve of the photo, whose end normals and
 nearest-point table are computed once (:class:`FaceCurveIndex`). A single camera is a batch of
-one (:func:`pll_penalty`, :meth:`PllContext.evaluate`). ``tests/pll_oracle.py`` spells the
-same steps out for one pair of curves; the tests check this module against it bit for bit.
+one (:func:`pll_penalty`; :class:`lilium.fitness.pll_context.PllContext` holds what one SFO
+fixes). ``tests/pll_oracle.py`` spells the same steps out for one pair of curves; the tests
+check this module against it bit for bit.
 
 1. Trimming (:func:`trim_curves_batch`): at each end of each curve, the mean tangent of its
    terminal 20 % (at least two points) defines the end's normal line (through the end point,
@@ -47,10 +48,8 @@ import numpy as np
 
 from .. import jit
 from ..constants import C_INF
-from ..imaging.raster import mesh_edge_topology
-from ._curve_kernels import edge_face_table
 from ._pll_kernels import SIDE_CODES, pair_kernel, terms_kernel, trim_kernel
-from .curves import CurveBatch, check_view, detect_curves_batch, refine_curve
+from .curves import CurveBatch, check_view
 
 #: Fraction of a curve's length whose mean tangent defines its end normal (SPEC: 20 %).
 END_FRACTION = 0.2
@@ -67,7 +66,8 @@ PLL_NO_CURVE = C_INF
 #: Query x point pairs per chunk of the brute-force nearest-point searches.
 NEAREST_CHUNK = 250_000
 
-#: Margin (pixels) around the facial curve of the nearest-face-point table of PllContext.
+#: Margin (pixels) around the facial curve of the nearest-face-point table of
+#: :class:`~lilium.fitness.pll_context.PllContext`.
 NEAREST_TABLE_MARGIN_PX = 64
 
 
@@ -75,7 +75,7 @@ NEAREST_TABLE_MARGIN_PX = 64
 class PllTerms:
     """The parts of P_pll (pixels for ``delta_d`` and ``p_conv``), of one camera or of ``S``.
 
-    Fields are scalars for one camera (:func:`pll_penalty`, :meth:`PllContext.evaluate`) and
+    Fields are scalars for one camera (:func:`pll_penalty`, ``PllContext.evaluate``) and
     ndarrays of shape (S,) for a population (:func:`pll_terms_batch`; :meth:`member` picks one).
     ``n_pairs`` = 0 marks a failure (an empty curve): the parts are NaN and ``total`` is
     :data:`PLL_NO_CURVE`.
@@ -515,7 +515,7 @@ def pll_penalty(skull_curve, face_curve, view, trim=True):
     Parameters
     ----------
     skull_curve : array_like of shape (K, 2)
-        From :meth:`PllContext.skull_curve`.
+        From :meth:`~lilium.fitness.pll_context.PllContext.skull_curve`.
     face_curve : array_like of shape (M, 2)
         Refined (:func:`lilium.fitness.curves.refine_curve`), same direction as the skull curve.
     view : {"frontal", "lateral_left", "lateral_right"}
@@ -539,94 +539,3 @@ def pll_penalty(skull_curve, face_curve, view, trim=True):
     """
     curves = CurveBatch.from_curves([skull_curve])
     return pll_terms_batch(curves, face_curve_index(face_curve), view, trim).member(0)
-
-
-@dataclass(frozen=True)
-class PllContext:
-    """What P_pll needs that is fixed during one SFO: the region and the facial curve.
-
-    Attributes
-    ----------
-    faces : ndarray of shape (G, 3)
-        The region's faces, indexing the region's own vertices.
-    topology : EdgeTopology
-    face_curve : ndarray of shape (M, 2)
-    view : str
-    image_shape : (int, int) or None
-    face_index : FaceCurveIndex or None
-        Built from ``face_curve`` when None.
-    edge_faces : tuple or None
-        The faces of every edge of ``topology`` (``edge_face_table``, for the compiled curve
-        detection); computed at each call when None.
-    """
-
-    faces: np.ndarray
-    topology: object
-    face_curve: np.ndarray
-    view: str
-    image_shape: tuple | None = None
-    face_index: FaceCurveIndex | None = None
-    edge_faces: tuple | None = None
-
-    @classmethod
-    def build(cls, region_faces, face_curve, view, image_shape=None, ordered=True):
-        """From a region's faces ``(G, 3)`` and a facial curve ``(M, 2)`` (refined here)."""
-        check_view(view)
-        curve = refine_curve(face_curve, view, ordered=ordered)
-        topology = mesh_edge_topology(region_faces)
-        return cls(
-            np.asarray(region_faces),
-            topology,
-            curve,
-            view,
-            None if image_shape is None else tuple(image_shape),
-            face_curve_index(curve),
-            edge_face_table(topology),
-        )
-
-    def skull_curves(self, region_uv, span_v=None):
-        """The skull curves (:class:`CurveBatch`) of ``region_uv`` (S, K, 2), ``span_v`` (S, 2)."""
-        return detect_curves_batch(
-            region_uv,
-            self.view,
-            topology=self.topology,
-            span_v=span_v,
-            image_shape=self.image_shape,
-            edge_faces=self.edge_faces,
-        )
-
-    def skull_curve(self, region_uv, span_v=None):
-        """The skull curve ``(N, 2)`` of one projection ``(K, 2)`` (``span_v``: (2,) or None)."""
-        region_uv = np.asarray(region_uv, dtype=float)[None]
-        span_v = None if span_v is None else np.asarray(span_v, dtype=float).reshape(1, 2)
-        return self.skull_curves(region_uv, span_v).curve(0)
-
-    def terms_batch(self, region_uv, span_v=None):
-        """:class:`PllTerms` (fields of shape (S,)) of a population's projections.
-
-        Parameters
-        ----------
-        region_uv : array_like of shape (S, K, 2)
-            The region's projected vertices, one row per member.
-        span_v : array_like of shape (S, 2), optional
-            Forehead only: the v of the projected cranial glabella and metopion.
-        """
-        region_uv = np.asarray(region_uv, dtype=float)
-        if region_uv.ndim != 3 or region_uv.shape[-1] != 2:
-            raise ValueError(f"region_uv must have shape (S, K, 2), got {region_uv.shape}")
-        if len(self.face_curve) == 0:
-            return _failed(len(region_uv))
-        index = (
-            self.face_index if self.face_index is not None else face_curve_index(self.face_curve)
-        )
-        return pll_terms_batch(self.skull_curves(region_uv, span_v), index, self.view)
-
-    def evaluate_batch(self, region_uv, span_v=None):
-        """Totals ``(S,)`` for a population: ``region_uv`` (S, K, 2), ``span_v`` (S, 2) or None."""
-        return self.terms_batch(region_uv, span_v).total
-
-    def evaluate(self, region_uv, span_v=None):
-        """Scalar :class:`PllTerms` of one projection ``(K, 2)`` (``span_v``: (2,) or None)."""
-        region_uv = np.asarray(region_uv, dtype=float)[None]
-        span_v = None if span_v is None else np.asarray(span_v, dtype=float).reshape(1, 2)
-        return self.terms_batch(region_uv, span_v).member(0)

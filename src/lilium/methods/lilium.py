@@ -31,7 +31,7 @@ import numpy as np
 
 from ..constants import C_INF, FOCAL_MIN_PX, focal_cap_px
 from ..fitness.camera_penalty import camera_penalty_from_priors
-from ..geometry.camera import Camera, Cameras, principal_point_of
+from ..geometry.camera import Cameras, principal_point_of
 from ..inputs import correspondences
 from ..optimisation.de import DifferentialEvolution
 from ..pose.posest import posest
@@ -39,16 +39,11 @@ from ..pose.refine import refine_batch
 from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode, encode_depth_only, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
-from .checks import facing_check, facing_failure
-from .lilium_terms import full_image_terms, image_terms, prior_terms_off
+from .checks import facing_check
+from .lilium_outcome import photo_outcome
+from .lilium_terms import image_terms, prior_terms_off
 from .options import SfoOptions, with_focal_cap
-from .posest_sfo import (
-    RUN_OFF_FACTOR,
-    focal_cap_message,
-    focal_cap_warning,
-    long_lens_focal_px,
-    mean_depth_landmarks,
-)
+from .posest_sfo import RUN_OFF_FACTOR, mean_depth_landmarks
 from .result import SfoResult
 from .working_level import working_level
 
@@ -517,90 +512,3 @@ def de_extra(de, fallbacks):
         "genes": de.x.tolist(),
         "fallbacks": fallbacks,
     }
-
-
-def photo_outcome(problem, best, seed):
-    """The camera, terms, error and warnings of one photo's best member.
-
-    Parameters
-    ----------
-    problem : LiliumProblem
-    best : dict
-        The best member's payload for this photo (``R``, ``t``, ``focal_px``, ``success``,
-        ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll``; scalars).
-    seed : int
-        For the long-lens check (:func:`~lilium.methods.posest_sfo.long_lens_focal_px`).
-
-    Returns
-    -------
-    camera : Camera or None
-    terms : dict of str -> float or None
-    error : str
-        "" when the photo has a camera.
-    warnings : tuple of CaseWarning
-        ``focal_cap`` (no focal prior, and a better fit above the cap).
-    """
-    ok = bool(best["success"])
-    camera = None
-    if ok:
-        camera = Camera.from_rt(best["R"], best["t"], best["focal_px"], problem.centre)
-    terms = {
-        k: (None if np.isnan(best[k]) else float(best[k]))
-        for k in ("mse_pix", "p_cam", "p_skof", "p_pll")
-    }
-    error, warnings = "", ()
-    photo, skull = problem.photo, problem.skull
-    if ok and not problem.level.is_full:
-        asked = (problem.skof is not None, problem.pll is not None)
-        exact, problem.outside = full_image_terms(skull, photo, camera, *asked)
-        terms.update(exact)
-    if not ok:
-        error = _failure_message(problem, best)
-    elif photo.priors.focal_px is None:
-        if problem.capped_mse < terms["mse_pix"]:
-            warnings = (focal_cap_warning(problem.capped_focal_px, photo),)
-        elif (long_lens := long_lens_focal_px(skull, photo, problem.options, seed)) is not None:
-            warnings = (focal_cap_warning(long_lens, photo),)
-    return camera, terms, error, warnings
-
-
-def _px(focal_px):
-    """A focal length for a message: whole pixels, or 3 significant digits for a run-off fit."""
-    return f"{focal_px:.0f}" if focal_px < 1e6 else f"{focal_px:.3g}"
-
-
-def _failure_message(problem, best):
-    """Why the best member has no camera: behind the skull, over the focal cap, or neither."""
-    R, t, f = np.asarray(best["R"]), np.asarray(best["t"]), float(best["focal_px"])
-    finite = np.isfinite(f) and np.all(np.isfinite(R)) and np.all(np.isfinite(t))
-    if finite and problem.facing is not None and not problem.facing(R[None], t[None])[0]:
-        return facing_failure(problem.skull, problem.photo)
-    if finite and f > RUN_OFF_FACTOR * problem.focal_cap_px:
-        return _run_off_message(problem, f)
-    if finite and f > problem.focal_cap_px:
-        return (
-            f"no camera found: the best soft-tissue estimate needs a focal length of {_px(f)} px; "
-            + focal_cap_message(problem.photo, f)
-        )
-    return "no camera found for the best soft-tissue estimate"
-
-
-def _run_off_message(problem, focal_px):
-    """The failure of an SFO whose cameras all ran off towards an infinite focal length.
-
-    In a single SFO only when POSEST-SFO's soft tissue has no camera either (else
-    :func:`rescue_population` gave the population one). The labels passed the left/right checks
-    before the SFO (:func:`~lilium.methods.checks.check_inputs`), so the message does not blame
-    them: it says how flat the landmarks are, the usual cause.
-    """
-    points = problem.corr.cranial_mm - problem.corr.cranial_mm.mean(axis=0)
-    rms = np.linalg.svd(points, compute_uv=False) / np.sqrt(len(points))
-    mean_tissue = "no camera either" if problem.posest_sfo_member() is None else "one"
-    return (
-        f"no camera found: the camera of every soft-tissue estimate ran off towards an infinite "
-        f"focal length ({_px(focal_px)} px); POSEST-SFO's mean soft tissue has {mean_tissue}. "
-        f"The {len(points)} landmark pairs lie nearly in one plane ({rms[2]:.1f} mm RMS out of "
-        f"it, {rms[0]:.1f} mm across), so they hardly fix the focal length and the distance: "
-        "mark landmarks away from that plane (zygion, gonion, pogonion, frontotemporale), or "
-        "look for a misplaced landmark"
-    )

@@ -12,7 +12,7 @@ clusters of faces that can reach a non-face pixel under each camera.
 import numpy as np
 
 from ..fitness.curves import face_curve_from_mask, missing_curve_bounds
-from ..fitness.pll import PllContext
+from ..fitness.pll_context import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_cameras
 from ..geometry.camera import principal_point_of

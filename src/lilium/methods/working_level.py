@@ -22,7 +22,7 @@ The terms come back in full-resolution units: P_skof's count divided by ``scale^
 distances (``Delta_d``, ``P_conv``) by ``scale``, ``P_int``'s count unchanged. The result of an
 SFO is not taken from the working level: its terms, the outside count and the implausible flag
 are recomputed on the full mesh at the photo's resolution
-(:func:`lilium.methods.lilium.photo_outcome`).
+(:func:`lilium.methods.lilium_outcome.photo_outcome`).
 """
 
 from dataclasses import dataclass, replace
