@@ -21,7 +21,8 @@ from scipy import ndimage
 from scipy.spatial.transform import Rotation
 
 from lilium.fitness.curves import CurveBatch, face_curve_from_mask
-from lilium.fitness.pll import PllContext, pll_terms_batch
+from lilium.fitness.pll import pll_terms_batch
+from lilium.fitness.pll_context import PllContext
 from lilium.fitness.regions import submesh
 from lilium.fitness.skof import face_mask_index, skull_outside_pixels, skull_outside_pixels_batch
 from lilium.geometry.camera import Camera

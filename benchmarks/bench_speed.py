@@ -37,6 +37,7 @@ from collections import defaultdict  # noqa: E402
 from dataclasses import replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+import lilium.methods.lilium_outcome as lilium_outcome  # noqa: E402
 import lilium.methods.lilium_terms as lilium_terms  # noqa: E402
 from lilium import jit  # noqa: E402
 from lilium.io.case import read_photo, read_skull  # noqa: E402
@@ -57,7 +58,7 @@ class TermClock:
         "cameras": (lilium_method.LiliumProblem, "cameras"),
         "p_skof": (lilium_terms.SkofTerm, "__call__"),
         "p_pll": (lilium_terms.PllTerm, "parts"),
-        "final": (lilium_method, "full_image_terms"),
+        "final": (lilium_outcome, "full_image_terms"),
     }
 
     def __init__(self):
