@@ -41,18 +41,23 @@ class PllContext:
     edge_faces: tuple | None = None
 
     @classmethod
-    def build(cls, region_faces, face_curve, view, image_shape=None, ordered=True):
-        """From a region's faces ``(G, 3)`` and a facial curve ``(M, 2)`` (refined here)."""
+    def build(cls, region_faces, face_curve, view, image_shape=None, ordered=True, face_index=None):
+        """From a region's faces ``(G, 3)`` and a facial curve ``(M, 2)`` (refined here).
+
+        ``face_index``: the :class:`FaceCurveIndex` of an already refined facial curve, reused
+        (``face_curve`` is then ignored: the index's own curve is the facial curve).
+        """
         check_view(view)
-        curve = refine_curve(face_curve, view, ordered=ordered)
+        if face_index is None:
+            face_index = face_curve_index(refine_curve(face_curve, view, ordered=ordered))
         topology = mesh_edge_topology(region_faces)
         return cls(
             np.asarray(region_faces),
             topology,
-            curve,
+            face_index.curve,
             view,
             None if image_shape is None else tuple(image_shape),
-            face_curve_index(curve),
+            face_index,
             edge_face_table(topology),
         )
 

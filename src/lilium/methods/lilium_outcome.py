@@ -13,6 +13,7 @@ from ..geometry.camera import Camera
 from .checks import facing_failure
 from .lilium_terms import full_image_terms
 from .posest_sfo import RUN_OFF_FACTOR, focal_cap_message, focal_cap_warning, long_lens_focal_px
+from .working_level import WorkingPll
 
 
 def photo_outcome(problem, best, seed):
@@ -48,7 +49,8 @@ def photo_outcome(problem, best, seed):
     photo, skull = problem.photo, problem.skull
     if ok and not problem.level.is_full:
         asked = (problem.skof is not None, problem.pll is not None)
-        exact, problem.outside = full_image_terms(skull, photo, camera, *asked)
+        working_pll = problem.pll.term if isinstance(problem.pll, WorkingPll) else None
+        exact, problem.outside = full_image_terms(skull, photo, camera, *asked, working_pll)
         terms.update(exact)
     if not ok:
         error = _failure_message(problem, best)

@@ -115,6 +115,41 @@ def pll_off_reason(skull, photo):
     return ""
 
 
+def _region_cut(skull, photo):
+    """P_pll's skull region of ``photo``'s view: ``(vertices_mm (K, 3), faces (G, 3))``, cut
+    from the full mesh (:class:`TermOff` when it cannot be)."""
+    reason = pll_off_reason(skull, photo)
+    if reason:
+        raise TermOff(reason)
+    lm, region_name = skull.landmarks_mm, _region_name(photo.view)
+    try:
+        frame = anatomical_frame(lm)
+    except ValueError as exc:
+        raise TermOff(f"skull {skull.id!r}: {exc}") from None
+    cut = chin_jaw_region if photo.view == "frontal" else forehead_region
+    region = cut(skull.vertices_mm, skull.faces, lm, frame)
+    if len(region.faces) == 0:
+        raise TermOff(
+            f"skull {skull.id!r}: the {region_name} region between its landmarks holds no "
+            "triangle of the mesh (check the landmarks against skull.ply)"
+        )
+    return skull.vertices_mm[region.vertex_index], region.faces
+
+
+def _facial_curve(photo):
+    """The photo's facial curve ``(M, 2)``: ``face_curve.json``, else from the face mask."""
+    if photo.face_curve_uv is not None:
+        face_curve = photo.face_curve_uv
+    else:
+        face_curve = face_curve_from_mask(photo.face_mask, photo.view, photo.landmarks_uv)
+    if len(face_curve) < 2:
+        raise TermOff(
+            f"photo {photo.id!r}: the facial {_region_name(photo.view)} curve is empty (check "
+            "face_mask.png and the landmarks, or give face_curve.json)"
+        )
+    return face_curve
+
+
 class PllTerm:
     """P_pll between the skull's and the face's chin-jaw (frontal) or forehead (lateral) curves.
 
@@ -130,6 +165,10 @@ class PllTerm:
     region_fraction : float
         Keep about this fraction of the region's faces (quadric decimation; the DE's working
         level, :mod:`lilium.methods.working_level`); 1 = the region as cut.
+    reuse : PllTerm, optional
+        A term built on the same skull (the DE's working term, for the result's full-level
+        P_pll): its region cut is reused, and so is its facial curve when it was built for this
+        very ``photo`` (the working level kept the photo's resolution).
 
     Raises
     ------
@@ -138,37 +177,24 @@ class PllTerm:
         empty; the skull's landmarks cannot orient the head); the message says why.
     """
 
-    def __init__(self, skull, photo, centre, region_fraction=1.0):
-        reason = pll_off_reason(skull, photo)
-        if reason:
-            raise TermOff(reason)
-        view, lm, region_name = photo.view, skull.landmarks_mm, _region_name(photo.view)
-        try:
-            frame = anatomical_frame(lm)
-        except ValueError as exc:
-            raise TermOff(f"skull {skull.id!r}: {exc}") from None
-        cut = chin_jaw_region if view == "frontal" else forehead_region
-        region = cut(skull.vertices_mm, skull.faces, lm, frame)
-        if len(region.faces) == 0:
-            raise TermOff(
-                f"skull {skull.id!r}: the {region_name} region between its landmarks holds no "
-                "triangle of the mesh (check the landmarks against skull.ply)"
-            )
-        if photo.face_curve_uv is not None:
-            face_curve = photo.face_curve_uv
+    def __init__(self, skull, photo, centre, region_fraction=1.0, reuse=None):
+        view, lm = photo.view, skull.landmarks_mm
+        if reuse is None:
+            self.cut = _region_cut(skull, photo)
+            face_curve = _facial_curve(photo)
+            face_index = None
         else:
-            face_curve = face_curve_from_mask(photo.face_mask, view, photo.landmarks_uv)
-        if len(face_curve) < 2:
-            raise TermOff(
-                f"photo {photo.id!r}: the facial {region_name} curve is empty (check "
-                "face_mask.png and the landmarks, or give face_curve.json)"
-            )
-        vertices_mm, faces = skull.vertices_mm[region.vertex_index], region.faces
+            self.cut = reuse.cut
+            same_photo = reuse.photo is photo
+            face_curve = None if same_photo else _facial_curve(photo)
+            face_index = reuse.context.face_index if same_photo else None
+        vertices_mm, faces = self.cut
         if region_fraction < 1.0 and len(faces) * region_fraction >= 4:
             vertices_mm, faces = decimate(vertices_mm, faces, len(faces) * region_fraction)
+        self.photo = photo
         self.region_vertices_mm = vertices_mm
         self.context = PllContext.build(
-            faces, face_curve, view, image_shape=photo.image_size_wh[::-1]
+            faces, face_curve, view, image_shape=photo.image_size_wh[::-1], face_index=face_index
         )
         self.span_mm = None if view == "frontal" else np.array([lm["glabella"], lm["metopion"]])
         self.centre = centre
@@ -294,7 +320,7 @@ def planned_terms_off(skull, photo, variant_terms):
     return {**off, **prior_terms_off(photo.priors)}
 
 
-def full_image_terms(skull, photo, camera, use_skof, use_pll):
+def full_image_terms(skull, photo, camera, use_skof, use_pll, working_pll=None):
     """P_skof and P_pll of one camera at the photo's resolution on the full mesh.
 
     What an SFO's result reports when its DE ran at a working level
@@ -307,6 +333,9 @@ def full_image_terms(skull, photo, camera, use_skof, use_pll):
     camera : Camera
     use_skof, use_pll : bool
         Which terms to compute (those that ran in the DE).
+    working_pll : PllTerm, optional
+        The DE's working P_pll term: its region cut (and facial curve, at the same resolution)
+        is reused.
 
     Returns
     -------
@@ -323,6 +352,6 @@ def full_image_terms(skull, photo, camera, use_skof, use_pll):
         outside = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
         terms["p_skof"] = float(skof_penalty(outside.outside_px))
     if use_pll:
-        pll = PllTerm(skull, photo, camera.principal_point_px)
+        pll = PllTerm(skull, photo, camera.principal_point_px, reuse=working_pll)
         terms["p_pll"] = float(pll(camera.as_batch())[0])
     return terms, outside
