@@ -126,6 +126,16 @@ def test_skull_slightly_inside_the_mask_counts_its_few_outside_pixels():
     full = skull_outside_pixels_batch(uv, faces, mask, cull=False)
     np.testing.assert_array_equal(skull_outside_pixels_cameras(context, R, t, focal, CENTRE), full)
     assert (full == 0).any() and (full > 0).any()
+    # The scratch arrays kept between calls: the same counts in any batching and order.
+    order = rng.permutation(n)
+    again = np.concatenate(
+        [
+            skull_outside_pixels_cameras(context, R[i], t[i], focal[i], CENTRE)
+            for i in np.array_split(order, 7)
+        ]
+    )
+    np.testing.assert_array_equal(again, full[order])
+    assert context.scratch.next_stamp == 2 * n
 
 
 def test_clusters_cover_every_face_once():

@@ -40,6 +40,7 @@ from ..imaging.raster import (
 )
 from ._skof_kernels import (
     FaceClusters,
+    SkofScratch,
     face_clusters,
     outside_pixels_kernel,
     project_vertices,
@@ -130,12 +131,16 @@ class SkofContext:
         The skull's vertices, for :func:`skull_outside_pixels_cameras`.
     clusters : FaceClusters or None
         The faces' Morton clusters (:mod:`lilium.fitness._skof_kernels`).
+    scratch : SkofScratch or None
+        The compiled count's scratch arrays (with the clusters; one context per SFO, not for
+        concurrent use).
     """
 
     topology: EdgeTopology
     mask_index: FaceMaskIndex
     vertices_mm: np.ndarray | None = None
     clusters: FaceClusters | None = None
+    scratch: SkofScratch | None = None
 
 
 def prepare_skof(faces, face_mask, vertices_mm=None):
@@ -149,12 +154,9 @@ def prepare_skof(faces, face_mask, vertices_mm=None):
         return SkofContext(mesh_edge_topology(faces), face_mask_index(face_mask))
     vertices_mm = np.ascontiguousarray(vertices_mm, dtype=float)
     clusters = face_clusters(vertices_mm, faces)
-    return SkofContext(
-        mesh_edge_topology(faces[clusters.order]),
-        face_mask_index(face_mask),
-        vertices_mm,
-        clusters,
-    )
+    topology = mesh_edge_topology(faces[clusters.order])
+    scratch = SkofScratch(len(vertices_mm), len(topology.edges_a))
+    return SkofContext(topology, face_mask_index(face_mask), vertices_mm, clusters, scratch)
 
 
 def skull_outside_pixels_cameras(context, R, t, focal_px, principal_point_px):
@@ -191,6 +193,9 @@ def skull_outside_pixels_cameras(context, R, t, focal_px, principal_point_px):
             uv, topology=context.topology, mask_index=context.mask_index
         )
     topo, cl, index = context.topology, context.clusters, context.mask_index
+    scratch = context.scratch
+    if scratch is None:  # a context made by hand: scratch for this call only
+        scratch = SkofScratch(len(context.vertices_mm), len(topo.edges_a))
     count, _ = outside_pixels_kernel(
         context.vertices_mm,
         topo.faces,
@@ -208,6 +213,11 @@ def skull_outside_pixels_cameras(context, R, t, focal_px, principal_point_px):
         float(c[1]),
         index.clearance2,
         index.outside_prefix,
+        scratch.vstamp,
+        scratch.mark,
+        scratch.mult,
+        scratch.touched,
+        scratch.stamps(len(R)),
     )
     return count
 
