@@ -217,6 +217,8 @@ def skull_outside_pixels_cameras(context, R, t, focal_px, principal_point_px):
         scratch.mark,
         scratch.mult,
         scratch.touched,
+        scratch.u,
+        scratch.v,
         scratch.stamps(len(R)),
     )
     return count
