@@ -104,3 +104,27 @@ def test_compiled_trials_are_the_numpy_trials_bit_for_bit():
                 pass
             populations.append(solver.population.copy())
     np.testing.assert_array_equal(populations[0], populations[1])
+
+
+def test_a_returned_result_is_detached_from_the_solver_and_the_objective():
+    """Selection updates the solver's payload in place: neither the objective's arrays nor a
+    result already returned change when the solver goes on."""
+    seen = {}
+
+    def with_payload(pop, members, thresholds):
+        fitness = np.sum((pop - 0.3) ** 2, axis=1)
+        payload = {"x": pop.copy(), "fitness": fitness}
+        seen.setdefault("first", payload)
+        return fitness, payload
+
+    solver = DifferentialEvolution(with_payload, 3, options=DEOptions(8, max_generations=5), rng=1)
+    first = {k: v.copy() for k, v in seen["first"].items()}
+    result = solver.solve()
+    kept = result.payload["x"].copy(), result.population_payload["x"].copy()
+    solver.options = DEOptions(8, max_generations=40)
+    for _ in solver:
+        pass
+    np.testing.assert_array_equal(seen["first"]["x"], first["x"])
+    np.testing.assert_array_equal(result.payload["x"], kept[0])
+    np.testing.assert_array_equal(result.population_payload["x"], kept[1])
+    assert not np.array_equal(solver.payload["x"], kept[1])

@@ -368,3 +368,36 @@ def test_projection_kernel_matches_numpy():
         behind = np.isnan(reference)
         assert behind.any() and np.array_equal(np.isnan(compiled), behind)
         np.testing.assert_allclose(compiled[~behind], reference[~behind], rtol=1e-12)
+
+
+@needs_numba
+def test_compiled_projection_and_errors_broadcast_as_numpy_does():
+    """A focal length and translation shared by the cameras ((1,) and (1, 3)), one point set
+    for all of them given as (1, N, 3), and a mismatch of image and 3D points: the compiled
+    wrappers answer as the numpy path does (same values, or an error) and never read past an
+    array."""
+    from lilium.geometry.camera import project_points
+    from lilium.pose.refine import refine_batch
+    from lilium.pose.residuals import reprojection_sq_errors
+
+    rng = np.random.default_rng(6)
+    R = np.repeat(np.eye(3)[None], 3, axis=0)
+    X = rng.normal(scale=30.0, size=(4, 3))
+    t, f = np.array([[0.0, 0.0, 500.0]]), np.array([800.0])
+    uv = rng.normal(scale=10.0, size=(4, 2))
+    for args in ((X, R, t, f), (X[None], R, t, f)):
+        compiled = project_points(*args)
+        with jit.kernels("numpy"):
+            np.testing.assert_allclose(compiled, project_points(*args), rtol=1e-12)
+    compiled = reprojection_sq_errors(uv, X, R, t, f)
+    with jit.kernels("numpy"):
+        np.testing.assert_allclose(compiled, reprojection_sq_errors(uv, X, R, t, f), rtol=1e-12)
+    assert np.ptp(compiled, axis=0).max() == 0  # three identical cameras
+    with pytest.raises(ValueError):
+        reprojection_sq_errors(uv[:3], X, R, t, f)
+    with pytest.raises(ValueError):
+        project_points(np.repeat(X[None], 2, axis=0), R, t, f)
+    one = refine_batch(uv, X, R[:1], t[0], [800.0])  # a (3,) translation for one camera
+    with jit.kernels("numpy"):
+        ref = refine_batch(uv, X, R[:1], t[0], [800.0])
+    np.testing.assert_allclose(one.t, ref.t, rtol=1e-9)

@@ -182,6 +182,8 @@ def camera_penalty_from_priors(focal_px, scd_mm, R, success, priors):
     ok = np.asarray(success, dtype=bool)
     if ok.shape != f.shape:
         raise ValueError(f"success has shape {ok.shape}, focal_px has shape {f.shape}")
+    if priors.scd_mm is not None and scd_mm is None:
+        raise ValueError("scd_mm is needed when its prior is given")
     # The priors' intervals were checked when they were made (CameraPriors).
     head = priors.uses_head
     dbeta = head_deviation_deg(R, priors.head_rotation_skull2cam) if head else None

@@ -96,13 +96,16 @@ def project_points(points_mm, R, t, focal_px, principal_point_px=(0.0, 0.0)):
         Pixel coordinates; NaN for points with camera depth <= ``MIN_DEPTH_MM``.
     """
     if jit.compiled():  # the same projection, compiled (geometry/_projection_kernels.py)
-        P = np.ascontiguousarray(points_mm, dtype=float)
-        R = np.ascontiguousarray(R, dtype=float)
+        R = np.ascontiguousarray(np.reshape(np.asarray(R, dtype=float), (-1, 3, 3)))
+        S = len(R)
+        P = np.asarray(points_mm, dtype=float)
+        if P.ndim == 3:  # one point set per camera (numpy's broadcasting rules)
+            P = np.broadcast_to(P, (S,) + P.shape[1:])
         kernel = project_shared_kernel if P.ndim == 2 else project_each_kernel
         c = np.asarray(principal_point_px, dtype=float)
-        f = np.ascontiguousarray(np.broadcast_to(np.asarray(focal_px, dtype=float), len(R)))
-        t = np.ascontiguousarray(t, dtype=float).reshape(len(R), 3)
-        return kernel(P, R, t, f, float(c[0]), float(c[1]))
+        f = np.ascontiguousarray(np.broadcast_to(np.asarray(focal_px, dtype=float), (S,)))
+        t = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), (S, 3)))
+        return kernel(np.ascontiguousarray(P), R, t, f, float(c[0]), float(c[1]))
     X = to_camera_frame(points_mm, R, t)
     z = X[..., 2]
     behind = z <= MIN_DEPTH_MM

@@ -369,7 +369,8 @@ class LiliumProblem:
         P_pll first: a trial that P_pll already puts above its threshold loses whatever P_skof
         adds (both are >= 0), and P_skof is 0 for almost every trial near the optimum, so
         P_skof's count runs for about a third as many trials (1,601 against 4,829 cameras in a
-        600k-face SFO of 750 generations; the same DE trajectory and result).
+        600k-face SFO of 750 generations; the same DE run to rounding: the fitness is summed in
+        another order).
 
         Parameters
         ----------

@@ -116,6 +116,11 @@ def _split(output):
     return np.asarray(fitness, dtype=float), payload
 
 
+def _copy(value):
+    """A row of a payload array, detached from it (a numpy scalar as it is)."""
+    return value.copy() if isinstance(value, np.ndarray) else value
+
+
 def select_payload(accepted, trial, current):
     """Member payloads after selection: ``trial[k][i]`` where ``accepted[i]``, else ``current``
     (``current``'s arrays are updated in place and returned)."""
@@ -211,7 +216,9 @@ class DifferentialEvolution:
         self.callback = callback
         self._start = time.perf_counter()
         self.population = self.rng.random((options.population_size, n_genes))
-        self.fitness, self.payload = _split(objective(self.population, None, None))
+        self.fitness, payload = _split(objective(self.population, None, None))
+        # The solver's own copy: selection updates it in place, never the objective's arrays.
+        self.payload = None if payload is None else {k: np.array(v) for k, v in payload.items()}
         self.nfev = options.population_size
         self.nit = 0
         self.history = [float(self.fitness.min())]
@@ -301,8 +308,12 @@ class DifferentialEvolution:
             population_fitness=self.fitness.copy(),
             history=np.asarray(self.history),
             seconds=self.elapsed,
-            payload=None if self.payload is None else {k: v[i] for k, v in self.payload.items()},
-            population_payload=self.payload,
+            payload=None
+            if self.payload is None
+            else {k: _copy(v[i]) for k, v in self.payload.items()},
+            population_payload=(
+                None if self.payload is None else {k: v.copy() for k, v in self.payload.items()}
+            ),
         )
 
 

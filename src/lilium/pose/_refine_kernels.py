@@ -273,8 +273,8 @@ def sq_errors_kernel(uv, P, R, t, f):
     """Squared reprojection errors ``(S, N)`` of :func:`lilium.pose.residuals` (compiled).
 
     The pinhole written out element by element (``X = R[0, 0] x + R[0, 1] y + R[0, 2] z + t[0]``,
-    ...), as numpy's ``einsum`` sums it; ``inf`` where a point is at or behind the camera or
-    the error is NaN.
+    ...; numpy's path multiplies matrices: the same to rounding); ``inf`` where a point is at
+    or behind the camera or the error is NaN.
 
     Parameters
     ----------

@@ -196,6 +196,7 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
     w = np.ones((S, N)) if weights is None else np.broadcast_to(np.asarray(weights, float), (S, N))
     t = np.array(t, dtype=float)
     if jit.compiled():  # the same iterations, compiled (pose/_refine_kernels.py)
+        t = np.array(np.broadcast_to(t, (S, 3)))
         return _refine_compiled(uv_c, P, w, R, t, focal_px, options)
     w_sqrt = np.sqrt(w)
     log_f = np.log(np.asarray(focal_px, dtype=float))
@@ -270,7 +271,7 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
 def _refine_compiled(uv_c, P, w, R, t, focal_px, options):
     """:func:`refine_batch` by :func:`~lilium.pose._refine_kernels.refine_kernel` (``R`` and
     ``t`` are the caller's copies, refined in place)."""
-    f = np.array(focal_px, dtype=float).reshape(-1)
+    f = np.array(np.broadcast_to(np.asarray(focal_px, dtype=float), (len(R),)))
     # Writeable C arrays (a broadcast view is read-only): one compiled signature, not two.
     cost, iterations, sq = refine_kernel(
         np.require(uv_c, float, ["C", "W"]),

@@ -25,16 +25,18 @@ def reprojection_sq_errors(uv_centred_px, points_mm, R, t, focal_px):
         ``inf`` where a point is at or behind the camera.
     """
     if jit.compiled():  # the same formula, compiled (pose/_refine_kernels.py)
-        R = np.asarray(R, dtype=float)
+        R = np.ascontiguousarray(np.reshape(np.asarray(R, dtype=float), (-1, 3, 3)))
         S = len(R)
         P = np.asarray(points_mm, dtype=float)
         uv = np.asarray(uv_centred_px, dtype=float)
+        if P.shape[-2] != uv.shape[-2]:
+            raise ValueError(f"{uv.shape[-2]} image points for {P.shape[-2]} points")
         return sq_errors_kernel(
             np.ascontiguousarray(np.broadcast_to(uv, (S,) + uv.shape[-2:])),
             np.ascontiguousarray(np.broadcast_to(P, (S,) + P.shape[-2:])),
-            np.ascontiguousarray(R),
-            np.ascontiguousarray(t, dtype=float),
-            np.ascontiguousarray(focal_px, dtype=float),
+            R,
+            np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), (S, 3))),
+            np.ascontiguousarray(np.broadcast_to(np.asarray(focal_px, dtype=float), (S,))),
         )
     uv = project_points(points_mm, R, t, focal_px)  # centred: principal point (0, 0)
     sq = np.sum((uv - uv_centred_px) ** 2, axis=-1)
