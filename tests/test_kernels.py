@@ -401,3 +401,21 @@ def test_compiled_projection_and_errors_broadcast_as_numpy_does():
     with jit.kernels("numpy"):
         ref = refine_batch(uv, X, R[:1], t[0], [800.0])
     np.testing.assert_allclose(one.t, ref.t, rtol=1e-9)
+
+
+@needs_numba
+def test_edge_table_kernel_gives_numpys_topology():
+    """The compiled edge table (a counting sort) gives np.unique's edges, in its order, and the
+    same face-edge links, also for a fan of 500 faces round one vertex, repeated and
+    degenerate faces."""
+    rng = np.random.default_rng(8)
+    vertices, faces = shell_skull(rng=1)
+    fan = np.column_stack([np.zeros(500, np.int64), np.arange(1, 501), np.arange(2, 502)])
+    odd = np.concatenate([fan, rng.integers(0, 600, (3000, 3)), [[5, 5, 7], [1, 2, 3], [1, 2, 3]]])
+    for f in (faces, odd):
+        compiled = mesh_edge_topology(f)
+        with jit.kernels("numpy"):
+            reference = mesh_edge_topology(f)
+        for name in ("edges", "face_edges", "face_dirs", "edges_a", "edges_b"):
+            np.testing.assert_array_equal(getattr(compiled, name), getattr(reference, name))
+        assert (compiled.incidence != reference.incidence).nnz == 0

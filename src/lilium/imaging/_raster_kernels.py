@@ -12,6 +12,8 @@ count made from them, are identical:
   instead of one global sort, and the running winding number.
 - :func:`member_crossings` the same for one member and an explicit list of faces, the building
   block of the culled P_skof count (:mod:`lilium.fitness._skof_kernels`).
+- :func:`edge_table_kernel` the edges of :func:`~lilium.imaging.raster.mesh_edge_topology` by
+  a counting sort instead of ``np.unique`` (the same edges in the same order).
 """
 
 import numpy as np
@@ -195,3 +197,58 @@ def scan_kernel(u, v, sign, face_edges, face_dirs, edges_a, edges_b, r_lo, r_hi,
         acc += out[i, 2]
         winding[i] = acc
     return out_member[:total], out[:total, 0].copy(), out[:total, 1].copy(), winding
+
+
+@njit
+def edge_table_kernel(lo, hi, n_vertices):
+    """The distinct edges of a mesh's half-edges and each half-edge's edge, as
+    ``np.unique(lo * n_vertices + hi, return_inverse=True)`` gives them (edges sorted by
+    ``(lo, hi)``), by a counting sort on ``lo`` and a sort of each vertex's few ``hi``.
+
+    Parameters
+    ----------
+    lo, hi : ndarray of shape (H,) of int64
+        Each half-edge's smaller and larger vertex index.
+    n_vertices : int
+
+    Returns
+    -------
+    edges_lo, edges_hi : ndarray of shape (E,) of int64
+    edge_of : ndarray of shape (H,) of int64
+    """
+    H = lo.shape[0]
+    start = np.zeros(n_vertices + 1, np.int64)
+    for i in range(H):
+        start[lo[i] + 1] += 1
+    for v in range(n_vertices):
+        start[v + 1] += start[v]
+    order = np.empty(H, np.int64)
+    fill = start[:-1].copy()
+    for i in range(H):
+        order[fill[lo[i]]] = i
+        fill[lo[i]] += 1
+    edges_lo = np.empty(H, np.int64)
+    edges_hi = np.empty(H, np.int64)
+    edge_of = np.empty(H, np.int64)
+    n_edges = 0
+    for v in range(n_vertices):
+        a, b = start[v], start[v + 1]
+        if b - a > 32:
+            run = order[a:b]
+            order[a:b] = run[np.argsort(hi[run], kind="mergesort")]
+        else:  # insertion sort of a vertex's few half-edges by their other vertex
+            for j in range(a + 1, b):
+                i = order[j]
+                k = j - 1
+                while k >= a and hi[order[k]] > hi[i]:
+                    order[k + 1] = order[k]
+                    k -= 1
+                order[k + 1] = i
+        for j in range(a, b):
+            i = order[j]
+            if j == a or hi[i] != hi[order[j - 1]]:
+                edges_lo[n_edges] = v
+                edges_hi[n_edges] = hi[i]
+                n_edges += 1
+            edge_of[i] = n_edges - 1
+    return edges_lo[:n_edges].copy(), edges_hi[:n_edges].copy(), edge_of

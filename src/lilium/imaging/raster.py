@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import jit
-from ._raster_kernels import scan_kernel
+from ._raster_kernels import edge_table_kernel, scan_kernel
 
 __all__ = [
     "Crossings",
@@ -126,7 +126,14 @@ def mesh_edge_topology(faces):
     face_of = np.repeat(np.arange(n_faces), 3)
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     direction = np.where(a < b, 1, -1).astype(np.int8)
-    if len(lo):
+    if len(lo) and jit.compiled():  # the same table, compiled (imaging/_raster_kernels.py)
+        edges_lo, edges_hi, edge_of = edge_table_kernel(
+            np.ascontiguousarray(lo, np.int64),
+            np.ascontiguousarray(hi, np.int64),
+            int(hi.max()) + 1,
+        )
+        edges = np.column_stack([edges_lo, edges_hi])
+    elif len(lo):
         # One int64 key per edge sorts like the (lo, hi) rows, and far faster.
         n_vertices = int(hi.max()) + 1
         keys, edge_of = np.unique(lo * n_vertices + hi, return_inverse=True)
