@@ -213,3 +213,30 @@ def test_true_skull_projects_inside_the_face_mask():
         cam = photo.camera
         uv = cam.camera.project(subject.skull_vertices_mm)
         assert skull_outside_pixels(uv, subject.skull_faces, photo.face_mask) == 0
+
+
+def test_true_skull_stays_on_the_inner_side_of_its_chin_curve():
+    """Dataset seed 1's subject s16 (its photo as the dataset draws it): the jaw-line cut left
+    isolated neck triangles under the mouth corners, holes in the outline's mask where the
+    chin-jaw curve shot up past the bone (303 of 542 pairs on the wrong side at the true
+    camera); with the holes filled the true skull's curve lies inside the face's, P_int = 0."""
+    from lilium.fitness.pll import pll_penalty
+    from lilium.fitness.pll_context import PllContext
+    from lilium.fitness.regions import anatomical_frame, chin_jaw_region
+    from lilium.synthetic.subjects import make_subject
+
+    seq = np.random.SeedSequence(1).spawn(16)[15]  # as generate_dataset(seed=1) draws s16
+    subject_seq, _, photos_seq = seq.spawn(3)
+    subject = make_subject("s16", np.random.default_rng(subject_seq))
+    head = prepare_head(subject)
+    camera_seq = photos_seq.spawn(2)[0].spawn(2)[0]
+    photo = make_photo(head, "frontal", np.random.default_rng(camera_seq))
+    curve = photo.face_curve["chin_jaw"]
+    assert np.abs(np.diff(curve[:, 1])).max() <= 1  # no spike up to a hole
+    lm = subject.cranial_landmarks
+    region = chin_jaw_region(
+        subject.skull_vertices_mm, subject.skull_faces, lm, anatomical_frame(lm)
+    )
+    ctx = PllContext.build(region.faces, curve, "frontal")
+    uv = photo.camera.camera.project(subject.skull_vertices_mm[region.vertex_index])
+    assert pll_penalty(ctx.skull_curve(uv), curve, "frontal").p_int == 0

@@ -458,9 +458,9 @@ def sample_camera(head, view, rng, ranges=CameraRanges()):
 def face_curve_from_mask(mask, view, landmarks_uv):
     """The photo's facial contour curve from its face mask, for ``face_curve.json``.
 
-    The rule of SPEC section 5 (:func:`lilium.fitness.curves.face_curve_from_mask`): the chin-jaw
-    between the cheilion u-coordinates (frontal) or the forehead between the glabella and metopion
-    v-coordinates (lateral).
+    The rule of SPEC section 5 (:func:`lilium.fitness.curves.face_curve_from_mask`) on the mask
+    with its holes filled: the chin-jaw between the cheilion u-coordinates (frontal) or the
+    forehead between the glabella and metopion v-coordinates (lateral).
 
     Returns
     -------
@@ -471,6 +471,10 @@ def face_curve_from_mask(mask, view, landmarks_uv):
     check_view(view)
     if _curves.missing_curve_bounds(view, landmarks_uv):
         return {}
+    from scipy import ndimage
+
+    # Holes filled: the jaw-line cut left a few isolated neck triangles under the mouth corners.
+    mask = ndimage.binary_fill_holes(mask)
     key = "chin_jaw" if view == "frontal" else "forehead"
     return {key: _curves.face_curve_from_mask(mask, view, landmarks_uv)}
 
