@@ -27,19 +27,9 @@ def _project_one(x, y, z, R, t, f, c0, c1, out):
 
 
 @njit
-def project_shared_kernel(P, R, t, f, c0, c1):
-    """Pixel coordinates ``(S, N, 2)`` of points ``P`` ``(N, 3)`` under S cameras."""
-    S, N = R.shape[0], P.shape[0]
-    uv = np.empty((S, N, 2))
-    for s in range(S):
-        for n in range(N):
-            _project_one(P[n, 0], P[n, 1], P[n, 2], R[s], t[s], f[s], c0, c1, uv[s, n])
-    return uv
-
-
-@njit
-def project_each_kernel(P, R, t, f, c0, c1):
-    """Pixel coordinates ``(S, N, 2)`` of points ``P`` ``(S, N, 3)``: set ``s`` under camera s."""
+def project_kernel(P, R, t, f, c0, c1):
+    """Pixel coordinates ``(S, N, 2)`` of points ``P`` ``(S, N, 3)``, set ``s`` under camera
+    ``s`` (one set shared by all cameras: a broadcast view, stride 0 along S)."""
     S, N = P.shape[0], P.shape[1]
     uv = np.empty((S, N, 2))
     for s in range(S):

@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import jit
 from ..constants import MIN_DEPTH_MM
-from ._projection_kernels import project_each_kernel, project_shared_kernel
+from ._projection_kernels import project_kernel
 from .rotations import check_rotation
 
 
@@ -99,13 +99,14 @@ def project_points(points_mm, R, t, focal_px, principal_point_px=(0.0, 0.0)):
         R = np.ascontiguousarray(np.reshape(np.asarray(R, dtype=float), (-1, 3, 3)))
         S = len(R)
         P = np.asarray(points_mm, dtype=float)
-        if P.ndim == 3:  # one point set per camera (numpy's broadcasting rules)
-            P = np.broadcast_to(P, (S,) + P.shape[1:])
-        kernel = project_shared_kernel if P.ndim == 2 else project_each_kernel
+        # One point set per camera, or one shared by all (a view: nothing copied).
+        P = np.broadcast_to(P, (S,) + P.shape[-2:])
+        if not P.flags.c_contiguous and P.strides[0] != 0:
+            P = np.ascontiguousarray(P)
         c = np.asarray(principal_point_px, dtype=float)
         f = np.ascontiguousarray(np.broadcast_to(np.asarray(focal_px, dtype=float), (S,)))
         t = np.ascontiguousarray(np.broadcast_to(np.asarray(t, dtype=float), (S, 3)))
-        return kernel(np.ascontiguousarray(P), R, t, f, float(c[0]), float(c[1]))
+        return project_kernel(P, R, t, f, float(c[0]), float(c[1]))
     X = to_camera_frame(points_mm, R, t)
     z = X[..., 2]
     behind = z <= MIN_DEPTH_MM
