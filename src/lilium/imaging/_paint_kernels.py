@@ -10,6 +10,10 @@ triangle's depth is the mean of its corners', as the painter sorted them; on a t
 triangle wins, as the painter's stable order painted it last). Triangles that hold no pixel
 centre paint nothing (the callers give the pixels of the silhouette left unpainted a neighbour's
 triangle).
+
+:func:`surface_kernel` then computes each painted pixel's depth and normal: the numpy steps of
+:func:`lilium.imaging.shading.render_surface` (its reference path) pixel by pixel, the same
+numbers bit for bit on the tests' meshes.
 """
 
 import cv2
@@ -90,3 +94,67 @@ def nearest_face_index(uv, faces, depth_mm, shape, keep=None, covered=None):
             index[gaps] = grown.astype(np.int32)[gaps]
         index[~covered] = -1
     return index
+
+
+@njit
+def surface_kernel(rows, cols, face, uv, faces, X, normals_cam, c0, c1, focal, height, width):
+    """Per covered pixel, the depth and unit normal of :func:`lilium.imaging.shading.render_surface`
+    (its numpy steps, pixel by pixel in the same order: barycentric weights of the pixel centre
+    clipped to the triangle, interpolated camera z and vertex normal, the face normal where the
+    vertex normals cancel, turned towards the camera).
+
+    Parameters
+    ----------
+    rows, cols, face : ndarray of shape (P,) of int
+        The painted pixels and their triangles.
+    uv : ndarray of shape (V, 2)
+    faces : ndarray of shape (F, 3)
+    X : ndarray of shape (V, 3)
+        Vertices in the camera frame (mm).
+    normals_cam : ndarray of shape (V, 3)
+    c0, c1, focal : float
+        Principal point and focal length (pixels).
+
+    Returns
+    -------
+    depth_mm : ndarray of shape (height, width) of float32 (NaN off the skull)
+    normal_cam : ndarray of shape (height, width, 3) of float32
+    """
+    depth_mm = np.full((height, width), np.nan, np.float32)
+    normal_cam = np.zeros((height, width, 3), np.float32)
+    w = np.empty(3)
+    n = np.empty(3)
+    for i in range(rows.shape[0]):
+        r, col, k = rows[i], cols[i], face[i]
+        ia, ib, ic = faces[k, 0], faces[k, 1], faces[k, 2]
+        a0, a1, b0, b1, e0, e1 = uv[ia, 0], uv[ia, 1], uv[ib, 0], uv[ib, 1], uv[ic, 0], uv[ic, 1]
+        p0, p1 = float(col), float(r)
+        d = (b1 - e1) * (a0 - e0) + (e0 - b0) * (a1 - e1)
+        if abs(d) > 1e-9:
+            w0 = ((b1 - e1) * (p0 - e0) + (e0 - b0) * (p1 - e1)) / d
+            w1 = ((e1 - a1) * (p0 - e0) + (a0 - e0) * (p1 - e1)) / d
+            w[0], w[1], w[2] = w0, w1, 1 - w0 - w1
+            for j in range(3):
+                w[j] = min(max(w[j], 0.0), 1.0)
+        else:
+            w[0] = w[1] = w[2] = 1 / 3
+        total = w[0] + w[1] + w[2]
+        for j in range(3):
+            w[j] = w[j] / total
+        depth = w[0] * X[ia, 2] + w[1] * X[ib, 2] + w[2] * X[ic, 2]
+        for j in range(3):
+            n[j] = w[0] * normals_cam[ia, j] + w[1] * normals_cam[ib, j] + w[2] * normals_cam[ic, j]
+        if np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) < 0.3:  # the face normal instead
+            ux, uy, uz = X[ib, 0] - X[ia, 0], X[ib, 1] - X[ia, 1], X[ib, 2] - X[ia, 2]
+            vx, vy, vz = X[ic, 0] - X[ia, 0], X[ic, 1] - X[ia, 1], X[ic, 2] - X[ia, 2]
+            n[0], n[1], n[2] = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+        length = max(np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1e-12)
+        for j in range(3):
+            n[j] = n[j] / length
+        if n[0] * (p0 - c0) + n[1] * (p1 - c1) + n[2] * focal > 0:
+            for j in range(3):
+                n[j] = -n[j]
+        depth_mm[r, col] = depth
+        for j in range(3):
+            normal_cam[r, col, j] = n[j]
+    return depth_mm, normal_cam

@@ -27,7 +27,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ._paint_kernels import nearest_face_index
+from .. import jit
+from ._paint_kernels import nearest_face_index, surface_kernel
 from .raster import content_key, skull_raster
 
 #: Direction towards the key light in the camera frame (x right, y down, z forward): upper
@@ -137,6 +138,13 @@ def render_surface(vertices_mm, faces, camera, image_size_wh, *, topology=None):
     face_index = nearest_face_index(uv, faces, depth_key, (height, width), covered=covered)
     rows, cols = np.nonzero(face_index >= 0)
     f = face_index[rows, cols]
+    if jit.compiled():  # the same steps per pixel, compiled (imaging/_paint_kernels.py)
+        c0, c1 = (float(x) for x in camera.principal_point_px)
+        depth_mm, normal_cam = surface_kernel(
+            rows, cols, f, np.ascontiguousarray(uv), faces, np.ascontiguousarray(X),
+            np.ascontiguousarray(normals_cam), c0, c1, float(camera.focal_px), height, width,
+        )  # fmt: skip
+        return SurfaceRender(covered, face_index, depth_mm, normal_cam, float(camera.focal_px))
     a, b, c = (uv[faces[f, k]] for k in range(3))
     p = np.stack([cols, rows], axis=1).astype(float)
     # Barycentric coordinates of the pixel centre (clipped: a gap pixel shows a neighbour).
