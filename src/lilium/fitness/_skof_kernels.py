@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..constants import MIN_DEPTH_MM
+from ..geometry._projection_kernels import pinhole
 from ..imaging._raster_kernels import accumulate_face, edge_crossings, sort_rows
 from ..jit import njit
 
@@ -345,17 +346,7 @@ def _sphere_inside(sphere, R, t, f, c0, c1, clearance2, width, height):
 
 @njit
 def _project(i, vertices, R, t, f, c0, c1, u, v):
-    x, y, z = vertices[i, 0], vertices[i, 1], vertices[i, 2]
-    X0 = R[0, 0] * x + R[0, 1] * y + R[0, 2] * z + t[0]
-    X1 = R[1, 0] * x + R[1, 1] * y + R[1, 2] * z + t[1]
-    X2 = R[2, 0] * x + R[2, 1] * y + R[2, 2] * z + t[2]
-    if X2 <= MIN_DEPTH_MM:
-        u[i] = np.nan
-        v[i] = np.nan
-    else:
-        scale = f / X2
-        u[i] = X0 * scale + c0
-        v[i] = X1 * scale + c1
+    u[i], v[i] = pinhole(vertices[i, 0], vertices[i, 1], vertices[i, 2], R, t, f, c0, c1)
 
 
 @njit

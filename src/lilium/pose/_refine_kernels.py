@@ -18,6 +18,7 @@ rejected step and a larger damping.
 import numpy as np
 
 from ..constants import MIN_DEPTH_MM
+from ..geometry._projection_kernels import pinhole
 from ..jit import njit
 
 _SMALL_ANGLE = 1e-8  # as lilium.geometry.rotations
@@ -272,9 +273,9 @@ def lm_kernel(
 def sq_errors_kernel(uv, P, R, t, f):
     """Squared reprojection errors ``(S, N)`` of :func:`lilium.pose.residuals` (compiled).
 
-    The pinhole written out element by element (``X = R[0, 0] x + R[0, 1] y + R[0, 2] z + t[0]``,
-    ...; numpy's path multiplies matrices: the same to rounding); ``inf`` where a point is at
-    or behind the camera or the error is NaN.
+    The compiled pinhole (:func:`lilium.geometry._projection_kernels.pinhole`; numpy's path
+    multiplies matrices: the same to rounding); ``inf`` where a point is at or behind the
+    camera or the error is NaN.
 
     Parameters
     ----------
@@ -289,16 +290,9 @@ def sq_errors_kernel(uv, P, R, t, f):
     out = np.empty((S, N))
     for s in range(S):
         for n in range(N):
-            x, y, z = P[s, n, 0], P[s, n, 1], P[s, n, 2]
-            X0 = R[s, 0, 0] * x + R[s, 0, 1] * y + R[s, 0, 2] * z + t[s, 0]
-            X1 = R[s, 1, 0] * x + R[s, 1, 1] * y + R[s, 1, 2] * z + t[s, 1]
-            X2 = R[s, 2, 0] * x + R[s, 2, 1] * y + R[s, 2, 2] * z + t[s, 2]
-            if X2 <= MIN_DEPTH_MM:
-                out[s, n] = np.inf
-                continue
-            scale = f[s] / X2
-            du = (X0 * scale + 0.0) - uv[s, n, 0]
-            dv = (X1 * scale + 0.0) - uv[s, n, 1]
+            u, v = pinhole(P[s, n, 0], P[s, n, 1], P[s, n, 2], R[s], t[s], f[s], 0.0, 0.0)
+            du = u - uv[s, n, 0]  # NaN behind the camera: inf below
+            dv = v - uv[s, n, 1]
             sq = du * du + dv * dv
             out[s, n] = np.inf if np.isnan(sq) else sq
     return out
