@@ -131,10 +131,7 @@ def camera_penalty(
     >>> camera_penalty([1000.0, 1300.0, 0.0], focal_interval_px=(800, 1200)).tolist()
     [0.0, 10000.0, 1000000640000.0]
     """
-    f = np.atleast_1d(np.asarray(focal_px, dtype=float))
-    ok = np.ones(f.shape, bool) if success is None else np.asarray(success, dtype=bool)
-    if ok.shape != f.shape:
-        raise ValueError(f"success has shape {ok.shape}, focal_px has shape {f.shape}")
+    f, ok = _focal_and_success(focal_px, success)
     focal_lo_hi = _interval(focal_interval_px, "focal_interval_px")
     scd_lo_hi = _interval(scd_interval_mm, "scd_interval_mm")
     tol = None if tolerance_deg is None else float(tolerance_deg)
@@ -142,6 +139,15 @@ def camera_penalty(
         if on is not None and x is None:
             raise ValueError(f"{name} is needed when its prior is given")
     return _penalty(f, scd_mm, dbeta_deg, ok, focal_lo_hi, scd_lo_hi, tol, focal_max_px)
+
+
+def _focal_and_success(focal_px, success):
+    """``focal_px`` and ``success`` (all True when None) as arrays of one shape ``(S,)``."""
+    f = np.atleast_1d(np.asarray(focal_px, dtype=float))
+    ok = np.ones(f.shape, bool) if success is None else np.asarray(success, dtype=bool)
+    if ok.shape != f.shape:
+        raise ValueError(f"success has shape {ok.shape}, focal_px has shape {f.shape}")
+    return f, ok
 
 
 def _penalty(f, scd_mm, dbeta_deg, ok, focal_lo_hi, scd_lo_hi, tolerance_deg, focal_max_px):
@@ -178,10 +184,7 @@ def camera_penalty_from_priors(focal_px, scd_mm, R, success, priors):
     -------
     p_cam : ndarray of shape (S,)
     """
-    f = np.atleast_1d(np.asarray(focal_px, dtype=float))
-    ok = np.asarray(success, dtype=bool)
-    if ok.shape != f.shape:
-        raise ValueError(f"success has shape {ok.shape}, focal_px has shape {f.shape}")
+    f, ok = _focal_and_success(focal_px, success)
     if priors.scd_mm is not None and scd_mm is None:
         raise ValueError("scd_mm is needed when its prior is given")
     # The priors' intervals were checked when they were made (CameraPriors).
