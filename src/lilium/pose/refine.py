@@ -194,9 +194,8 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
     N = P.shape[1]
     uv_c = np.broadcast_to(np.asarray(uv_centred_px, dtype=float), (S, N, 2))
     w = np.ones((S, N)) if weights is None else np.broadcast_to(np.asarray(weights, float), (S, N))
-    t = np.array(t, dtype=float)
+    t = np.array(np.broadcast_to(np.asarray(t, dtype=float), (S, 3)))  # the caller's copy
     if jit.compiled():  # the same iterations, compiled (pose/_refine_kernels.py)
-        t = np.array(np.broadcast_to(t, (S, 3)))
         return _refine_compiled(uv_c, P, w, R, t, focal_px, options)
     w_sqrt = np.sqrt(w)
     log_f = np.log(np.asarray(focal_px, dtype=float))
