@@ -3,6 +3,7 @@ calibration, the conclusion and its caps, and the ``"identification"`` record of
 and ``lilium case``."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -299,6 +300,41 @@ def test_cohort_reads_a_photo_against_other_skulls(tmp_path):
         read_cohort(tmp_path / "bad.json")
     # A cohort without the views' landmarks gives no terms.
     assert cohort_terms([view], Cohort(({"x": np.zeros(3)},), ({"x": np.ones(3)},))) == (None, None)
+
+
+def test_skull_cohort_reads_a_skull_against_other_faces():
+    """The skull cohort: the candidate skull against other people's faces, each projected by
+    the SFO's camera. A cohort person with the candidate's own skull (in another frame) gives a
+    noise-free photo the candidate fits exactly; other people's faces fit it worse; two views
+    of one person share the soft tissue; too few members give no terms."""
+    from lilium.identification.cohort import Cohort, skull_cohort_chi2, skull_cohort_terms
+
+    rng = np.random.default_rng(8)
+    view = _view(rng)
+    names = view.names
+    landmarks, axes = [], []
+    for k in range(6):
+        other = view if k == 0 else _view(np.random.default_rng(200 + k), noise=False)
+        turn = _rotation([0.0, 0.4 * k, 0.1])
+        landmarks.append(dict(zip(names, other.cranial_mm @ turn.T + [0.0, 5.0 * k, 0.0],
+                                  strict=True)))
+        axes.append(dict(zip(names, other.axes @ turn.T, strict=True)))
+    cohort = Cohort(tuple(landmarks), tuple(axes))
+    values = skull_cohort_chi2([view], cohort)
+    assert len(values) == 6
+    assert values[0] < 1e-3  # its own face, without noise: fitted exactly
+    assert np.all(values[1:] > 100 * values[0])
+    mean, sd = skull_cohort_terms([view], cohort)
+    assert mean == pytest.approx(np.log(values).mean()) and sd == pytest.approx(
+        np.log(values).std())
+    # Two views: one value per cohort person, the views stacked.
+    side = replace(view, camera=Camera.from_rt(_rotation([0.0, 0.1, 0.0]) @ view.camera.R,
+                                                view.camera.t + [40.0, 0.0, 100.0],
+                                                view.camera.focal_px,
+                                                view.camera.principal_point_px))
+    assert len(skull_cohort_chi2([view, side], cohort)) == 6
+    few = Cohort(cohort.landmarks_mm[:4], cohort.axes[:4])
+    assert skull_cohort_terms([view], few) == (None, None)
 
 
 def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path):

@@ -29,7 +29,7 @@ import numpy as np
 from ..geometry.camera import Camera
 from ..identification.calibration import cross_validated, fit, performance
 from ..identification.cohort import Cohort
-from ..identification.score import identification_terms, pll_face
+from ..identification.score import identification_terms, pll_face, with_skull_cohort
 from ..identification.terms import TERM_NAMES, eye_corner_px
 from ..inputs import correspondences
 from ..io.calibration import shipped_cohort
@@ -146,6 +146,17 @@ def _complete(terms):
     return terms is not None and all(name in terms for name in TERM_NAMES)
 
 
+#: The terms added last: stored terms lacking only these are completed, not computed again.
+SKULL_COHORT_TERMS = ("skull_mean", "skull_sd")
+
+
+def _completed(terms, skull, photos, cameras):
+    """Stored terms lacking only :data:`SKULL_COHORT_TERMS`, completed; else None."""
+    if terms is None or not all(n in terms for n in TERM_NAMES if n not in SKULL_COHORT_TERMS):
+        return None
+    return with_skull_cohort(terms, skull, photos, cameras, cohort=shipped_cohort())
+
+
 def single_terms(rows, inputs=None, cohort_cache=None):
     """The terms of every row (None for a failed SFO): stored, or computed with ``inputs``
     (also when the stored ones lack a term of this version)."""
@@ -164,11 +175,14 @@ def single_terms(rows, inputs=None, cohort_cache=None):
             )
         else:
             skull, photo = _inputs(r, inputs)
-            image = [row_image(r, skull, photo, camera)]
-            out.append(identification_terms(
-                skull, [photo], [camera], _facial(r), image=image, cohort=shipped_cohort(),
-                cohort_cache=cohort_cache,
-            ))
+            terms = _completed(r["data"].get(TERMS_KEY), skull, [photo], [camera])
+            if terms is None:
+                image = [row_image(r, skull, photo, camera)]
+                terms = identification_terms(
+                    skull, [photo], [camera], _facial(r), image=image, cohort=shipped_cohort(),
+                    cohort_cache=cohort_cache,
+                )
+            out.append(terms)
     return out
 
 
@@ -239,11 +253,14 @@ def decisions(rows, terms, inputs=None, cohort_cache=None):
                     raise ValueError("pair terms need the dataset; give --dataset DIR")
                 skull, pf = _inputs(fr, inputs)
                 _, pl = _inputs(lr, inputs)
-                image = [(t["outside_fraction"], t["pll_face"]) for t in (ft, lt)]
-                stored = identification_terms(
-                    skull, [pf, pl], [_camera(fr), _camera(lr)], _facial(fr), image=image,
-                    cohort=shipped_cohort(), cohort_cache=cohort_cache,
-                )
+                cameras = [_camera(fr), _camera(lr)]
+                stored = _completed(stored, skull, [pf, pl], cameras)
+                if stored is None:
+                    image = [(t["outside_fraction"], t["pll_face"]) for t in (ft, lt)]
+                    stored = identification_terms(
+                        skull, [pf, pl], cameras, _facial(fr), image=image,
+                        cohort=shipped_cohort(), cohort_cache=cohort_cache,
+                    )
             out[(run[1], run[2], "joint" if joint else "pair")].append(base | {"terms": stored})
             if not joint:
                 out[(run[1], run[2], "pair_sum")].append(base | {"parts": (ft, lt)})

@@ -40,6 +40,8 @@ FEATURES = {
     "prior_excess": lambda v: np.log1p(10.0 * np.maximum(v, 0.0)),
     "cohort_mean": lambda v: v,
     "cohort_sd": lambda v: np.log(np.maximum(v, 1e-6)),
+    "skull_mean": lambda v: v,
+    "skull_sd": lambda v: np.log(np.maximum(v, 1e-6)),
 }
 
 #: L2 penalty on the standardised weights.

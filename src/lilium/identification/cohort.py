@@ -94,7 +94,7 @@ def _whitened(R, t, f, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
     f ``(K,)``); the marginal covariance ``S = J Sigma J^T + sigma^2 I`` of each landmark
     whitens its residual, so the squared norm is ``sum r^T S^-1 r``."""
     points = cranial + mean_mm[None, :, None] * axes
-    r = uv[None] - project_points(points, R, t, f, pp)  # NaN behind a camera
+    r = (uv if uv.ndim == 3 else uv[None]) - project_points(points, R, t, f, pp)  # NaN: behind
     bad = ~np.isfinite(r).all(axis=(1, 2))
     J = projection_jacobians(to_camera_frame(points, R, t), R, f)
     sigma = soft_tissue_covariance(axes.reshape(-1, 3), np.tile(mean_mm, len(R)),
@@ -130,8 +130,8 @@ def refit_cameras(R0, t0, f0, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
         Each skull's cranial landmarks and unit soft-tissue axes.
     mean_mm, sd_mm : ndarray of shape (N,)
         Population depth statistics.
-    uv : ndarray of shape (N, 2)
-        The photo's facial landmarks.
+    uv : ndarray of shape (N, 2) or (K, N, 2)
+        The photo's facial landmarks, or one photo per camera (the skull cohort).
     sigma_px : ndarray of shape (N,)
         The landmarks' 2D errors (kept fixed).
 
@@ -143,27 +143,30 @@ def refit_cameras(R0, t0, f0, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
     """
     K = len(R0)
     args = (pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px)
-    p = np.zeros((K, 7))
-    w = _whitened(*_cameras(R0, t0, f0, p), *args)
-    cost = np.sum(w**2, axis=1)
-    lam = np.full(K, 1e-3)
-    for _ in range(REFIT_ITERATIONS):
-        J = np.empty((K, w.shape[1], 7))
-        for j in range(7):
-            q = p.copy()
-            q[:, j] += FD_STEPS[j]
-            J[:, :, j] = (_whitened(*_cameras(R0, t0, f0, q), *args) - w) / FD_STEPS[j]
-        JtJ = np.swapaxes(J, 1, 2) @ J
-        g = np.einsum("kmj,km->kj", J, w)
-        A = JtJ + lam[:, None, None] * (np.eye(7) * np.diagonal(JtJ, axis1=1, axis2=2)[:, None]
-                                        + 1e-9 * np.eye(7))
-        step = -np.linalg.solve(A, g[..., None])[..., 0]
-        trial = p + step
-        w_trial = _whitened(*_cameras(R0, t0, f0, trial), *args)
-        cost_trial = np.sum(w_trial**2, axis=1)
-        better = cost_trial < cost
-        p[better], w[better], cost[better] = trial[better], w_trial[better], cost_trial[better]
-        lam = np.where(better, lam * 0.3, lam * 10.0)
+    # A trial step that runs off (a focal overflowing, a point behind the camera) is scored
+    # 1e3 per residual by _whitened and rejected; its floating-point warnings say nothing more.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        p = np.zeros((K, 7))
+        w = _whitened(*_cameras(R0, t0, f0, p), *args)
+        cost = np.sum(w**2, axis=1)
+        lam = np.full(K, 1e-3)
+        for _ in range(REFIT_ITERATIONS):
+            J = np.empty((K, w.shape[1], 7))
+            for j in range(7):
+                q = p.copy()
+                q[:, j] += FD_STEPS[j]
+                J[:, :, j] = (_whitened(*_cameras(R0, t0, f0, q), *args) - w) / FD_STEPS[j]
+            JtJ = np.swapaxes(J, 1, 2) @ J
+            g = np.einsum("kmj,km->kj", J, w)
+            A = JtJ + lam[:, None, None] * (np.eye(7) * np.diagonal(JtJ, axis1=1, axis2=2)[:, None]
+                                            + 1e-9 * np.eye(7))
+            step = -np.linalg.solve(A, g[..., None])[..., 0]
+            trial = p + step
+            w_trial = _whitened(*_cameras(R0, t0, f0, trial), *args)
+            cost_trial = np.sum(w_trial**2, axis=1)
+            better = cost_trial < cost
+            p[better], w[better], cost[better] = trial[better], w_trial[better], cost_trial[better]
+            lam = np.where(better, lam * 0.3, lam * 10.0)
     return _cameras(R0, t0, f0, p)
 
 
@@ -224,6 +227,78 @@ def cohort_terms(views, cohort):
     these landmarks. The calibration reads them beside the candidate's own ``landmark_chi2``.
     """
     values = cohort_chi2(views, cohort)
+    values = np.log(values[np.isfinite(values) & (values > 0)])
+    if len(values) < MIN_COHORT:
+        return None, None
+    return float(values.mean()), float(max(values.std(), 1e-6))
+
+
+def skull_cohort_chi2(views, cohort):
+    """``landmark_chi2`` of the candidate skull against every cohort person's face.
+
+    The photo cohort (:func:`cohort_chi2`) asks how well other skulls fit this photo; this asks
+    the converse, how well this skull fits other people's faces. Each cohort person's face
+    (their cranial landmarks plus the population mean depth along their own axes) is moved
+    onto the candidate skull (rigid fit of the common landmarks) and projected by each view's
+    SFO camera: a noise-free photo with the same landmarks, view and camera as the real one.
+    The candidate's camera is refitted to it as in :func:`refit_cameras` and the candidate's
+    ``landmark_chi2`` computed (several views still share their soft tissue).
+
+    Parameters
+    ----------
+    views : sequence of View
+    cohort : Cohort
+
+    Returns
+    -------
+    ndarray of shape (K',)
+        One value per cohort person who has every landmark the views use.
+    """
+    names = sorted({n for v in views for n in v.names})
+    members = [k for k in range(len(cohort)) if all(
+        n in cohort.landmarks_mm[k] and n in cohort.axes[k] for n in names)]
+    if not members:
+        return np.empty(0)
+    K = len(members)
+    candidate = {n: c for v in views for n, c in zip(v.names, v.cranial_mm, strict=True)}
+    target = np.array([candidate[n] for n in names])
+    moves = [kabsch(np.array([cohort.landmarks_mm[k][n] for n in names]), target)
+             for k in members]
+    per_member = [[] for _ in members]
+    for view in views:
+        cam = view.camera
+        faces = []
+        for k, (Ra, ta) in zip(members, moves, strict=True):
+            cranial = np.array([cohort.landmarks_mm[k][n] for n in view.names], float)
+            axes = np.array([cohort.axes[k][n] for n in view.names], float)
+            axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
+            faces.append((cranial + view.depth_mean_mm[:, None] * axes) @ Ra.T + ta)
+        R0, t0, f0 = np.repeat(cam.R[None], K, axis=0), np.repeat(cam.t[None], K, axis=0), np.full(
+            K, cam.focal_px)
+        uv = project_points(np.array(faces), R0, t0, f0, cam.principal_point_px)
+        R, t, f = refit_cameras(
+            R0, t0, f0, cam.principal_point_px,
+            np.repeat(view.cranial_mm[None], K, axis=0), np.repeat(view.axes[None], K, axis=0),
+            view.depth_mean_mm, view.depth_sd_mm, uv, landmark_sigma_px(view),
+        )
+        for j in range(K):
+            per_member[j].append(replace(
+                view, camera=Camera.from_rt(R[j], t[j], f[j], cam.principal_point_px),
+                uv_px=uv[j],
+            ))
+    return np.array([landmark_chi2(v)[0] for v in per_member])
+
+
+def skull_cohort_terms(views, cohort):
+    """The candidate skull's fit to the cohort's faces: mean and SD of ``ln landmark_chi2``
+    (None, None when fewer than :data:`MIN_COHORT` cohort people have the views' landmarks).
+
+    They describe the skull against other people, not the photo's person: a skull that fits
+    anyone's landmarks (one near the population's average) gives its own ``landmark_chi2``
+    less weight. Zero normalisation ("Z-norm") of speaker recognition, beside the photo's test
+    normalisation (:func:`cohort_terms`); the calibration weighs both.
+    """
+    values = skull_cohort_chi2(views, cohort)
     values = np.log(values[np.isfinite(values) & (values > 0)])
     if len(values) < MIN_COHORT:
         return None, None

@@ -15,9 +15,9 @@ from ..methods.checks import scd_point_mm
 from ..methods.lilium_terms import PllTerm, TermOff
 from ..softtissue.depths import depth_stats
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from .cohort import cohort_terms
+from .cohort import cohort_terms, skull_cohort_terms
 from .terms import (
-    PHOTO_TERMS,
+    COHORT_TERMS,
     TERM_NAMES,
     eye_corner_px,
     landmark_chi2,
@@ -89,8 +89,9 @@ def identification_terms(
         SFO when several are combined); computed for a photo whose entry is None, or for every
         photo when not given.
     cohort : Cohort, optional
-        Other people's skulls (:mod:`lilium.identification.cohort`): without it
-        ``cohort_mean`` and ``cohort_sd`` are None.
+        Other people's skulls and faces (:mod:`lilium.identification.cohort`): without it
+        the cohort terms (``cohort_mean``, ``cohort_sd``, ``skull_mean``, ``skull_sd``) are
+        None.
     cohort_cache : dict, optional
         Cohort terms already computed, by the photos' landmarks (names and positions): the
         cohort terms describe the photos, so scoring many skulls against one photo computes
@@ -123,6 +124,9 @@ def identification_terms(
         if key not in cache:
             cache[key] = cohort_terms(views, cohort)
         cohort_mean, cohort_sd = cache[key]
+    skull_mean = skull_sd = None
+    if cohort is not None and np.isfinite(chi2):
+        skull_mean, skull_sd = skull_cohort_terms(views, cohort)
     st = _soft_tissue_term(skull, facial_landmarks_mm or {}, depth_table)
 
     def mean(values):
@@ -141,6 +145,8 @@ def identification_terms(
         ),
         cohort_mean=cohort_mean,
         cohort_sd=cohort_sd,
+        skull_mean=skull_mean,
+        skull_sd=skull_sd,
     )
     assert tuple(out) == TERM_NAMES
     out["nll"] = nll
@@ -148,11 +154,25 @@ def identification_terms(
     return out
 
 
+def with_skull_cohort(terms, skull, photos, cameras, depth_table=None, cohort=None):
+    """Terms stored by a version before the skull cohort terms, completed: ``skull_mean`` and
+    ``skull_sd`` computed (:func:`lilium.identification.cohort.skull_cohort_terms`), every
+    other term kept as stored (arguments as in :func:`identification_terms`)."""
+    mean = sd = None
+    if cohort is not None and np.isfinite(terms.get("landmark_chi2") or np.nan):
+        views = [
+            make_view(camera, correspondences(skull, photo), photo.landmark_sources, depth_table)
+            for photo, camera in zip(photos, cameras, strict=True)
+        ]
+        mean, sd = skull_cohort_terms(views, cohort)
+    return {**terms, "skull_mean": mean, "skull_sd": sd}
+
+
 def nll_score(terms):
     """The unweighted identification score (lower = more likely the same person): the
     landmarks' chi^2 per coordinate plus the other terms of the skull as they are (a None
-    counts 0; the cohort terms describe the photo and are left out)."""
-    return float(sum(terms[k] or 0.0 for k in TERM_NAMES if k not in PHOTO_TERMS))
+    counts 0; the cohort terms are left out: they say how to read the others)."""
+    return float(sum(terms[k] or 0.0 for k in TERM_NAMES if k not in COHORT_TERMS))
 
 
 def cameras_of(result):

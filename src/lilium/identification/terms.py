@@ -35,6 +35,10 @@ The terms (all "lower is better", dimensionless):
   of ``ln landmark_chi2`` of a cohort of other people's skulls, each under its own best
   camera (:mod:`lilium.identification.cohort`); they let the calibration read a
   ``landmark_chi2`` against what this photo gives any skull.
+- ``skull_mean``, ``skull_sd``: the converse, about the skull: the mean and SD of the
+  candidate's ``ln landmark_chi2`` against the cohort's faces, each a noise-free photo with
+  the real photo's landmarks under the SFO's camera (:func:`lilium.identification.cohort.
+  skull_cohort_terms`); a skull that fits anyone's landmarks weighs its own fit less.
 
 A term whose input is missing (no mask, no curve, no prior) is None; the calibration
 (:mod:`lilium.identification.calibration`) reads a None as the term's typical value and says so.
@@ -74,10 +78,14 @@ TERM_NAMES = (
     "prior_excess",
     "cohort_mean",
     "cohort_sd",
+    "skull_mean",
+    "skull_sd",
 )
 
-#: The terms about the photo(s) rather than the skull (left out of the unweighted score).
-PHOTO_TERMS = ("cohort_mean", "cohort_sd")
+#: The cohort terms: the photo(s) against other people's skulls, the skull against other
+#: people's faces. Not evidence by themselves (left out of the unweighted score): they tell
+#: the calibration how to read ``landmark_chi2``.
+COHORT_TERMS = ("cohort_mean", "cohort_sd", "skull_mean", "skull_sd")
 
 #: The terms the calibration uses. ``soft_tissue_z2`` is reported but left out: measured on 20
 #: generated subjects (docs/method.md, Identification) it lowered Lilium's frontal per-photo
@@ -90,6 +98,8 @@ CALIBRATED_TERMS = (
     "prior_excess",
     "cohort_mean",
     "cohort_sd",
+    "skull_mean",
+    "skull_sd",
 )
 
 
