@@ -89,17 +89,16 @@ def kabsch(source_mm, target_mm):
     return R, ct - cs @ R.T
 
 
-def _whitened(R, t, f, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
+def _whitened(R, t, f, pp, points, cov, uv, sigma_px):
     """Whitened residuals ``(K, 2N)`` of K skulls under K cameras (R ``(K,3,3)``, t ``(K,3)``,
-    f ``(K,)``); the marginal covariance ``S = J Sigma J^T + sigma^2 I`` of each landmark
-    whitens its residual, so the squared norm is ``sum r^T S^-1 r``."""
-    points = cranial + mean_mm[None, :, None] * axes
+    f ``(K,)``): ``points`` ``(K, N, 3)`` are the skulls' mean facial points, ``cov``
+    ``(K, N, 3, 3)`` their soft-tissue covariances; the marginal covariance
+    ``S = J Sigma J^T + sigma^2 I`` of each landmark whitens its residual, so the squared norm
+    is ``sum r^T S^-1 r``."""
     r = (uv if uv.ndim == 3 else uv[None]) - project_points(points, R, t, f, pp)  # NaN: behind
     bad = ~np.isfinite(r).all(axis=(1, 2))
     J = projection_jacobians(to_camera_frame(points, R, t), R, f)
-    sigma = soft_tissue_covariance(axes.reshape(-1, 3), np.tile(mean_mm, len(R)),
-                                   np.tile(sd_mm, len(R))).reshape(J.shape[:2] + (3, 3))
-    S = J @ sigma @ np.swapaxes(J, -1, -2)
+    S = J @ cov @ np.swapaxes(J, -1, -2)
     S[..., 0, 0] += sigma_px**2
     S[..., 1, 1] += sigma_px**2
     a = np.sqrt(S[..., 0, 0])
@@ -142,7 +141,8 @@ def refit_cameras(R0, t0, f0, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
     f : ndarray of shape (K,)
     """
     K = len(R0)
-    args = (pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px)
+    cov = soft_tissue_covariance(axes.reshape(-1, 3), np.tile(mean_mm, K), np.tile(sd_mm, K))
+    args = (pp, cranial + mean_mm[None, :, None] * axes, cov.reshape(K, -1, 3, 3), uv, sigma_px)
     # A trial step that runs off (a focal overflowing, a point behind the camera) is scored
     # 1e3 per residual by _whitened and rejected; its floating-point warnings say nothing more.
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
