@@ -170,6 +170,37 @@ def refit_cameras(R0, t0, f0, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
     return _cameras(R0, t0, f0, p)
 
 
+def _aligned(views, cohort):
+    """The cohort members with every landmark of ``views`` and the rigid fit ``(R, t)`` of each
+    onto the candidate skull (cohort frame -> candidate frame, by their common landmarks)."""
+    names = sorted({n for v in views for n in v.names})
+    members = [k for k in range(len(cohort)) if all(
+        n in cohort.landmarks_mm[k] and n in cohort.axes[k] for n in names)]
+    candidate = {n: c for v in views for n, c in zip(v.names, v.cranial_mm, strict=True)}
+    target = np.array([candidate[n] for n in names])
+    moves = [kabsch(np.array([cohort.landmarks_mm[k][n] for n in names]), target)
+             for k in members]
+    return members, moves
+
+
+def _landmarks(cohort, members, names):
+    """Cranial landmarks ``(K, N, 3)`` and unit soft-tissue axes ``(K, N, 3)`` of ``members``
+    (each in its own frame), in the order of ``names``."""
+    cranial = np.array([[cohort.landmarks_mm[k][n] for n in names] for k in members], float)
+    axes = np.array([[cohort.axes[k][n] for n in names] for k in members], float)
+    axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
+    return cranial, axes
+
+
+def _log_stats(values):
+    """Mean and SD of ``ln`` of the finite, positive ``values`` (None, None when fewer than
+    :data:`MIN_COHORT`)."""
+    values = np.log(values[np.isfinite(values) & (values > 0)])
+    if len(values) < MIN_COHORT:
+        return None, None
+    return float(values.mean()), float(max(values.std(), 1e-6))
+
+
 def cohort_chi2(views, cohort):
     """``landmark_chi2`` of every cohort skull against the photos of ``views``.
 
@@ -185,33 +216,21 @@ def cohort_chi2(views, cohort):
         One value per cohort skull that has every landmark the views use (the others are
         left out).
     """
-    names = sorted({n for v in views for n in v.names})
-    members = [k for k in range(len(cohort)) if all(
-        n in cohort.landmarks_mm[k] and n in cohort.axes[k] for n in names)]
+    members, moves = _aligned(views, cohort)
     if not members:
         return np.empty(0)
-    candidate = {n: c for v in views for n, c in zip(v.names, v.cranial_mm, strict=True)}
-    target = np.array([candidate[n] for n in names])
+    K = len(members)
     cohort_views = [[] for _ in members]
     for view in views:
         cam = view.camera
-        R0, t0, cranial, axes = [], [], [], []
-        for k in members:
-            source = np.array([cohort.landmarks_mm[k][n] for n in names])
-            Ra, ta = kabsch(source, target)  # cohort frame -> candidate frame
-            R0.append(cam.R @ Ra)
-            t0.append(cam.R @ ta + cam.t)
-            cranial.append([cohort.landmarks_mm[k][n] for n in view.names])
-            axes.append([cohort.axes[k][n] for n in view.names])
-        cranial = np.array(cranial, float)
-        axes = np.array(axes, float)
-        axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
+        R0 = np.array([cam.R @ Ra for Ra, _ in moves])
+        t0 = np.array([cam.R @ ta + cam.t for _, ta in moves])
+        cranial, axes = _landmarks(cohort, members, view.names)
         R, t, f = refit_cameras(
-            np.array(R0), np.array(t0), np.full(len(members), cam.focal_px),
-            cam.principal_point_px, cranial, axes, view.depth_mean_mm, view.depth_sd_mm,
-            view.uv_px, landmark_sigma_px(view),
+            R0, t0, np.full(K, cam.focal_px), cam.principal_point_px, cranial, axes,
+            view.depth_mean_mm, view.depth_sd_mm, view.uv_px, landmark_sigma_px(view),
         )
-        for j in range(len(members)):
+        for j in range(K):
             cohort_views[j].append(replace(
                 view, camera=Camera.from_rt(R[j], t[j], f[j], cam.principal_point_px),
                 cranial_mm=cranial[j], axes=axes[j],
@@ -226,11 +245,7 @@ def cohort_terms(views, cohort):
     They describe the photo, not the candidate skull: how hard it is for any skull to fit
     these landmarks. The calibration reads them beside the candidate's own ``landmark_chi2``.
     """
-    values = cohort_chi2(views, cohort)
-    values = np.log(values[np.isfinite(values) & (values > 0)])
-    if len(values) < MIN_COHORT:
-        return None, None
-    return float(values.mean()), float(max(values.std(), 1e-6))
+    return _log_stats(cohort_chi2(views, cohort))
 
 
 def skull_cohort_chi2(views, cohort):
@@ -254,27 +269,19 @@ def skull_cohort_chi2(views, cohort):
     ndarray of shape (K',)
         One value per cohort person who has every landmark the views use.
     """
-    names = sorted({n for v in views for n in v.names})
-    members = [k for k in range(len(cohort)) if all(
-        n in cohort.landmarks_mm[k] and n in cohort.axes[k] for n in names)]
+    members, moves = _aligned(views, cohort)
     if not members:
         return np.empty(0)
     K = len(members)
-    candidate = {n: c for v in views for n, c in zip(v.names, v.cranial_mm, strict=True)}
-    target = np.array([candidate[n] for n in names])
-    moves = [kabsch(np.array([cohort.landmarks_mm[k][n] for n in names]), target)
-             for k in members]
     per_member = [[] for _ in members]
     for view in views:
         cam = view.camera
-        faces = []
-        for k, (Ra, ta) in zip(members, moves, strict=True):
-            cranial = np.array([cohort.landmarks_mm[k][n] for n in view.names], float)
-            axes = np.array([cohort.axes[k][n] for n in view.names], float)
-            axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
-            faces.append((cranial + view.depth_mean_mm[:, None] * axes) @ Ra.T + ta)
-        R0, t0, f0 = np.repeat(cam.R[None], K, axis=0), np.repeat(cam.t[None], K, axis=0), np.full(
-            K, cam.focal_px)
+        cranial, axes = _landmarks(cohort, members, view.names)
+        faces = [(c + view.depth_mean_mm[:, None] * a) @ Ra.T + ta
+                 for c, a, (Ra, ta) in zip(cranial, axes, moves, strict=True)]
+        R0 = np.repeat(cam.R[None], K, axis=0)
+        t0 = np.repeat(cam.t[None], K, axis=0)
+        f0 = np.full(K, cam.focal_px)
         uv = project_points(np.array(faces), R0, t0, f0, cam.principal_point_px)
         R, t, f = refit_cameras(
             R0, t0, f0, cam.principal_point_px,
@@ -298,8 +305,4 @@ def skull_cohort_terms(views, cohort):
     less weight. Zero normalisation ("Z-norm") of speaker recognition, beside the photo's test
     normalisation (:func:`cohort_terms`); the calibration weighs both.
     """
-    values = skull_cohort_chi2(views, cohort)
-    values = np.log(values[np.isfinite(values) & (values > 0)])
-    if len(values) < MIN_COHORT:
-        return None, None
-    return float(values.mean()), float(max(values.std(), 1e-6))
+    return _log_stats(skull_cohort_chi2(views, cohort))
