@@ -419,3 +419,110 @@ def test_edge_table_kernel_gives_numpys_topology():
         for name in ("edges", "face_edges", "face_dirs", "edges_a", "edges_b"):
             np.testing.assert_array_equal(getattr(compiled, name), getattr(reference, name))
         assert (compiled.incidence != reference.incidence).nnz == 0
+
+
+@needs_numba
+@pytest.mark.parametrize("priors_on", [True, False])
+def test_camera_terms_and_checks_kernels_match_numpy(case, priors_on):
+    """A population's cameras and camera terms (the checks after the refinement: facing rule,
+    focal range and cap, best capped fit; MSE_pix, P_cam with or without priors) agree with
+    the numpy path: the same validity and capped fit, terms to rounding."""
+    from dataclasses import replace
+
+    from lilium.inputs import CameraPriors
+    from lilium.io.case import read_photo, read_skull
+    from lilium.methods import SfoOptions
+    from lilium.methods.lilium import LiliumProblem
+
+    skull, photo = read_skull(case[0]), read_photo(case[1])
+    if priors_on:
+        R_head = photo.priors.head_rotation_skull2cam
+        if R_head is None:
+            R_head = rotvec_to_matrix(np.array([np.pi, 0.0, 0.0]))
+        photo = replace(
+            photo,
+            priors=CameraPriors(
+                focal_px=(1100.0, 1150.0),
+                scd_mm=(900.0, 950.0),
+                head_rotation_skull2cam=R_head,
+                head_tolerance_deg=1.0,
+            ),
+        )
+    else:
+        photo = replace(photo, priors=CameraPriors())
+    rng = np.random.default_rng(6)
+    outputs = []
+    for path in ("numba", "numpy"):
+        with jit.kernels(path):
+            problem = LiliumProblem(skull, photo, SfoOptions("base"), rng=0)
+            facial = problem.facial_landmarks(rng.random((120, problem.cones.n_genes)))
+            first = problem.camera_terms(facial)  # POSEST, then the refinement
+            members = {k: first[k] for k in ("R", "t", "focal_px", "success")}
+            # Warm starts from other members' cameras: some fits fail the checks.
+            shuffled = {k: np.asarray(v)[::-1].copy() for k, v in members.items()}
+            second = problem.camera_terms(facial, shuffled)
+            outputs.append((first, second, problem.capped_mse, problem.capped_focal_px))
+        rng = np.random.default_rng(6)
+    (a1, a2, a_mse, a_f), (b1, b2, b_mse, b_f) = outputs
+    for a, b in ((a1, b1), (a2, b2)):
+        np.testing.assert_array_equal(a["success"], b["success"])
+        for key in ("mse_pix", "p_cam", "fitness", "focal_px"):
+            np.testing.assert_allclose(a[key], b[key], rtol=1e-9)
+    assert not a2["success"].all() and a2["success"].any()
+    hinged = (a2["p_cam"] > 0) & (a2["p_cam"] < 1e12)
+    assert hinged.any() if priors_on else not hinged.any()
+    assert (a_f is None) == (b_f is None)
+    if a_f is not None:
+        np.testing.assert_allclose([a_mse, a_f], [b_mse, b_f], rtol=1e-9)
+
+
+@needs_numba
+def test_camera_checks_kernel_matches_the_numpy_rules():
+    """Facing rule, focal range, best capped fit and the hand-back to the numpy path (a broken
+    camera; no valid camera and no lender), against the numpy rules they replace."""
+    from lilium.fitness._camera_kernels import camera_checks_kernel
+    from lilium.methods.checks import FacingRule, SkullDirections
+
+    rng = np.random.default_rng(8)
+    S, N = 400, 12
+    R = np.array([rotvec_to_matrix(v) for v in rng.normal(scale=1.5, size=(S, 3))])
+    t = rng.normal(scale=400.0, size=(S, 3))
+    f = rng.choice([0.5, 800.0, 1500.0, 2500.0, 4000.0, 9000.0], S)
+    sq = rng.random((S, N)) * 50.0
+    cost = sq.sum(axis=1)
+    anterior = np.array([0.0, 0.0, 1.0])
+    directions = SkullDirections(np.array([1.0, -2.0, 3.0]), anterior, None, None, "", "")
+    rule = FacingRule(directions, 0.2)
+    cap, run_off = 2000.0, 5000.0
+    facing = rule(R, t)
+    ok = (f >= 1.0) & (f <= cap) & facing
+    capped = (f > cap) & (f <= run_off) & facing
+    assert 0 < facing.sum() < S and ok.any() and capped.any()
+    mse = np.where(capped, sq.mean(axis=1), np.inf)
+    origin = rule.directions.origin_mm
+    out = sq.copy()
+    done, got_ok, k, k_mse = camera_checks_kernel(
+        R, t, f, cost, out, origin, anterior, rule.cos_max, cap, run_off, True
+    )
+    assert done and np.array_equal(got_ok, ok)
+    assert k == np.argmin(mse) and np.isclose(k_mse, mse.min(), rtol=1e-12)
+    assert np.isinf(out[~ok]).all() and np.array_equal(out[ok], sq[ok])
+    # Without the rule every camera faces.
+    done, got_ok, _, _ = camera_checks_kernel(
+        R, t, f, cost, sq.copy(), origin, anterior, np.nan, cap, run_off, True
+    )
+    assert done and np.array_equal(got_ok, (f >= 1.0) & (f <= cap))
+    # Hand-backs: nothing is changed.
+    broken = sq.copy()
+    broken[7, 3] = np.inf
+    assert not camera_checks_kernel(
+        R, t, f, cost, broken, origin, anterior, rule.cos_max, cap, run_off, True
+    )[0]
+    assert np.isinf(broken).sum() == 1
+    none_ok = np.full(S, 9000.0)
+    assert not camera_checks_kernel(
+        R, t, none_ok, cost, sq.copy(), origin, anterior, rule.cos_max, cap, run_off, False
+    )[0]
+    assert camera_checks_kernel(
+        R, t, none_ok, cost, sq.copy(), origin, anterior, rule.cos_max, cap, run_off, True
+    )[0]

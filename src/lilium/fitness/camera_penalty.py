@@ -168,6 +168,20 @@ def _penalty(f, scd_mm, dbeta_deg, ok, focal_lo_hi, scd_lo_hi, tolerance_deg, fo
     return np.where(fail, C_INF, 0.0) + terms
 
 
+def prior_arrays(priors):
+    """:class:`CameraPriors` as the arguments of the compiled camera terms
+    (:func:`lilium.fitness._camera_kernels.camera_terms_kernel`): ``(focal (2,), scd (2,),
+    head (3, 3), tol, cap)``, a prior that is off as NaN."""
+    off = np.full(2, np.nan)
+    focal = off if priors.focal_px is None else np.array(priors.focal_px, float)
+    scd = off if priors.scd_mm is None else np.array(priors.scd_mm, float)
+    head, tol = np.eye(3), np.nan
+    if priors.uses_head:
+        head = np.ascontiguousarray(priors.head_rotation_skull2cam, float)
+        tol = float(priors.head_tolerance_deg)
+    return focal, scd, head, tol, float(focal_cap_px(priors.focal_px))
+
+
 def camera_penalty_from_priors(focal_px, scd_mm, R, success, priors):
     """P_cam of a population given :class:`CameraPriors`.
 

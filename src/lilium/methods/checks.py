@@ -190,28 +190,31 @@ def _facing_cos(directions, R, t):
         return (d @ directions.anterior) / np.sqrt(np.einsum("si,si->s", d, d))
 
 
-def facing_check(skull):
-    """The skull-faces-camera rule of one skull as a batched predicate, or None.
+@dataclass(frozen=True)
+class FacingRule:
+    """The skull-faces-camera rule of one skull as a batched predicate.
 
-    Returns
-    -------
-    callable or None
-        ``check(R (S, 3, 3), t (S, 3)) -> (S,) bool``, True where the camera sees the front of
-        the skull (a non-finite camera passes: it fails elsewhere); None when the skull has no
-        anterior direction (the rule is then skipped).
+    ``rule(R (S, 3, 3), t (S, 3)) -> (S,) bool``: True where the camera sees the front of the
+    skull (a non-finite camera passes: it fails elsewhere). The angle > :data:`FACING_MAX_DEG`
+    is compared as cosines (``cos_max``; the DE asks every generation): the same rule but for
+    rounding at the boundary itself. The compiled camera checks
+    (:func:`lilium.fitness._camera_kernels.camera_checks_kernel`) read its fields.
     """
+
+    directions: SkullDirections
+    cos_max: float
+
+    def __call__(self, R, t):
+        return ~(_facing_cos(self.directions, R, t) < self.cos_max)
+
+
+def facing_check(skull):
+    """The skull-faces-camera rule of one skull (:class:`FacingRule`), or None when the skull
+    has no anterior direction (the rule is then skipped)."""
     directions = skull_directions(skull.landmarks_mm, skull.vertices_mm)
     if directions is None:
         return None
-
-    # angle > FACING_MAX_DEG compared as cosines (the DE asks every generation): the same
-    # rule but for rounding at the boundary itself.
-    cos_max = np.cos(np.radians(FACING_MAX_DEG))
-
-    def check(R, t):
-        return ~(_facing_cos(directions, R, t) < cos_max)
-
-    return check
+    return FacingRule(directions, float(np.cos(np.radians(FACING_MAX_DEG))))
 
 
 def facing_failure(skull, photo):

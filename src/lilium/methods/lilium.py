@@ -29,8 +29,10 @@ import time
 
 import numpy as np
 
+from .. import jit
 from ..constants import C_INF, FOCAL_MIN_PX, focal_cap_px
-from ..fitness.camera_penalty import camera_penalty_from_priors
+from ..fitness._camera_kernels import camera_checks_kernel, camera_terms_kernel
+from ..fitness.camera_penalty import camera_penalty_from_priors, prior_arrays
 from ..geometry.camera import Cameras, principal_point_of
 from ..inputs import correspondences
 from ..optimisation.de import DifferentialEvolution
@@ -122,6 +124,7 @@ class LiliumProblem:
         self.n_no_camera = 0
         # Lowest MSE (px^2) of a camera refused for the focal cap, and its focal length.
         self.capped_mse, self.capped_focal_px = np.inf, None
+        self.prior_arrays = prior_arrays(photo.priors)
 
     def level_extra(self):
         """The working level of the DE and the result's outside count, for ``SfoResult.extra``:
@@ -197,6 +200,11 @@ class LiliumProblem:
                 R0[~ok], t0[~ok], f0[~ok] = R0[j], t0[j], f0[j]
         ref = refine_batch(self.uv_c, facial_mm, R0, t0, f0, options=self.options.refine)
         R, t, f = ref.R, ref.t, ref.focal_px
+        lender = members is not None and bool(np.any(members["success"]))
+        if jit.compiled():  # the checks below, compiled, unless a camera must be replaced
+            ok = self._checks_compiled(ref, lender)
+            if ok is not None:
+                return R, t, f, ok, ref.sq_err_px2
         # Numerical failure (a point behind the camera): fall back to full POSEST.
         broken = ~np.isfinite(ref.cost) | ~np.all(np.isfinite(ref.sq_err_px2), axis=1)
         self._own_posest(facial_mm, R, t, f, broken, broken)
@@ -208,7 +216,6 @@ class LiliumProblem:
         # mandible seen from the front) and every later warm start would start from a run-off
         # camera and run off again: each member takes its own POSEST, whose inliers fix a
         # finite focal length (docs/method.md, "No camera on a mandible-less frontal photo").
-        lender = members is not None and np.any(members["success"])
         facing = self._facing(R, t)
         ok = self._valid(f, facing)
         if not lender and not ok.any():
@@ -228,6 +235,28 @@ class LiliumProblem:
         self._note_capped(f, facing, sq)
         sq[~ok] = np.inf
         return R, t, f, ok, sq
+
+    def _checks_compiled(self, ref, lender):
+        """:meth:`cameras`' checks of refined cameras by
+        :func:`~lilium.fitness._camera_kernels.camera_checks_kernel`: the validity ``(S,)``
+        (``ref.sq_err_px2`` set to inf where invalid, the best capped fit noted), or None when
+        a camera must be replaced by its own POSEST (the numpy path does that)."""
+        rule = self.facing
+        if rule is None:
+            origin, anterior, cos_max = np.zeros(3), np.zeros(3), np.nan
+        else:
+            origin, anterior = rule.directions.origin_mm, rule.directions.anterior
+            cos_max = rule.cos_max
+        cap = self.focal_cap_px
+        done, ok, k, mse = camera_checks_kernel(
+            ref.R, ref.t, ref.focal_px, ref.cost, ref.sq_err_px2, origin, anterior, cos_max,
+            cap, RUN_OFF_FACTOR * cap, lender,
+        )  # fmt: skip
+        if not done:
+            return None
+        if k >= 0 and mse < self.capped_mse:
+            self.capped_mse, self.capped_focal_px = float(mse), float(ref.focal_px[k])
+        return ok
 
     def _own_posest(self, facial_mm, R, t, f, which, lost):
         """Replace the cameras of members ``which`` by their own POSEST (in place, in member
@@ -308,15 +337,24 @@ class LiliumProblem:
 
     def _terms(self, facial_mm, R, t, f, ok, sq):
         """:meth:`camera_terms` of given cameras (``ok``: valid; ``sq``: squared errors)."""
-        S = len(R)
-        mse = np.where(ok, np.mean(sq, axis=1), C_INF)
-        mse = np.where(np.isfinite(mse), mse, C_INF)
         i = self.scd_index
         centre = facial_mm[:, i[0]] if len(i) == 1 else facial_mm[:, i].mean(axis=1)
+        if jit.compiled():  # the same terms, compiled (fitness/_camera_kernels.py)
+            mse, p_cam = camera_terms_kernel(
+                sq, ok, R, t, f, np.ascontiguousarray(centre), *self.prior_arrays
+            )
+            return self._term_dict(mse, p_cam, R, t, f, ok)
+        mse = np.where(ok, np.mean(sq, axis=1), C_INF)
+        mse = np.where(np.isfinite(mse), mse, C_INF)
         # Cameras that ran off (huge focal and depth) overflow here; P_cam gives them C_INF.
         with np.errstate(over="ignore", invalid="ignore"):
             scd = np.linalg.norm(np.einsum("sij,sj->si", R, centre) + t, axis=1)
             p_cam = camera_penalty_from_priors(f, scd, R, ok, self.photo.priors)
+        return self._term_dict(mse, p_cam, R, t, f, ok)
+
+    @staticmethod
+    def _term_dict(mse, p_cam, R, t, f, ok):
+        S = len(R)
         return {
             "fitness": mse + p_cam,
             "mse_pix": mse,
