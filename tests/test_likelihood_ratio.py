@@ -337,7 +337,7 @@ def test_skull_cohort_reads_a_skull_against_other_faces():
     assert skull_cohort_terms([view], few) == (None, None)
 
 
-def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path):
+def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeypatch):
     """Separate SFOs of one frontal and one lateral photo: the decision's log10 LR is the sum
     of the two photos' own (each from its view's model); other sets use the pair model."""
     from dataclasses import replace
@@ -360,6 +360,24 @@ def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path):
     assert both["calibration"]["model"] == "posest-sfo//frontal + posest-sfo//lateral"
     assert both["log10_lr"] == pytest.approx(one[0]["log10_lr"] + one[1]["log10_lr"])
     assert "single_photo" not in both["caps"]
+    # Each photo's LR comes from its own SFO's soft tissue, not the first photo's.
+    import lilium.casework.identify as identify_module
+
+    own = {k: np.asarray(v, float) for k, v in data["facial_landmarks_3d"].items()}
+    moved = {k: v + np.array([4.0, -3.0, 8.0]) for k, v in own.items()}
+    first = SimpleNamespace(**{**vars(result), "facial_landmarks_mm": own})
+    second = SimpleNamespace(**{**vars(result), "facial_landmarks_mm": moved})
+    seen = []
+
+    def recording(skull, photos, cameras, facial, **kwargs):
+        seen.append(([p.view for p in photos], facial))
+        return terms_of(skull, photos, cameras, facial, **kwargs)
+
+    terms_of = identify_module.identification_terms
+    monkeypatch.setattr(identify_module, "identification_terms", recording)
+    identify(skull, [frontal, lateral], [first, second], calibrations)
+    singles = {tuple(views): facial for views, facial in seen if len(views) == 1}
+    assert singles[("frontal",)] is own and singles[("lateral_left",)] is moved
     two_frontal = identify(skull, [frontal, frontal], [result, result], calibrations)
     assert two_frontal["calibration"]["model"] == "posest-sfo//pair"
     assert "these photos differ" in two_frontal["note"]

@@ -81,7 +81,8 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
         One per photo (a joint SFO's per-photo results, or separate SFOs).
     calibrations : Calibrations
     facial_landmarks_mm : dict, optional
-        The soft tissue (default: the first result's).
+        The soft tissue of the decision's terms (default: the first result's). A frontal and a
+        lateral photo's separate SFOs each give their LR from their own result's soft tissue.
     joint : bool
         The results are one joint SFO's.
 
@@ -131,9 +132,9 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
     model = calibrations.get(key)
     note = ""
     if adds_views(photos, joint):
+        # Each photo's LR from its own SFO's soft tissue, as the views' models were fitted.
         parts = [
-            identify(skull, [p], [r], calibrations, facial) for p, r in zip(photos, results,
-                                                                            strict=True)
+            identify(skull, [p], [r], calibrations) for p, r in zip(photos, results, strict=True)
         ]
         lrs = [part["log10_lr"] for part in parts]
         lr = None if None in lrs else float(sum(lrs))
