@@ -512,6 +512,16 @@ def test_camera_checks_kernel_matches_the_numpy_rules():
         R, t, f, cost, sq.copy(), origin, anterior, np.nan, cap, run_off, True
     )
     assert done and np.array_equal(got_ok, (f >= 1.0) & (f <= cap))
+    # A camera centred on the origin (no direction): it passes, as on the numpy path.
+    eye, centred = np.eye(3)[None], -directions.origin_mm[None]
+    with np.errstate(invalid="ignore"):
+        assert rule(eye, centred)[0]
+    one = sq[:1].copy()
+    done, got_ok, _, _ = camera_checks_kernel(
+        eye, centred, np.array([1000.0]), cost[:1], one, origin, anterior, rule.cos_max, cap,
+        run_off, True,
+    )  # fmt: skip
+    assert done and got_ok[0]
     # Hand-backs: nothing is changed.
     broken = sq.copy()
     broken[7, 3] = np.inf

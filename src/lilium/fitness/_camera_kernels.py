@@ -155,11 +155,12 @@ def camera_checks_kernel(R, t, f, cost, sq, origin, anterior, cos_max, cap, run_
             d1 = -(R[s, 0, 1] * t[s, 0] + R[s, 1, 1] * t[s, 1] + R[s, 2, 1] * t[s, 2]) - origin[1]
             d2 = -(R[s, 0, 2] * t[s, 0] + R[s, 1, 2] * t[s, 1] + R[s, 2, 2] * t[s, 2]) - origin[2]
             big = max(abs(d0), abs(d1), abs(d2))
-            d0, d1, d2 = d0 / big, d1 / big, d2 / big
-            cos = (d0 * anterior[0] + d1 * anterior[1] + d2 * anterior[2]) / np.sqrt(
-                d0 * d0 + d1 * d1 + d2 * d2
-            )
-            facing = not (cos < cos_max)
+            if big > 0.0:  # a camera at the origin itself: NaN on the numpy path, so it passes
+                d0, d1, d2 = d0 / big, d1 / big, d2 / big
+                cos = (d0 * anterior[0] + d1 * anterior[1] + d2 * anterior[2]) / np.sqrt(
+                    d0 * d0 + d1 * d1 + d2 * d2
+                )
+                facing = not (cos < cos_max)
         fs = f[s]
         ok[s] = fs >= FOCAL_MIN_PX and fs <= cap and facing
         any_ok = any_ok or ok[s]
