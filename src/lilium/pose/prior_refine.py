@@ -14,8 +14,9 @@ cannot bend itself to bring every photo's least-squares camera inside that photo
 
 Unknowns as in :mod:`lilium.pose.refine` (a left rotation increment; the image position, log
 scale and log depth of the centroid of the points); the reprojection Jacobian is that module's,
-the five prior residuals are differentiated analytically (focal length, distance) or
-numerically over the rotation (head angle); their kinks are where they switch on.
+the five prior residuals are differentiated analytically (focal length, distance; the head
+angle's derivative over the rotation increment is the unit axis of the rotation from the prior);
+their kinks are where they switch on.
 """
 
 import numpy as np
@@ -24,9 +25,6 @@ from ..constants import MIN_DEPTH_MM
 from ..geometry.rotations import geodesic_angle_deg, rotvec_to_matrix
 from .refine import BatchRefineResult, _residuals_and_jacobian, _step_image_unknowns
 from .residuals import reprojection_sq_errors
-
-#: Forward-difference step (rad) of the head-orientation residual.
-_ROTATION_STEP = 1e-6
 
 
 def _prior_residuals(R, c, log_f, scd_rel, focal_interval, scd_interval, head_rotation, tol):
@@ -68,11 +66,16 @@ def _prior_residuals(R, c, log_f, scd_rel, focal_interval, scd_interval, head_ro
         on = dbeta - tol > 0.0
         h[:, 4] = np.where(on, dbeta - tol, 0.0)
         if on.any():
-            for k in range(3):  # numerically, over the rotation increment only
-                w = np.zeros((S, 3))
-                w[:, k] = _ROTATION_STEP
-                moved = geodesic_angle_deg(rotvec_to_matrix(w) @ R, head_rotation)
-                J[:, 4, k] = np.where(on, (moved - dbeta) / _ROTATION_STEP, 0.0)
+            # d angle / d w of a left increment exp([w]x) R is the unit axis of R P^T (the
+            # rotation from the prior): turning about that axis changes the angle one for one,
+            # about a perpendicular axis only at second order. In degrees.
+            Q = R @ np.asarray(head_rotation, float).T
+            axis = np.stack([Q[:, 2, 1] - Q[:, 1, 2], Q[:, 0, 2] - Q[:, 2, 0],
+                             Q[:, 1, 0] - Q[:, 0, 1]], axis=1)  # fmt: skip
+            norm = np.linalg.norm(axis, axis=1, keepdims=True)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                unit = np.where(norm > 0.0, axis / norm, 0.0)
+            J[:, 4, :3] = np.where(on[:, None], np.degrees(unit), 0.0)
     return h, J
 
 
