@@ -66,6 +66,9 @@ DEFAULT_CAMERA = "least_squares"
 #: generated Exp. C frontal + lateral pairs, DE 30 x 750, skof+pll; docs/method.md): mean BPE
 #: against the independent SFOs x0.917 with ``sum``, x0.867 with ``scale``, x0.857 with
 #: ``scale`` and 1.25 x the generations (time x0.70, x0.82, x1.11 of the two SFOs together).
+#: Since then the independent SFOs have improved more than the joint one: on 8 generated
+#: subjects of the current code the joint SFO is x1.04 (complete) and x1.14-1.19 (no
+#: mandible) of them (docs/method.md, "On generated subjects the joint SFO no longer wins").
 DEFAULT_WEIGHTING = "scale"
 DEFAULT_GENERATIONS_FACTOR = 1.0
 
