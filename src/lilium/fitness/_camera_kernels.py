@@ -23,6 +23,15 @@ def _excess2(x, lo, hi):
 
 
 @njit
+def _row_mean(sq, s):
+    """Mean of row ``s`` of ``sq``, summed in order."""
+    total = 0.0
+    for n in range(sq.shape[1]):
+        total += sq[s, n]
+    return total / sq.shape[1]
+
+
+@njit
 def _head_deviation_deg(R, P):
     """Geodesic angle (degrees) of ``R @ P.T``
     (:func:`lilium.geometry.rotations.geodesic_angle_deg`)."""
@@ -64,26 +73,18 @@ def camera_terms_kernel(sq, ok, R, t, f, centre, focal, scd, head, tol, cap):
     -------
     mse_pix, p_cam : ndarray of shape (S,)
     """
-    S, N = sq.shape
+    S = sq.shape[0]
     mse = np.empty(S)
     p_cam = np.empty(S)
     focal_on, scd_on, head_on = not np.isnan(focal[0]), not np.isnan(scd[0]), not np.isnan(tol)
     for s in range(S):
-        m = C_INF
-        if ok[s]:
-            total = 0.0
-            for n in range(N):
-                total += sq[s, n]
-            m = total / N
-            if not np.isfinite(m):
-                m = C_INF
-        mse[s] = m
+        m = _row_mean(sq, s) if ok[s] else C_INF
+        mse[s] = m if np.isfinite(m) else C_INF
         fs = f[s]
         fail = (not ok[s]) or (not np.isfinite(fs)) or fs < FOCAL_MIN_PX or fs > cap
         terms = 0.0
         if focal_on:
-            value = _excess2(fs, focal[0], focal[1])
-            fail = fail or not np.isfinite(fs)
+            value = _excess2(fs, focal[0], focal[1])  # a non-finite fs already fails
             terms += value if np.isfinite(value) else 0.0
         if scd_on:
             c = centre[s]
@@ -165,10 +166,7 @@ def camera_checks_kernel(R, t, f, cost, sq, origin, anterior, cos_max, cap, run_
         ok[s] = fs >= FOCAL_MIN_PX and fs <= cap and facing
         any_ok = any_ok or ok[s]
         if fs > cap and fs <= run_off_cap and facing:
-            total = 0.0
-            for n in range(N):
-                total += sq[s, n]
-            mse = total / N
+            mse = _row_mean(sq, s)
             if capped < 0 or mse < capped_mse:
                 capped, capped_mse = s, mse
     if not lender and not any_ok:
