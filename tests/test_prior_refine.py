@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from lilium import jit
 from lilium.geometry import Camera
 from lilium.geometry.rotations import geodesic_angle_deg, rotvec_to_matrix
 from lilium.pose import refine_batch
@@ -81,3 +82,37 @@ def test_camera_is_pulled_into_the_priors(seed):
     mse = np.mean(out.sq_err_px2[0])
     assert out.cost[0] == pytest.approx(mse + excess**2 + head**2)
     assert out.cost[0] < np.mean(ls.sq_err_px2[0]) + start_excess**2 + start_head**2
+
+
+@pytest.mark.skipif(not jit.NUMBA_AVAILABLE, reason="numba not installed")
+@pytest.mark.parametrize("head", [True, False])
+def test_compiled_path_takes_the_numpy_steps(head):
+    """The compiled kernel against the numpy reference: a batch of cameras started off their
+    priors (focal, distance, head), every prior on, or the head's off."""
+    rng = np.random.default_rng(11)
+    S = 12
+    X, uv, truth = scene(4, noise_px=5.0)
+    P = X[None] + rng.normal(scale=2.0, size=(S,) + X.shape)  # members' soft tissue
+    R0 = rotvec_to_matrix(rng.normal(scale=0.05, size=(S, 3))) @ truth.R
+    t0 = truth.t + rng.normal(scale=(5.0, 5.0, 80.0), size=(S, 3))
+    f0 = truth.focal_px * rng.uniform(0.6, 1.5, S)
+    kwargs = dict(
+        focal_interval_px=(0.95 * truth.focal_px, 1.05 * truth.focal_px),
+        scd_interval_mm=(880.0, 920.0),
+        head_rotation=truth.R if head else None,
+        head_tolerance_deg=1.0 if head else None,
+        max_iterations=8,
+    )
+    args = (uv - CENTRE, P, R0, t0, f0, P[:, 0])
+    start = R0.copy()
+    with jit.kernels("numpy"):
+        ref = refine_with_priors(*args, **kwargs)
+    with jit.kernels("numba"):
+        out = refine_with_priors(*args, **kwargs)
+    assert np.all(np.isfinite(ref.cost)) and ref.n_iterations >= 4  # real work, not one step
+    np.testing.assert_allclose(out.cost, ref.cost, rtol=1e-9)
+    np.testing.assert_allclose(out.focal_px, ref.focal_px, rtol=1e-9)
+    np.testing.assert_allclose(out.R, ref.R, atol=1e-9)
+    np.testing.assert_allclose(out.t, ref.t, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(out.sq_err_px2, ref.sq_err_px2, rtol=1e-9, atol=1e-9)
+    np.testing.assert_array_equal(R0, start)  # the caller's start is not refined in place

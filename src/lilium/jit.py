@@ -1,8 +1,8 @@
 """Compiled kernels: numba when it is there, the numpy reference path otherwise.
 
 The hot loops of an SFO (the skull raster and P_skof's outside-pixel count, the curve detection
-and pairing of P_pll, the batched Levenberg-Marquardt of the population and its reprojection
-errors, the cameras' checks and terms (MSE_pix, P_cam), the decoding of the genes, the DE's
+and pairing of P_pll, the batched Levenberg-Marquardt of the population (plain, and on the
+camera priors for the joint SFO) and its reprojection errors, the cameras' checks and terms (MSE_pix, P_cam), the decoding of the genes, the DE's
 trials, the pinhole projection) have two implementations that give the same numbers: a compiled
 kernel (``_*_kernels.py`` modules, numba, ``cache=True``, so only the first run on a machine
 pays the compile time) and the plain numpy code they replaced, kept as the reference the tests

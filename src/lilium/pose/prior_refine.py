@@ -16,13 +16,17 @@ Unknowns as in :mod:`lilium.pose.refine` (a left rotation increment; the image p
 scale and log depth of the centroid of the points); the reprojection Jacobian is that module's,
 the five prior residuals are differentiated analytically (focal length, distance; the head
 angle's derivative over the rotation increment is the unit axis of the rotation from the prior);
-their kinks are where they switch on.
+their kinks are where they switch on. Compiled by
+:func:`~lilium.pose._prior_refine_kernels.prior_refine_kernel` (the same steps; this numpy code
+is its reference).
 """
 
 import numpy as np
 
+from .. import jit
 from ..constants import MIN_DEPTH_MM
 from ..geometry.rotations import geodesic_angle_deg, rotvec_to_matrix
+from ._prior_refine_kernels import prior_refine_kernel
 from .refine import BatchRefineResult, _residuals_and_jacobian, _step_image_unknowns
 from .residuals import reprojection_sq_errors
 
@@ -130,6 +134,17 @@ def refine_with_priors(
     P = np.broadcast_to(np.asarray(points_mm, dtype=float), (S,) + np.shape(points_mm)[-2:])
     N = P.shape[1]
     uv_c = np.broadcast_to(np.asarray(uv_centred_px, dtype=float), (S, N, 2))
+    if jit.compiled():
+        return _refine_compiled(
+            uv_c,
+            P,
+            R,
+            t,
+            focal_px,
+            scd_points_mm,
+            (focal_interval_px, scd_interval_mm, head_rotation, head_tolerance_deg),
+            max_iterations,
+        )
     w_sqrt = np.full((S, N), 1.0 / np.sqrt(N))
     log_f = np.log(np.asarray(focal_px, dtype=float)).copy()
     m = P.mean(axis=1)
@@ -182,3 +197,32 @@ def refine_with_priors(
     f_out = np.exp(log_f)
     sq = reprojection_sq_errors(uv_c, P, R, t_out, f_out)
     return BatchRefineResult(R, t_out, f_out, sq, cost, iteration)
+
+
+def _refine_compiled(uv_c, P, R, t, focal_px, scd_points_mm, priors, max_iterations):
+    """:func:`refine_with_priors` by the compiled kernel (``R`` is the caller's copy)."""
+    focal_interval, scd_interval, head_rotation, tol = priors
+    nan2 = (np.nan, np.nan)
+    focal_lo, focal_hi = nan2 if focal_interval is None else map(float, focal_interval)
+    scd_lo, scd_hi = nan2 if scd_interval is None else map(float, scd_interval)
+    head_on = head_rotation is not None and tol is not None
+    S = len(R)
+    t = np.array(np.broadcast_to(np.asarray(t, dtype=float), (S, 3)))
+    f = np.array(np.broadcast_to(np.asarray(focal_px, dtype=float), (S,)))
+    cost, iterations, sq = prior_refine_kernel(
+        np.require(uv_c, float, ["C", "W"]),
+        np.require(P, float, ["C", "W"]),
+        R,
+        t,
+        f,
+        np.require(np.broadcast_to(np.asarray(scd_points_mm, float), (S, 3)), float, ["C", "W"]),
+        focal_lo,
+        focal_hi,
+        scd_lo,
+        scd_hi,
+        np.require(head_rotation if head_on else np.eye(3), float, ["C", "W"]),
+        float(tol) if head_on else np.nan,
+        int(max_iterations),
+    )
+    n_iterations = int(iterations.max()) if len(iterations) else 0
+    return BatchRefineResult(R, t, f, sq, cost, n_iterations)
