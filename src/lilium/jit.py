@@ -2,8 +2,8 @@
 
 The hot loops of an SFO (the skull raster and P_skof's outside-pixel count, the curve detection
 and pairing of P_pll, the batched Levenberg-Marquardt of the population (plain, and on the
-camera priors for the joint SFO) and its reprojection errors, the cameras' checks and terms (MSE_pix, P_cam), the decoding of the genes, the DE's
-trials, the pinhole projection) have two implementations that give the same numbers: a compiled
+camera priors for the joint SFO) and its reprojection errors, the cameras' checks and terms
+(MSE_pix, P_cam), the decoding of the genes, the DE's trials, the pinhole projection) have two implementations that give the same numbers: a compiled
 kernel (``_*_kernels.py`` modules, numba, ``cache=True``, so only the first run on a machine
 pays the compile time) and the plain numpy code they replaced, kept as the reference the tests
 compare the kernels against and as the fallback. On the same inputs integers agree exactly,
