@@ -2,6 +2,7 @@
 
 import json
 import sqlite3
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -141,9 +142,11 @@ def test_joint_result_is_the_member_de_ranked_and_reproducible(pair):
     a = joint_lilium_sfo(skull, photos, options, seed=4)
     b = joint_lilium_sfo(skull, photos, options, seed=4)
     assert a.fitness == b.fitness and a.extra["genes"] == b.extra["genes"]
-    assert a.fitness == a.extra["history"][-1] and a.extra["weighting"] == "scale"
+    assert a.extra["weighting"] == "scale" and a.extra["camera_fit"] == "priors"
     weighted = sum(w * r.fitness for w, r in zip(a.weights, a.photos, strict=True))
     assert a.fitness == pytest.approx(weighted, rel=1e-12)
+    full = joint_lilium_sfo(skull, photos, replace(options, working_face_px=None), seed=4)
+    assert full.fitness == full.extra["history"][-1]  # at full level, the DE's own fitness
     assert a.weights[0] != a.weights[1]  # the toy photos differ in scale
     for r in a.photos:
         assert r.fitness == pytest.approx(sum(v for v in r.terms.values() if v is not None))
@@ -206,7 +209,11 @@ def test_sfo_cli_writes_the_joint_contract(pair, tmp_path, capsys):
     assert data["fitness"] == pytest.approx(sum(p["fitness"] for p in data["photos"]))
     weighted = sum(p["weight"] * p["fitness_unweighted"] for p in data["photos"])
     assert data["fitness"] == pytest.approx(weighted) and data["weighting"] == "scale"
-    assert data["fitness"] == data["history"][-1]
+    # Each photo's terms at full level, as a single SFO's (the DE's history is at the working
+    # level): their sum is the photo's fitness.
+    for p in data["photos"]:
+        own = sum(v for v in p["terms"].values() if v is not None)
+        assert p["fitness_unweighted"] == pytest.approx(own, rel=1e-12)
     assert not (out / "overlay.png").exists()
     printed = capsys.readouterr().out
     assert "joint (2 photos)" in printed and photo_dirs[1].name in printed

@@ -1,15 +1,15 @@
 """Compiled kernels: numba when it is there, the numpy reference path otherwise.
 
-The hot loops of an SFO (the skull raster and P_skof's outside-pixel count, the curve detection
-and pairing of P_pll, the batched Levenberg-Marquardt of the population (plain, and on the
-camera priors for the joint SFO) and its reprojection errors, the cameras' checks and terms
-(MSE_pix, P_cam), the decoding of the genes, the DE's trials, the pinhole projection) have two implementations that give the same numbers: a compiled
-kernel (``_*_kernels.py`` modules, numba, ``cache=True``, so only the first run on a machine
-pays the compile time) and the plain numpy code they replaced, kept as the reference the tests
-compare the kernels against and as the fallback. On the same inputs integers agree exactly,
-floats to 1e-9 (most of them bit for bit); since the projection itself is compiled, a pixel that
-rounds at exactly half a pixel may round the other way on the two paths (a rare one-pixel
-difference in a curve or a count).
+The hot loops of an SFO (the skull raster and P_skof's outside-pixel count, the curve detection and
+pairing of P_pll, the batched Levenberg-Marquardt of the population (plain, and on the camera
+priors for the joint SFO) and its reprojection errors, the cameras' checks and terms (MSE_pix,
+P_cam), the decoding of the genes, the DE's trials, the pinhole projection) have two
+implementations that give the same numbers: a compiled kernel (``_*_kernels.py`` modules, numba,
+``cache=True``, so only the first run on a machine pays the compile time) and the plain numpy code
+they replaced, kept as the reference the tests compare the kernels against and as the fallback. On
+the same inputs integers agree exactly, floats to 1e-9 (most of them bit for bit); since the
+projection itself is compiled, a pixel that rounds at exactly half a pixel may round the other way
+on the two paths (a rare one-pixel difference in a curve or a count).
 
 numba is a pinned dependency (``pyproject.toml``); should it fail to import (a platform without
 its wheels), Lilium still runs, on the numpy path, only slower. ``LILIUM_KERNELS=numpy`` in the

@@ -24,19 +24,24 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   times as much. Equal-scale photos get ``w_p = 1``, the plain sum; ``weighting="sum"`` is
   the plain sum always. ``result.json`` gives each photo's own (unweighted) fitness and its
   ``weight``; the total is the weighted sum DE ranked.
-- **Camera fit.** ``camera="least_squares"`` (the default, :data:`DEFAULT_CAMERA`): each
-  photo's camera is fitted to the landmarks alone, as in a single SFO; P_cam judges it. A
-  single SFO lets its soft tissue bend until that camera lands inside the priors; one shared
-  soft tissue cannot do that for every photo at once, which is why the joint SFO loses to the
-  independent ones on the mandible-less headsq head (docs/method.md, "Real anatomy").
-  ``camera="priors"`` refines each least-squares camera further on that photo's MSE_pix + P_cam
-  (:func:`camera_on_priors`): better at 150 generations, worse than least squares at the full
-  budget on generated and complete headsq subjects, and 3-6 x slower, so not the default.
+- **Camera fit.** ``camera="priors"`` (the default, :data:`DEFAULT_CAMERA`): each photo's
+  camera is fitted to the landmarks (as in a single SFO), then, where it lies outside the
+  photo's priors, refined further on that photo's MSE_pix + P_cam (:func:`camera_on_priors`).
+  A single SFO lets its soft tissue bend until its least-squares camera lands inside the
+  priors; one shared soft tissue cannot do that for every photo at once, and with least-squares
+  cameras even the *true* soft tissue scores P_cam in the millions (the focal length of a
+  least-squares camera is 0.2-6 x the truth under Exp. C's landmark noise), so the joint DE
+  bent the soft tissue away from the face. ``camera="least_squares"`` is the design before
+  (docs/method.md, "The joint SFO's cameras on the priors").
 - **Early exit.** A trial's image penalties of photo ``p`` are skipped when the partial sum
   over all photos already exceeds its threshold (the other photos' partial sums are the
   offset): the run is the same, with fewer P_skof/P_pll evaluations.
-- **Budget.** ``generations_factor`` scales the DE generations (default 1: one generation of
-  the joint costs about the sum of the photos' single generations). The wall-clock limit
+- **Budget.** ``generations_factor`` scales the DE generations (default
+  :data:`DEFAULT_GENERATIONS_FACTOR`, 0.5: with the cameras on the priors half the generations
+  gave the same BPE as all of them on 8 generated subjects x 3 seeds, complete and
+  mandible-less, and on headsq, at about half the time; one joint generation costs more than
+  the photos' single generations together, the lower-bound pruning skipping fewer image
+  terms once P_cam no longer rules trials out). The wall-clock limit
   (``options.de.max_seconds``) bounds the joint run as a whole.
 """
 
@@ -60,17 +65,16 @@ WEIGHTINGS = ("sum", "scale")
 
 #: How each photo's camera is fitted to a member's soft tissue (see the module notes).
 CAMERAS = ("priors", "least_squares")
-DEFAULT_CAMERA = "least_squares"
 
-#: The default weighting and DE budget factor, chosen by ``benchmarks/bench_joint.py`` (8
-#: generated Exp. C frontal + lateral pairs, DE 30 x 750, skof+pll; docs/method.md): mean BPE
-#: against the independent SFOs x0.917 with ``sum``, x0.867 with ``scale``, x0.857 with
-#: ``scale`` and 1.25 x the generations (time x0.70, x0.82, x1.11 of the two SFOs together).
-#: Since then the independent SFOs have improved more than the joint one: on 8 generated
-#: subjects of the current code the joint SFO is x1.04 (complete) and x1.14-1.19 (no
-#: mandible) of them (docs/method.md, "On generated subjects the joint SFO no longer wins").
+#: The defaults, chosen by ``benchmarks/bench_joint.py`` (full budget, seeds 1-3, scale
+#: weighting; mean BPE of both photos against the independent SFOs of the same photos,
+#: docs/method.md): least-squares cameras x1.044 / x1.177 on 8 generated subjects complete /
+#: without mandible and x1.223 / x1.440 on headsq ``hq`` / ``hq_nm``; cameras on the priors at
+#: half the generations x0.898 / x1.022 / x1.101 / x1.058 (all the generations: x0.894 /
+#: x0.995 / x1.141 / x1.015). The plain sum (``weighting="sum"``) was worse with either camera.
+DEFAULT_CAMERA = "priors"
 DEFAULT_WEIGHTING = "scale"
-DEFAULT_GENERATIONS_FACTOR = 1.0
+DEFAULT_GENERATIONS_FACTOR = 0.5
 
 #: Per-photo arrays of the DE payload, shape ``(S, P, ...)``.
 PHOTO_KEYS = ("fitness", "mse_pix", "p_cam", "p_skof", "p_pll", "R", "t", "focal_px", "success")
@@ -323,7 +327,9 @@ class JointSfoResult:
         SFO: ``joint_photos`` (the ids), ``joint_fitness``, and the joint ``history``,
         ``generations``, ``evaluations``, ``stop``.
     fitness : float
-        The joint fitness DE ranked (``sum_p w_p fitness_p``; equals ``history[-1]``).
+        The joint fitness ``sum_p w_p fitness_p`` of the photos' fitnesses (each at full level,
+        as a single SFO's); it equals the DE's ``history[-1]`` when every photo ran at full
+        level (:mod:`~lilium.methods.working_level`).
     facial_landmarks_mm : dict of str -> ndarray of shape (3,)
         The shared soft tissue's facial landmarks (the union of the photos'), skull frame.
     seconds : float
@@ -454,6 +460,11 @@ def joint_lilium_sfo(
     for p, single in enumerate(problem.problems):
         mine = {k: np.asarray(best[k])[p] for k in PHOTO_KEYS if k != "fitness"}
         camera, terms, error, warnings = photo_outcome(single, mine, seed)
+        fitness = float(np.asarray(best["photo_fitness"])[p])
+        if camera is not None and not single.level.is_full:
+            # As a single SFO: the DE's fitness was at the working level, the result's is the
+            # sum of the terms at full level.
+            fitness = sum(v for v in terms.values() if v is not None)
         rows = problem.rows[p]
         results.append(
             SfoResult(
@@ -463,7 +474,7 @@ def joint_lilium_sfo(
                 skull_id=skull.id,
                 photo_id=single.photo.id,
                 camera=camera,
-                fitness=float(np.asarray(best["photo_fitness"])[p]),
+                fitness=fitness,
                 terms=terms,
                 facial_landmarks_mm=dict(zip(single.corr.facial_names, shared[rows], strict=True)),
                 seconds=0.0,  # the joint run's, below
@@ -472,6 +483,11 @@ def joint_lilium_sfo(
                 terms_off=dict(single.terms_off),
             )
         )
+    total = de.fun
+    if any(r.camera is not None for r in results) and not all(
+        pr.level.is_full for pr in problem.problems
+    ):
+        total = float(sum(w * r.fitness for w, r in zip(problem.weights, results, strict=True)))
     seconds = time.perf_counter() - start
     ids = [r.photo_id for r in results]
     shared_extra = {
@@ -489,7 +505,7 @@ def joint_lilium_sfo(
         seed=seed,
         skull_id=skull.id,
         photos=tuple(results),
-        fitness=de.fun,
+        fitness=total,
         facial_landmarks_mm=dict(zip(problem.facial_names, shared, strict=True)),
         seconds=seconds,
         weights=tuple(float(w) for w in problem.weights),
