@@ -14,6 +14,7 @@ A prior that is off is passed as NaN (both ends of an interval, the head toleran
 import numpy as np
 
 from ..constants import C_INF, FOCAL_MIN_PX
+from ..geometry._rotation_kernels import relative_angle_axis
 from ..jit import njit
 
 
@@ -29,20 +30,6 @@ def _row_mean(sq, s):
     for n in range(sq.shape[1]):
         total += sq[s, n]
     return total / sq.shape[1]
-
-
-@njit
-def _head_deviation_deg(R, P):
-    """Geodesic angle (degrees) of ``R @ P.T``
-    (:func:`lilium.geometry.rotations.geodesic_angle_deg`)."""
-    Q = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            Q[i, j] = R[i, 0] * P[j, 0] + R[i, 1] * P[j, 1] + R[i, 2] * P[j, 2]
-    cos = (Q[0, 0] + Q[1, 1] + Q[2, 2] - 1.0) / 2.0
-    x, y, z = Q[2, 1] - Q[1, 2], Q[0, 2] - Q[2, 0], Q[1, 0] - Q[0, 1]
-    sin = np.sqrt(x * x + y * y + z * z) / 2.0
-    return np.arctan2(sin, cos) * (180.0 / np.pi)
 
 
 @njit
@@ -96,7 +83,7 @@ def camera_terms_kernel(sq, ok, R, t, f, centre, focal, scd, head, tol, cap):
             fail = fail or not np.isfinite(d)
             terms += value if np.isfinite(value) else 0.0
         if head_on:
-            dbeta = _head_deviation_deg(R[s], head)
+            dbeta = relative_angle_axis(R[s], head)[0]
             value = max(0.0, dbeta - tol) ** 2
             fail = fail or not np.isfinite(dbeta)
             terms += value if np.isfinite(value) else 0.0

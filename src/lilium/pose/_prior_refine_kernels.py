@@ -14,8 +14,15 @@ A prior is switched off by NaN bounds (NaN ``tol`` for the head orientation).
 import numpy as np
 
 from ..constants import MIN_DEPTH_MM
+from ..geometry._rotation_kernels import relative_angle_axis
 from ..jit import njit
-from ._refine_kernels import _residuals, _rotvec_to_matrix, _solve7, sq_errors_kernel
+from ._refine_kernels import (
+    _apply_step,
+    _normal_equations,
+    _residuals,
+    _solve7,
+    sq_errors_kernel,
+)
 
 _DEG = 180.0 / np.pi
 
@@ -65,14 +72,7 @@ def _hinges(R, c, log_f, rel, focal_lo, focal_hi, scd_lo, scd_hi, head, tol, r, 
             for j in range(7):
                 J[row + 3, j] = d[j]
     if not np.isnan(tol):
-        Q = np.empty((3, 3))
-        for i in range(3):
-            for j in range(3):
-                Q[i, j] = R[i, 0] * head[j, 0] + R[i, 1] * head[j, 1] + R[i, 2] * head[j, 2]
-        cos = (Q[0, 0] + Q[1, 1] + Q[2, 2] - 1.0) / 2.0
-        x, y, z = Q[2, 1] - Q[1, 2], Q[0, 2] - Q[2, 0], Q[1, 0] - Q[0, 1]
-        norm = np.sqrt(x * x + y * y + z * z)
-        dbeta = np.arctan2(norm / 2.0, cos) * _DEG
+        dbeta, x, y, z, norm = relative_angle_axis(R, head)
         if dbeta - tol > 0.0:
             r[row + 4] = dbeta - tol
             if norm > 0.0:  # the unit axis of R P^T, in degrees (see the numpy code)
@@ -172,17 +172,7 @@ def prior_refine_kernel(
         it = 0
         while active and it < max_iterations:
             it += 1
-            for i in range(7):
-                for j in range(i + 1):
-                    acc = 0.0
-                    for k in range(M):
-                        acc += J[k, i] * J[k, j]
-                    JtJ[i, j] = acc
-                    JtJ[j, i] = acc
-                acc = 0.0
-                for k in range(M):
-                    acc += J[k, i] * r[k]
-                g[i] = acc
+            _normal_equations(J, r, M, JtJ, g)
             for i in range(7):
                 for j in range(7):
                     A[i, j] = JtJ[i, j]
@@ -190,21 +180,7 @@ def prior_refine_kernel(
             if not _solve7(A, g, delta):
                 for i in range(7):
                     delta[i] = np.nan
-            _rotvec_to_matrix(delta[0], delta[1], delta[2], dR)
-            for i in range(3):
-                for j in range(3):
-                    R_new[i, j] = (
-                        dR[i, 0] * R[s, 0, j] + dR[i, 1] * R[s, 1, j] + dR[i, 2] * R[s, 2, j]
-                    )
-            log_cz = np.log(c[2])
-            sigma = log_f - log_cz + delta[5]
-            tau = log_cz + delta[6]
-            scale = np.exp(log_f - log_cz)
-            back = np.exp(-sigma)
-            c_new[0] = (c[0] * scale + delta[3]) * back
-            c_new[1] = (c[1] * scale + delta[4]) * back
-            c_new[2] = np.exp(tau)
-            logf_new = sigma + tau
+            logf_new = _apply_step(R[s], c, log_f, delta, dR, R_new, c_new)
             cost_new = _residuals(uv[s], Pm, ws, R_new, c_new, logf_new, r_new, J_new)
             cost_new += _hinges(
                 R_new,

@@ -137,6 +137,41 @@ def _solve7(A, g, out):
 
 
 @njit
+def _normal_equations(J, r, rows, JtJ, g):
+    """``JtJ = J^T J`` and ``g = J^T r`` over the first ``rows`` rows (fixed summation order)."""
+    for i in range(7):
+        for j in range(i + 1):  # symmetric: J[k, i] J[k, j] == J[k, j] J[k, i] exactly
+            acc = 0.0
+            for k in range(rows):
+                acc += J[k, i] * J[k, j]
+            JtJ[i, j] = acc
+            JtJ[j, i] = acc
+        acc = 0.0
+        for k in range(rows):
+            acc += J[k, i] * r[k]
+        g[i] = acc
+
+
+@njit
+def _apply_step(R, c, log_f, delta, dR, R_new, c_new):
+    """The camera after an increment ``delta`` (7,) of the unknowns (module
+    :mod:`lilium.pose.refine`): ``R_new``, ``c_new`` filled; returns the new log focal length."""
+    _rotvec_to_matrix(delta[0], delta[1], delta[2], dR)
+    for i in range(3):
+        for j in range(3):
+            R_new[i, j] = dR[i, 0] * R[0, j] + dR[i, 1] * R[1, j] + dR[i, 2] * R[2, j]
+    log_cz = np.log(c[2])
+    sigma = log_f - log_cz + delta[5]
+    tau = log_cz + delta[6]
+    scale = np.exp(log_f - log_cz)
+    back = np.exp(-sigma)
+    c_new[0] = (c[0] * scale + delta[3]) * back
+    c_new[1] = (c[1] * scale + delta[4]) * back
+    c_new[2] = np.exp(tau)
+    return sigma + tau
+
+
+@njit
 def lm_kernel(
     uv,
     P,
@@ -195,17 +230,7 @@ def lm_kernel(
         it = 0
         while active and it < max_iterations:
             it += 1
-            for i in range(7):
-                for j in range(i + 1):  # symmetric: J[k, i] J[k, j] == J[k, j] J[k, i] exactly
-                    acc = 0.0
-                    for k in range(2 * N):
-                        acc += J[k, i] * J[k, j]
-                    JtJ[i, j] = acc
-                    JtJ[j, i] = acc
-                acc = 0.0
-                for k in range(2 * N):
-                    acc += J[k, i] * r[k]
-                g[i] = acc
+            _normal_equations(J, r, 2 * N, JtJ, g)
             worst = 0.0
             for i in range(7):
                 worst = max(worst, abs(g[i]) / np.sqrt(max(JtJ[i, i], 1e-300)))
@@ -224,21 +249,7 @@ def lm_kernel(
                 for j in range(7):
                     dJd += delta[i] * JtJ[i, j] * delta[j]
             predicted = -2.0 * gd - dJd
-            _rotvec_to_matrix(delta[0], delta[1], delta[2], dR)
-            for i in range(3):
-                for j in range(3):
-                    R_new[i, j] = (
-                        dR[i, 0] * R[s, 0, j] + dR[i, 1] * R[s, 1, j] + dR[i, 2] * R[s, 2, j]
-                    )
-            log_cz = np.log(c[s, 2])
-            sigma = log_f[s] - log_cz + delta[5]
-            tau = log_cz + delta[6]
-            scale = np.exp(log_f[s] - log_cz)
-            back = np.exp(-sigma)
-            c_new[0] = (c[s, 0] * scale + delta[3]) * back
-            c_new[1] = (c[s, 1] * scale + delta[4]) * back
-            c_new[2] = np.exp(tau)
-            logf_new = sigma + tau
+            logf_new = _apply_step(R[s], c[s], log_f[s], delta, dR, R_new, c_new)
             cost_new = _residuals(uv[s], P[s], ws[s], R_new, c_new, logf_new, r_new, J_new)
             better = cost_new < cost_s
             cost_old = cost_s
