@@ -55,7 +55,7 @@ from ..pose.prior_refine import refine_with_priors
 from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from .lilium import LiliumProblem, build_cones, de_extra
+from .lilium import IMAGE_TERMS, LiliumProblem, build_cones, de_extra
 from .lilium_outcome import photo_outcome
 from .options import SfoOptions
 from .result import SfoResult, finite_or_none
@@ -217,10 +217,13 @@ class JointLiliumProblem:
         # weighted sums may overflow to inf, which ranks them last as it should.
         with np.errstate(over="ignore", invalid="ignore"):
             partial = np.array([w[p] * per[p]["fitness"] for p in range(len(per))])
-            for p, problem in enumerate(self.problems):
-                offset = np.delete(partial, p, axis=0).sum(axis=0)  # the other photos' bounds
-                problem.add_image_terms(per[p], thresholds, offset, w[p])
-                partial[p] = w[p] * per[p]["fitness"]
+            # Each term for every photo before the next: P_skof's pruning (the costly count)
+            # then knows every photo's P_pll.
+            for name in IMAGE_TERMS:
+                for p, problem in enumerate(self.problems):
+                    offset = np.delete(partial, p, axis=0).sum(axis=0)  # the other photos' bounds
+                    problem.add_image_terms(per[p], thresholds, offset, w[p], names=(name,))
+                    partial[p] = w[p] * per[p]["fitness"]
             total = partial.sum(axis=0)
         out = {k: np.stack([t[k] for t in per], axis=1) for k in PHOTO_KEYS}
         out["photo_fitness"] = out.pop("fitness")

@@ -60,6 +60,9 @@ VARIANTS = {
     "skof+pll": (True, True),
 }
 
+#: The image terms :meth:`LiliumProblem.add_image_terms` adds, in its order (P_pll first).
+IMAGE_TERMS = ("p_pll", "p_skof")
+
 
 def build_cones(skull, corr, depth_table=None):
     """Cones of the usable landmarks (``corr``: anything with ``cranial_names`` and ``axes``, a
@@ -401,7 +404,7 @@ class LiliumProblem:
         sq[~ok] = np.inf
         return genes, self.add_image_terms(self._terms(facial, R, t, f, ok, sq))
 
-    def add_image_terms(self, terms, thresholds=None, offset=0.0, weight=1.0):
+    def add_image_terms(self, terms, thresholds=None, offset=0.0, weight=1.0, names=IMAGE_TERMS):
         """Add P_skof and P_pll to :meth:`camera_terms`' dictionary (in place; returned).
 
         P_pll first: a trial that P_pll already puts above its threshold loses whatever P_skof
@@ -422,6 +425,10 @@ class LiliumProblem:
             weighted partial sums); 0 for one photo.
         weight : float
             This photo's weight in the trial's fitness (a joint SFO); 1 for one photo.
+        names : tuple of str
+            The terms to add, of :data:`IMAGE_TERMS` and in its order (a joint SFO adds each
+            term for every photo before the next, so that the pruning of one photo's P_skof
+            knows the other photos' P_pll).
         """
         fitness, ok = terms["fitness"], terms["success"]
         R, t, f = terms["R"], terms["t"], terms["focal_px"]
@@ -429,7 +436,7 @@ class LiliumProblem:
         bound = np.full(S, np.inf) if thresholds is None else np.asarray(thresholds, float)
         for name, term in (("p_pll", self.pll), ("p_skof", self.skof)):
             values = terms[name]
-            if term is None:
+            if term is None or name not in names:
                 continue
             with np.errstate(over="ignore", invalid="ignore"):
                 todo = ok & (offset + weight * fitness <= bound)
