@@ -28,7 +28,7 @@ _DEG = 180.0 / np.pi
 
 
 @njit
-def _hinges(R, c, log_f, rel, focal_lo, focal_hi, scd_lo, scd_hi, head, tol, r, J, row):
+def _hinges(R, c, log_f, rel, focal, scd, head, tol, r, J, row):
     """The five prior hinges into ``r[row:row + 5]`` and ``J[row:row + 5]``; their sum of
     squares (the formulas of :func:`lilium.pose.prior_refine._prior_residuals`)."""
     for k in range(5):
@@ -36,39 +36,39 @@ def _hinges(R, c, log_f, rel, focal_lo, focal_hi, scd_lo, scd_hi, head, tol, r, 
         for j in range(7):
             J[row + k, j] = 0.0
     f = np.exp(log_f)
-    if not np.isnan(focal_lo):
-        if focal_lo - f > 0.0:
-            r[row] = focal_lo - f
+    if not np.isnan(focal[0]):
+        if focal[0] - f > 0.0:
+            r[row] = focal[0] - f
             J[row, 5] = -f
             J[row, 6] = -f
-        if f - focal_hi > 0.0:
-            r[row + 1] = f - focal_hi
+        if f - focal[1] > 0.0:
+            r[row + 1] = f - focal[1]
             J[row + 1, 5] = f
             J[row + 1, 6] = f
-    if not np.isnan(scd_lo):
+    if not np.isnan(scd[0]):
         q0 = R[0, 0] * rel[0] + R[0, 1] * rel[1] + R[0, 2] * rel[2]
         q1 = R[1, 0] * rel[0] + R[1, 1] * rel[1] + R[1, 2] * rel[2]
         q2 = R[2, 0] * rel[0] + R[2, 1] * rel[1] + R[2, 2] * rel[2]
         X0, X1, X2 = q0 + c[0], q1 + c[1], q2 + c[2]
-        scd = np.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
+        dist = np.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
         inv_scale = c[2] / f
         # d scd / d unknown = X . dX / scd (dX of a left rotation increment, the image
         # position, the log scale and the log depth, as in the numpy code).
         d = (
-            (-X1 * q2 + X2 * q1) / scd,
-            (X0 * q2 - X2 * q0) / scd,
-            (-X0 * q1 + X1 * q0) / scd,
-            X0 * inv_scale / scd,
-            X1 * inv_scale / scd,
-            (-X0 * c[0] - X1 * c[1]) / scd,
-            X2 * c[2] / scd,
+            (-X1 * q2 + X2 * q1) / dist,
+            (X0 * q2 - X2 * q0) / dist,
+            (-X0 * q1 + X1 * q0) / dist,
+            X0 * inv_scale / dist,
+            X1 * inv_scale / dist,
+            (-X0 * c[0] - X1 * c[1]) / dist,
+            X2 * c[2] / dist,
         )
-        if scd_lo - scd > 0.0:
-            r[row + 2] = scd_lo - scd
+        if scd[0] - dist > 0.0:
+            r[row + 2] = scd[0] - dist
             for j in range(7):
                 J[row + 2, j] = -d[j]
-        if scd - scd_hi > 0.0:
-            r[row + 3] = scd - scd_hi
+        if dist - scd[1] > 0.0:
+            r[row + 3] = dist - scd[1]
             for j in range(7):
                 J[row + 3, j] = d[j]
     if not np.isnan(tol):
@@ -91,18 +91,16 @@ def prior_refine_kernel(
     P,
     R,
     t,
-    focal,
+    focal_px,
     scd_points,
-    focal_lo,
-    focal_hi,
-    scd_lo,
-    scd_hi,
+    focal,
+    scd,
     head,
     tol,
     max_iterations,
 ):
     """The whole of :func:`~lilium.pose.prior_refine.refine_with_priors`: ``R``, ``t``,
-    ``focal`` in place.
+    ``focal_px`` in place.
 
     Parameters
     ----------
@@ -111,10 +109,11 @@ def prior_refine_kernel(
     P : ndarray of shape (S, N, 3)
     R : ndarray of shape (S, 3, 3)
     t : ndarray of shape (S, 3)
-    focal : ndarray of shape (S,)
+    focal_px : ndarray of shape (S,)
     scd_points : ndarray of shape (S, 3)
-    focal_lo, focal_hi, scd_lo, scd_hi : float
-        Prior intervals; NaN switches a prior off.
+    focal, scd : ndarray of shape (2,)
+        Prior intervals (px, mm); NaN switches a prior off (the layout of
+        :func:`lilium.fitness._camera_kernels.camera_terms_kernel`'s priors).
     head : ndarray of shape (3, 3)
     tol : float
         Head tolerance (degrees); NaN switches the head prior off.
@@ -160,11 +159,9 @@ def prior_refine_kernel(
             rel[j] = scd_points[s, j] - m[s, j]
         for i in range(3):
             c[i] = R[s, i, 0] * m[s, 0] + R[s, i, 1] * m[s, 1] + R[s, i, 2] * m[s, 2] + t[s, i]
-        log_f = np.log(focal[s])
+        log_f = np.log(focal_px[s])
         cost_s = _residuals(uv[s], Pm, ws, R[s], c, log_f, r, J)
-        cost_s += _hinges(
-            R[s], c, log_f, rel, focal_lo, focal_hi, scd_lo, scd_hi, head, tol, r, J, 2 * N
-        )
+        cost_s += _hinges(R[s], c, log_f, rel, focal, scd, head, tol, r, J, 2 * N)
         if not (c[2] > MIN_DEPTH_MM and np.isfinite(cost_s)):
             cost_s = np.inf
         lam = 1e-3
@@ -183,19 +180,7 @@ def prior_refine_kernel(
             logf_new = _apply_step(R[s], c, log_f, delta, dR, R_new, c_new)
             cost_new = _residuals(uv[s], Pm, ws, R_new, c_new, logf_new, r_new, J_new)
             cost_new += _hinges(
-                R_new,
-                c_new,
-                logf_new,
-                rel,
-                focal_lo,
-                focal_hi,
-                scd_lo,
-                scd_hi,
-                head,
-                tol,
-                r_new,
-                J_new,
-                2 * N,
+                R_new, c_new, logf_new, rel, focal, scd, head, tol, r_new, J_new, 2 * N
             )
             if not (c_new[2] > MIN_DEPTH_MM and np.isfinite(cost_new)):
                 cost_new = np.inf
@@ -219,5 +204,5 @@ def prior_refine_kernel(
         iterations[s] = it
         for i in range(3):
             t[s, i] = c[i] - (R[s, i, 0] * m[s, 0] + R[s, i, 1] * m[s, 1] + R[s, i, 2] * m[s, 2])
-        focal[s] = np.exp(log_f)
-    return cost, iterations, sq_errors_kernel(uv, P, R, t, focal)
+        focal_px[s] = np.exp(log_f)
+    return cost, iterations, sq_errors_kernel(uv, P, R, t, focal_px)

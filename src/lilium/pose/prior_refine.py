@@ -200,11 +200,12 @@ def refine_with_priors(
 
 
 def _refine_compiled(uv_c, P, R, t, focal_px, scd_points_mm, priors, max_iterations):
-    """:func:`refine_with_priors` by the compiled kernel (``R`` is the caller's copy)."""
+    """:func:`refine_with_priors` by the compiled kernel (``R`` is the caller's copy); the
+    priors as the compiled camera terms take them (intervals of 2, a prior that is off NaN)."""
     focal_interval, scd_interval, head_rotation, tol = priors
-    nan2 = (np.nan, np.nan)
-    focal_lo, focal_hi = nan2 if focal_interval is None else map(float, focal_interval)
-    scd_lo, scd_hi = nan2 if scd_interval is None else map(float, scd_interval)
+    off = np.full(2, np.nan)
+    focal = off if focal_interval is None else np.array(focal_interval, float)
+    scd = off if scd_interval is None else np.array(scd_interval, float)
     head_on = head_rotation is not None and tol is not None
     S = len(R)
     t = np.array(np.broadcast_to(np.asarray(t, dtype=float), (S, 3)))
@@ -216,10 +217,8 @@ def _refine_compiled(uv_c, P, R, t, focal_px, scd_points_mm, priors, max_iterati
         t,
         f,
         np.require(np.broadcast_to(np.asarray(scd_points_mm, float), (S, 3)), float, ["C", "W"]),
-        focal_lo,
-        focal_hi,
-        scd_lo,
-        scd_hi,
+        focal,
+        scd,
         np.require(head_rotation if head_on else np.eye(3), float, ["C", "W"]),
         float(tol) if head_on else np.nan,
         int(max_iterations),
