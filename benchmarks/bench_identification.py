@@ -227,13 +227,16 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
           "misleading same | misleading different |", file=file)
     print("|---|---|---|---|---|---|---|---|", file=file)
     for (method, variant, decision), v in sorted(validated.items()):
-        p = v["performance"]
-        print(
-            f"| {decision} | {method_label(method, variant)} | {p['n_same']} / {p['n_diff']} | "
-            f"{p['failed']} | {p['cllr']:.3f} | {p['cllr_min']:.3f} | "
-            f"{100 * p['misleading_same']:.1f} % | {100 * p['misleading_diff']:.1f} % |",
-            file=file,
-        )
+        rows = [(decision, v["performance"])]
+        if "performance_added" in v:  # the plain sum beside the calibrated one
+            rows.append((f"{decision}, plain sum", v["performance_added"]))
+        for label, p in rows:
+            print(
+                f"| {label} | {method_label(method, variant)} | {p['n_same']} / {p['n_diff']} "
+                f"| {p['failed']} | {p['cllr']:.3f} | {p['cllr_min']:.3f} | "
+                f"{100 * p['misleading_same']:.1f} % | {100 * p['misleading_diff']:.1f} % |",
+                file=file,
+            )
     print(file=file)
     print("| ranked by identification log10 LR | view | mean rank | rank-1 | AUC | photos |",
           file=file)

@@ -131,6 +131,39 @@ def test_cross_validation_and_performance():
     assert cllr(pav_log10_lr(noise, same), same) > 0.7
 
 
+def test_two_views_that_repeat_each_other_are_not_counted_twice():
+    """A frontal and a lateral photo carrying the same evidence (identical terms): added, their
+    LRs count it twice; the calibrated sum (``pair_sum``) learns a slope of about one half and
+    costs less, cross-validated; its model is the one ``lilium calibrate`` writes."""
+    from lilium.experiments.calibrate import fit_models, validate
+    from lilium.identification.calibration import VIEWS_LOG10_LR, VIEWS_TERMS
+
+    rng = np.random.default_rng(5)
+    pairs = _synthetic_pairs(rng, n_subjects=20, shift=1.0)
+    decision_pairs = {}
+    for view in ("frontal", "lateral"):
+        decision_pairs[("m", "", view)] = [
+            p | {"photo": f"{p['person']}_{view}", "run": ("r",)} for p in pairs
+        ]
+    decision_pairs[("m", "", "pair_sum")] = [
+        {k: p[k] for k in ("same", "person", "skull")} | {"photo": f"{p['person']}_frontal",
+                                                           "run": ("r",)}
+        for p in pairs
+    ]
+    validated = validate(decision_pairs, folds=4)
+    single = validated[("m", "", "frontal")]["log10_lr"]
+    both = validated[("m", "", "pair_sum")]
+    np.testing.assert_allclose(both["added"], 2 * single)
+    assert both["performance"]["cllr"] < both["performance_added"]["cllr"] - 0.02
+    models = fit_models(decision_pairs, {}, log=lambda line: None, validated=validated)
+    model = models["m//pair_sum"]
+    assert model.names == VIEWS_TERMS
+    lr = model.log10_lr([{VIEWS_LOG10_LR: x} for x in (-2.0, 0.0, 2.0)])
+    slope = (lr[2] - lr[0]) / 4.0
+    assert 0.35 < slope < 0.7, slope
+    assert "m//pair_sum" not in fit_models(decision_pairs, {}, log=lambda line: None)
+
+
 def test_conclusion_scale_caps_and_consistency():
     assert [level(x) for x in (-3, -1.5, -0.7, 0.0, 0.7, 1.5, 3)] == list(range(7))
     assert conclude(2.5).label == "strong support"
@@ -339,7 +372,8 @@ def test_skull_cohort_reads_a_skull_against_other_faces():
 
 def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeypatch):
     """Separate SFOs of one frontal and one lateral photo: the decision's log10 LR is the sum
-    of the two photos' own (each from its view's model); other sets use the pair model."""
+    of the two photos' own (each from its view's model) calibrated by the method's
+    ``pair_sum`` model, or the plain sum without one; other sets use the pair model."""
     from dataclasses import replace
     from types import SimpleNamespace
 
@@ -357,8 +391,21 @@ def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeyp
     calibrations = Calibrations()
     one = [identify(skull, [p], [result], calibrations) for p in (frontal, lateral)]
     both = identify(skull, [frontal, lateral], [result, result], calibrations)
-    assert both["calibration"]["model"] == "posest-sfo//frontal + posest-sfo//lateral"
-    assert both["log10_lr"] == pytest.approx(one[0]["log10_lr"] + one[1]["log10_lr"])
+    assert both["calibration"]["model"] == (
+        "posest-sfo//frontal + posest-sfo//lateral -> posest-sfo//pair_sum"
+    )
+    added = one[0]["log10_lr"] + one[1]["log10_lr"]
+    assert both["views_log10_lr"] == [one[0]["log10_lr"], one[1]["log10_lr"]]
+    views = calibrations.get("posest-sfo//pair_sum")
+    assert both["calibration"]["views_model"] == "posest-sfo//pair_sum"
+    assert both["log10_lr"] == pytest.approx(views.log10_lr([{"views_log10_lr": added}])[0])
+    assert "calibrated as one decision" in both["note"]
+    without = Calibrations()
+    del without.models["posest-sfo//pair_sum"]
+    plain = identify(skull, [frontal, lateral], [result, result], without)
+    assert plain["log10_lr"] == pytest.approx(added)
+    assert "as if independent" in plain["note"] and plain["calibration"]["views_model"] is None
+    assert plain["calibration"]["model"] == "posest-sfo//frontal + posest-sfo//lateral"
     assert "single_photo" not in both["caps"]
     # Each photo's LR comes from its own SFO's soft tissue, not the first photo's.
     import lilium.casework.identify as identify_module

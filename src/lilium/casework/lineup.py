@@ -172,8 +172,18 @@ def run_lineup(
     first = method_tag(methods[0], options.variant)
 
     def order(entry):
-        lr = entry["identification"].get("log10_lr")
-        return (entry["method"] != first, -(lr if lr is not None else float("-inf")))
+        # Ties at the calibration's bound are broken by what the bound clipped: the views'
+        # log10 LRs added (a frontal and a lateral photo), then the unbounded score (NLL).
+        record = entry["identification"]
+        lr = record.get("log10_lr")
+        views = record.get("views_log10_lr") or []
+        score = record.get("score")
+        return (
+            entry["method"] != first,
+            -(lr if lr is not None else float("-inf")),
+            -(sum(views) if views and None not in views else float("-inf")),
+            score if score is not None else float("inf"),
+        )
 
     ranking.sort(key=order)
     for k, entry in enumerate(ranking, start=1):

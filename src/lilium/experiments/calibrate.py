@@ -13,10 +13,14 @@ photo once.
   together by one likelihood: the landmark term stacks both photos' residuals of each
   landmark with **one shared soft tissue** (:func:`lilium.identification.terms.landmark_chi2`),
   the other terms add up; calibrated as a model of its own;
-- ``pair_sum``: the same two SFOs' cross-validated log10 LRs added, i.e. as if the photos
-  were independent evidence (they are not: they share the soft tissue); measured beside
-  ``pair``, and better (docs/method.md), so it is what a case with one frontal and one lateral
-  photo reports (:mod:`lilium.casework.identify`); it needs no model of its own;
+- ``pair_sum``: the same two SFOs' cross-validated log10 LRs added and calibrated as one
+  decision: a logistic regression on their sum (:data:`~lilium.identification.calibration.
+  VIEWS_TERMS`, fitted on the cross-validated single-photo LRs, so on LRs like a new case's).
+  Added alone they would count the photos as independent evidence, which they are not (they
+  share the soft tissue); the fitted slope and offset take the dependence from the data.
+  Measured beside ``pair`` and beside the plain sum, and better than both (docs/method.md),
+  so it is what a case with one frontal and one lateral photo reports
+  (:mod:`lilium.casework.identify`);
 - ``joint``: a joint SFO (SPEC section 9) of the pair: its shared soft tissue and two cameras.
 """
 
@@ -27,7 +31,13 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.camera import Camera
-from ..identification.calibration import cross_validated, fit, performance
+from ..identification.calibration import (
+    VIEWS_LOG10_LR,
+    VIEWS_TERMS,
+    cross_validated,
+    fit,
+    performance,
+)
 from ..identification.cohort import Cohort
 from ..identification.score import identification_terms, pll_face, with_skull_cohort
 from ..identification.terms import TERM_NAMES, eye_corner_px
@@ -270,12 +280,14 @@ def decisions(rows, terms, inputs=None, cohort_cache=None):
 def validate(decision_pairs, folds=5):
     """Cross-validated log10 LR of every decision and its performance.
 
-    ``pair_sum`` decisions add their two photos' cross-validated single-photo log10 LRs.
+    ``pair_sum`` decisions add their two photos' cross-validated single-photo log10 LRs
+    (``added``, with its ``performance_added``) and calibrate the sum, cross-validated by
+    subject in turn (:func:`views_pairs`).
 
     Returns
     -------
     dict
-        ``{key: {"log10_lr": ndarray, "performance": dict}}``.
+        ``{key: {"log10_lr": ndarray, "performance": dict, ...}}``.
     """
     out = {}
     for key, pairs in sorted(decision_pairs.items()):
@@ -286,9 +298,21 @@ def validate(decision_pairs, folds=5):
     for key, pairs in decision_pairs.items():
         if key[2] != "pair_sum":
             continue
-        lr = _pair_sum(pairs, decision_pairs, out, key)
-        out[key] = {"log10_lr": lr, "performance": performance(lr, [p["same"] for p in pairs])}
+        same = [p["same"] for p in pairs]
+        added = _pair_sum(pairs, decision_pairs, out, key)
+        lr = cross_validated(views_pairs(pairs, added), folds, VIEWS_TERMS, ridge=0.0)
+        out[key] = {"log10_lr": lr, "performance": performance(lr, same),
+                    "added": added, "performance_added": performance(added, same)}
     return out
+
+
+def views_pairs(pairs, added):
+    """``pair_sum`` pairs with their one feature, the sum ``added`` (P,) of their views'
+    log10 LRs, as ``terms`` (None where an SFO failed)."""
+    return [
+        p | {"terms": None if not np.isfinite(v) else {VIEWS_LOG10_LR: float(v)}}
+        for p, v in zip(pairs, added, strict=True)
+    ]
 
 
 def _pair_sum(pairs, decision_pairs, validated, key):
@@ -316,21 +340,29 @@ def _pair_sum(pairs, decision_pairs, validated, key):
 MIN_PAIRS = 10
 
 
-def fit_models(decision_pairs, provenance, log=print):
-    """One :class:`Calibration` per decision (``pair_sum`` excepted), fitted on every pair;
-    a decision with fewer than :data:`MIN_PAIRS` pairs of either kind gets none (and says so)."""
+def fit_models(decision_pairs, provenance, log=print, validated=None):
+    """One :class:`Calibration` per decision, fitted on every pair; a decision with fewer
+    than :data:`MIN_PAIRS` pairs of either kind gets none (and says so). ``pair_sum`` models
+    are fitted on the cross-validated single-photo LRs of :func:`validate` (``validated``;
+    without it, none)."""
     models = {}
     for key, pairs in sorted(decision_pairs.items()):
+        names, ridge = None, None
         if key[2] == "pair_sum":
-            continue
+            if validated is None or key not in validated:
+                continue
+            pairs = views_pairs(pairs, validated[key]["added"])
+            names, ridge = VIEWS_TERMS, 0.0
         train = [p for p in pairs if p["terms"] is not None]
         same = [p["same"] for p in train]
         if min(sum(same), len(same) - sum(same)) < MIN_PAIRS:
             log(f"{'/'.join(key)}: {sum(same)} same- and {len(same) - sum(same)} "
                 f"different-person pairs, fewer than {MIN_PAIRS}: no model")
             continue
+        options = {} if names is None else {"names": names, "ridge": ridge}
         models["/".join(key)] = fit(
-            [p["terms"] for p in train], same, provenance=dict(provenance, decision=key[2])
+            [p["terms"] for p in train], same, provenance=dict(provenance, decision=key[2]),
+            **options,
         )
     return models
 

@@ -34,16 +34,25 @@ def decision_label(method, variant, decision):
     label = method_label(method, variant)
     return {
         "pair": f"{label}, separate SFOs, shared soft tissue",
-        "pair_sum": f"{label}, separate SFOs, LRs added",
+        "pair_sum": f"{label}, separate SFOs, LRs added and calibrated",
     }.get(decision, label)
 
 
-def ranking_rows(pairs, log10_lr, view):
+#: Weight of the tie-break in :func:`ranking_rows`: far below any difference of two LRs that
+#: are not equal, so it only orders LRs tied at the calibration's bound.
+TIE_BREAK = 1e-9
+
+
+def ranking_rows(pairs, log10_lr, view, tie_break=None):
     """Rows for :func:`lilium.experiments.identification.identification_table` that rank each
     photo's skulls by ``-log10 LR`` (a failed SFO ranks last); a pair ranks by its frontal
-    photo, so ``view`` is that of the decision's photo."""
+    photo, so ``view`` is that of the decision's photo. ``tie_break`` (P,), optional: what
+    orders LRs tied at the calibration's bound (the views' log10 LRs added, before their
+    model clipped them), as ``lilium lineup`` orders its candidates."""
+    if tie_break is None:
+        tie_break = np.zeros(len(log10_lr))
     out = []
-    for p, v in zip(pairs, log10_lr, strict=True):
+    for p, v, t in zip(pairs, log10_lr, np.nan_to_num(tie_break), strict=True):
         ok = bool(np.isfinite(v))
         out.append(
             dict(
@@ -57,7 +66,7 @@ def ranking_rows(pairs, log10_lr, view):
                 subject=p["skull"],
                 true_subject=p["person"],
                 success=ok,
-                score=-float(v) if ok else None,
+                score=-float(v) - TIE_BREAK * float(t) if ok else None,
             )
         )
     return out
@@ -72,7 +81,9 @@ def lr_identification_table(decision_pairs, validated):
     for key in sorted(validated):
         method, variant, decision = key
         view = "lateral" if decision == "lateral" else "frontal"
-        rows = ranking_rows(decision_pairs[key], validated[key]["log10_lr"], view)
+        rows = ranking_rows(
+            decision_pairs[key], validated[key]["log10_lr"], view, validated[key].get("added")
+        )
         parts = []
         for db in sorted({p["run"][0] for p in decision_pairs[key]}):
             mine = [r for r, p in zip(rows, decision_pairs[key], strict=True) if p["run"][0] == db]
@@ -219,7 +230,7 @@ def calibrate_databases(dbs, out_dir, dataset=None, log=print):
         "databases": [database_provenance(db) for db in dbs],
         "model": "logistic regression on the identification terms (lilium.identification)",
     }
-    models = fit_models(decision_pairs, provenance, log)
+    models = fit_models(decision_pairs, provenance, log, validated)
     for key, model in models.items():
         perf = validated[tuple(key.split("/"))]["performance"]
         model.provenance.update(

@@ -3,7 +3,8 @@
 A calibration file is JSON: ``{"format": "lilium-calibration", "version": 1, "models":
 {"<method>/<variant>/<decision>": Calibration.to_dict(), ...}, "provenance": {...}}``, with
 ``<variant>`` empty for POSEST-SFO and ``<decision>`` one of ``frontal``, ``lateral``,
-``pair`` (separate SFOs of a frontal and a lateral photo) and ``joint`` (a joint SFO).
+``pair`` (separate SFOs of a frontal and a lateral photo, one shared soft tissue),
+``pair_sum`` (the same two SFOs' log10 LRs added, calibrated) and ``joint`` (a joint SFO).
 The package ships one (``lilium/data/calibration.json``, fitted by ``lilium calibrate`` on
 generated subjects; its provenance says how); ``lilium calibrate DB`` writes another, and
 ``--calibration FILE`` makes a command use it.
