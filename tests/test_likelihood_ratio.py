@@ -224,6 +224,28 @@ def test_a_file_that_is_not_a_calibration_is_refused(case, tmp_path, capsys):
     assert code == 2 and "not a Lilium calibration file" in err and str(bad) in err
 
 
+def test_lineup_orders_ties_at_the_bound_by_what_was_clipped():
+    from lilium.casework.lineup import rank_key
+
+    def entry(name, lr, views=None, score=None, method="lilium-skof+pll"):
+        record = {"log10_lr": lr, "views_log10_lr": views, "score": score}
+        return {"candidate": name, "method": method, "identification": record}
+
+    entries = [
+        entry("none", None),
+        entry("bound, smaller sum", 2.95, [1.5, 0.8], 3.0),
+        entry("other method", 3.5, method="posest-sfo"),
+        entry("bound, larger sum", 2.95, [2.5, 1.9], 9.0),
+        entry("below", 1.2, [0.5, 0.6], 1.0),
+        entry("one photo, bound, lower score", 2.95, None, 2.0),
+    ]
+    ranked = sorted(entries, key=lambda e: rank_key(e, "lilium-skof+pll"))
+    assert [e["candidate"] for e in ranked] == [
+        "bound, larger sum", "bound, smaller sum", "one photo, bound, lower score", "below",
+        "none", "other method",
+    ]
+
+
 def test_lineup_ranks_candidates_and_resumes(case, tmp_path, capsys, monkeypatch):
     subject_dir, photo_dir = case
     out = tmp_path / "lineup"

@@ -67,6 +67,23 @@ def check_candidates(candidates):
         seen.add(key)
 
 
+def rank_key(entry, first_method):
+    """Sort key of a lineup entry: the first method's entries first, then by log10 LR
+    (highest first; none last). Ties at the calibration's bound are broken by what the bound
+    clipped: the views' log10 LRs added (a frontal and a lateral photo), then the unbounded
+    score (the NLL, lowest first)."""
+    record = entry["identification"]
+    lr = record.get("log10_lr")
+    views = record.get("views_log10_lr") or []
+    score = record.get("score")
+    return (
+        entry["method"] != first_method,
+        -(lr if lr is not None else float("-inf")),
+        -(sum(views) if views and None not in views else float("-inf")),
+        score if score is not None else float("inf"),
+    )
+
+
 def run_lineup(
     skull_path,
     candidates,
@@ -171,21 +188,7 @@ def run_lineup(
     bar.close()
     first = method_tag(methods[0], options.variant)
 
-    def order(entry):
-        # Ties at the calibration's bound are broken by what the bound clipped: the views'
-        # log10 LRs added (a frontal and a lateral photo), then the unbounded score (NLL).
-        record = entry["identification"]
-        lr = record.get("log10_lr")
-        views = record.get("views_log10_lr") or []
-        score = record.get("score")
-        return (
-            entry["method"] != first,
-            -(lr if lr is not None else float("-inf")),
-            -(sum(views) if views and None not in views else float("-inf")),
-            score if score is not None else float("inf"),
-        )
-
-    ranking.sort(key=order)
+    ranking.sort(key=lambda entry: rank_key(entry, first))
     for k, entry in enumerate(ranking, start=1):
         entry["rank"] = k
         log(f"{k}. {entry['candidate']} ({entry['method']}): "
