@@ -150,10 +150,15 @@ def test_two_views_that_repeat_each_other_are_not_counted_twice():
                                                            "run": ("r",)}
         for p in pairs
     ]
+    decision_pairs[("m", "", "frontal")][0] = decision_pairs[("m", "", "frontal")][0] | {
+        "terms": None  # a failed SFO: its pair has no sum and no LR, and is counted failed
+    }
     validated = validate(decision_pairs, folds=4)
-    single = validated[("m", "", "frontal")]["log10_lr"]
+    frontal, lateral = (validated[("m", "", v)]["log10_lr"] for v in ("frontal", "lateral"))
     both = validated[("m", "", "pair_sum")]
-    np.testing.assert_allclose(both["added"], 2 * single)
+    np.testing.assert_allclose(both["added"][1:], frontal[1:] + lateral[1:])
+    assert np.isnan(both["added"][0]) and np.isnan(both["log10_lr"][0])
+    assert both["performance"]["failed"] == both["performance_added"]["failed"] == 1
     assert both["performance"]["cllr"] < both["performance_added"]["cllr"] - 0.02
     models = fit_models(decision_pairs, {}, log=lambda line: None, validated=validated)
     model = models["m//pair_sum"]
@@ -244,6 +249,20 @@ def test_lineup_orders_ties_at_the_bound_by_what_was_clipped():
         "bound, larger sum", "bound, smaller sum", "one photo, bound, lower score", "below",
         "none", "other method",
     ]
+
+
+def test_rankings_break_ties_at_the_bound_by_the_plain_sum():
+    from lilium.experiments.identification import photo_matches
+    from lilium.experiments.lr_report import ranking_rows
+
+    pairs = [dict(run=(0, "e", "m", "", "C1", 0), photo="p1", person="a", skull=s)
+             for s in ("a", "b", "c")]
+    lr = np.array([2.95, 2.95, 1.0])  # the true skull and a wrong one at the upper bound
+    for added, better, tied in (([5.0, 3.0, 0.5], 0, 0), ([3.0, 5.0, 0.5], 1, 0),
+                                (None, 0, 1)):
+        rows = ranking_rows(pairs, lr, "frontal", None if added is None else np.array(added))
+        match = photo_matches(rows)[0]
+        assert (match["better"], match["tied"]) == (better, tied)
 
 
 def test_lineup_ranks_candidates_and_resumes(case, tmp_path, capsys, monkeypatch):

@@ -12,7 +12,8 @@ def register(subparsers):
         help="fit the identification calibration (log10 LR) on experiment databases",
         description=(
             "Computes every stored SFO's identification terms, fits one log10 LR model per "
-            "method, variant and decision (frontal, lateral, frontal+lateral pair, joint), "
+            "method, variant and decision (frontal, lateral, a frontal+lateral pair with its "
+            "soft tissue shared, the same pair's two LRs added and calibrated, joint), "
             "cross-validated by subject, and writes OUT/calibration.json (give it to lilium "
             "sfo/case/lineup with --calibration) and OUT/calibration.csv (Cllr, Cllr_min, "
             "rates of misleading evidence)."

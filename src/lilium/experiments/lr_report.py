@@ -48,7 +48,7 @@ def ranking_rows(pairs, log10_lr, view, tie_break=None):
     photo's skulls by ``-log10 LR`` (a failed SFO ranks last); a pair ranks by its frontal
     photo, so ``view`` is that of the decision's photo. ``tie_break`` (P,), optional: what
     orders LRs tied at the calibration's bound (the views' log10 LRs added, before their
-    model clipped them), as ``lilium lineup`` orders its candidates."""
+    model clipped them; higher ranks first), as ``lilium lineup`` breaks such ties first."""
     if tie_break is None:
         tie_break = np.zeros(len(log10_lr))
     out = []
@@ -233,6 +233,11 @@ def calibrate_databases(dbs, out_dir, dataset=None, log=print):
     models = fit_models(decision_pairs, provenance, log, validated)
     for key, model in models.items():
         perf = validated[tuple(key.split("/"))]["performance"]
+        if key.endswith("/pair_sum"):
+            model.provenance["model"] = (
+                "logistic regression on the sum of the frontal and the lateral photo's "
+                "out-of-fold log10 LRs (lilium.experiments.calibrate)"
+            )
         model.provenance.update(
             pairs_same=model.n_same,
             pairs_different=model.n_diff,
