@@ -9,6 +9,7 @@ Used by ``lilium calibrate`` (:func:`calibrate_databases`) and ``lilium report``
 
 import csv
 import json
+import textwrap
 import time
 from pathlib import Path
 
@@ -139,7 +140,7 @@ def plot_tippett(validated, path):
         ax.axvline(0.0, color="grey", lw=0.8)
         perf = validated[key]["performance"]
         ax.set_title(
-            f"{decision_label(*key)}\n{key[2]}: Cllr {perf['cllr']:.2f} "
+            f"{textwrap.fill(decision_label(*key), 50)}\n{key[2]}: Cllr {perf['cllr']:.2f} "
             f"(min {perf['cllr_min']:.2f})",
             fontsize=8,
         )
