@@ -59,7 +59,7 @@ from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from .lilium import IMAGE_TERMS, LiliumProblem, build_cones, de_extra
-from .lilium_outcome import photo_outcome
+from .lilium_outcome import outcome_fitness, photo_outcome
 from .options import SfoOptions
 from .result import SfoResult, finite_or_none
 
@@ -466,11 +466,7 @@ def joint_lilium_sfo(
     for p, single in enumerate(problem.problems):
         mine = {k: np.asarray(best[k])[p] for k in PHOTO_KEYS if k != "fitness"}
         camera, terms, error, warnings = photo_outcome(single, mine, seed)
-        fitness = float(np.asarray(best["photo_fitness"])[p])
-        if camera is not None and not single.level.is_full:
-            # As a single SFO: the DE's fitness was at the working level, the result's is the
-            # sum of the terms at full level.
-            fitness = sum(v for v in terms.values() if v is not None)
+        fitness = outcome_fitness(single, np.asarray(best["photo_fitness"])[p], camera, terms)
         rows = problem.rows[p]
         results.append(
             SfoResult(

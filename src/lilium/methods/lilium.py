@@ -42,7 +42,7 @@ from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode, encode_depth_only, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
 from .checks import facing_check
-from .lilium_outcome import photo_outcome
+from .lilium_outcome import outcome_fitness, photo_outcome
 from .lilium_terms import image_terms, prior_terms_off
 from .options import SfoOptions, with_focal_cap
 from .posest_sfo import RUN_OFF_FACTOR, mean_depth_landmarks
@@ -491,10 +491,7 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     de = solver.solve()
     best = de.payload
     camera, terms, error, warnings = photo_outcome(problem, best, seed)
-    fitness = de.fun
-    if camera is not None and not problem.level.is_full:
-        # The DE's own fitness was at the working level; the result's is the full one.
-        fitness = sum(v for v in terms.values() if v is not None)
+    fitness = outcome_fitness(problem, de.fun, camera, terms)
     facial = problem.facial_landmarks(de.x)[0]
     return SfoResult(
         method="lilium",

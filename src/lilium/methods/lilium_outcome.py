@@ -62,6 +62,15 @@ def photo_outcome(problem, best, seed):
     return camera, terms, error, warnings
 
 
+def outcome_fitness(problem, de_fitness, camera, terms):
+    """The result's fitness of one photo: the DE's own ``de_fitness``, or, when the DE ran at a
+    working level and the photo has a camera, the sum of :func:`photo_outcome`'s ``terms``
+    (recomputed at full level), as a single SFO and each photo of a joint SFO report it."""
+    if camera is not None and not problem.level.is_full:
+        return float(sum(v for v in terms.values() if v is not None))
+    return float(de_fitness)
+
+
 def _px(focal_px):
     """A focal length for a message: whole pixels, or 3 significant digits for a run-off fit."""
     return f"{focal_px:.0f}" if focal_px < 1e6 else f"{focal_px:.3g}"
