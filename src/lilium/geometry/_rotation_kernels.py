@@ -6,7 +6,8 @@ import numpy as np
 
 from ..jit import njit
 
-_DEG = 180.0 / np.pi
+#: Degrees per radian (the angle's unit; the prior-aware refinement's derivative too).
+DEG_PER_RAD = 180.0 / np.pi
 
 
 @njit(inline="always")
@@ -34,4 +35,4 @@ def relative_angle_axis(R, P):
     cos = (Q[0, 0] + Q[1, 1] + Q[2, 2] - 1.0) / 2.0
     x, y, z = Q[2, 1] - Q[1, 2], Q[0, 2] - Q[2, 0], Q[1, 0] - Q[0, 1]
     norm = np.sqrt(x * x + y * y + z * z)
-    return np.arctan2(norm / 2.0, cos) * _DEG, x, y, z, norm
+    return np.arctan2(norm / 2.0, cos) * DEG_PER_RAD, x, y, z, norm

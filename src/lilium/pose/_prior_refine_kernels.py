@@ -14,7 +14,7 @@ A prior is switched off by NaN bounds (NaN ``tol`` for the head orientation).
 import numpy as np
 
 from ..constants import MIN_DEPTH_MM
-from ..geometry._rotation_kernels import relative_angle_axis
+from ..geometry._rotation_kernels import DEG_PER_RAD, relative_angle_axis
 from ..jit import njit
 from ._refine_kernels import (
     _apply_step,
@@ -23,8 +23,6 @@ from ._refine_kernels import (
     _solve7,
     sq_errors_kernel,
 )
-
-_DEG = 180.0 / np.pi
 
 
 @njit
@@ -76,9 +74,9 @@ def _hinges(R, c, log_f, rel, focal, scd, head, tol, r, J, row):
         if dbeta - tol > 0.0:
             r[row + 4] = dbeta - tol
             if norm > 0.0:  # the unit axis of R P^T, in degrees (see the numpy code)
-                J[row + 4, 0] = x / norm * _DEG
-                J[row + 4, 1] = y / norm * _DEG
-                J[row + 4, 2] = z / norm * _DEG
+                J[row + 4, 0] = x / norm * DEG_PER_RAD
+                J[row + 4, 1] = y / norm * DEG_PER_RAD
+                J[row + 4, 2] = z / norm * DEG_PER_RAD
     total = 0.0
     for k in range(5):
         total += r[row + k] * r[row + k]
