@@ -43,7 +43,7 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   gave the same BPE as all of them on 8 generated subjects x 3 seeds, complete and
   mandible-less, and on headsq, at about half the time; one joint generation costs more than
   the photos' single generations together, the lower-bound pruning skipping fewer image
-  terms once P_cam no longer rules trials out: 1.2-2.3 x the independent pair's time). The
+  terms once P_cam no longer rules trials out: 1.2-1.8 x the independent pair's time). The
   wall-clock limit
   (``options.de.max_seconds``) bounds the joint run as a whole.
 """
@@ -74,7 +74,9 @@ CAMERAS = ("priors", "least_squares")
 #: docs/method.md): least-squares cameras x1.044 / x1.177 on 8 generated subjects complete /
 #: without mandible and x1.223 / x1.440 on headsq ``hq`` / ``hq_nm``; cameras on the priors at
 #: half the generations x0.898 / x1.022 / x1.101 / x1.058 (all the generations: x0.894 /
-#: x0.995 / x1.141 / x1.015). The plain sum (``weighting="sum"``) was worse with either camera.
+#: x0.995 / x1.141 / x1.015), x0.922 / x0.995 / x1.018 / x1.034 since the refinement takes 10
+#: iterations (:data:`PRIOR_CAMERA_ITERATIONS`). The plain sum (``weighting="sum"``) was worse
+#: with either camera.
 DEFAULT_CAMERA = "priors"
 DEFAULT_WEIGHTING = "scale"
 DEFAULT_GENERATIONS_FACTOR = 0.5
@@ -239,8 +241,15 @@ class JointLiliumProblem:
         return terms["fitness"], terms
 
 
-#: Levenberg-Marquardt iterations of :func:`camera_on_priors` (it starts near its optimum).
-PRIOR_CAMERA_ITERATIONS = 5
+#: Levenberg-Marquardt iterations of :func:`camera_on_priors` per evaluation (it starts from
+#: the member's refined camera, so a chain keeps converging over the generations). 10, not 5:
+#: with 5 a camera far outside its priors (a mandible-less photo's least-squares focal length)
+#: was still on the prior's edge, or outside it, at the end of the run; measured
+#: (``bench_joint.py``, seeds 1-3, docs/method.md) 5 -> 10 -> 15 iterations: mean BPE against
+#: the independent SFOs x0.898 -> x0.922 -> x0.972 on generated complete subjects, x1.022 ->
+#: x0.995 -> x0.974 without mandible, x1.101 -> x1.018 -> x1.088 on headsq ``hq``, x1.058 ->
+#: x1.034 -> x1.037 on ``hq_nm``; time x1.19-2.31 -> x1.17-1.82 -> x1.10-1.47 of the pair.
+PRIOR_CAMERA_ITERATIONS = 10
 
 
 def camera_on_priors(problem, facial_mm, terms, members=None):
