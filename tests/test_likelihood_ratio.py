@@ -135,7 +135,7 @@ def test_two_views_that_repeat_each_other_are_not_counted_twice():
     """A frontal and a lateral photo carrying the same evidence (identical terms): added, their
     LRs count it twice; the calibrated sum (``pair_sum``) learns a slope of about one half and
     costs less, cross-validated; its model is the one ``lilium calibrate`` writes."""
-    from lilium.experiments.calibrate import fit_models, validate
+    from lilium.experiments.calibrate import VIEWS_MODEL, fit_models, validate
     from lilium.identification.calibration import VIEWS_LOG10_LR, VIEWS_TERMS
 
     rng = np.random.default_rng(5)
@@ -163,6 +163,7 @@ def test_two_views_that_repeat_each_other_are_not_counted_twice():
     models = fit_models(decision_pairs, {}, log=lambda line: None, validated=validated)
     model = models["m//pair_sum"]
     assert model.names == VIEWS_TERMS
+    assert model.provenance["model"] == VIEWS_MODEL
     lr = model.log10_lr([{VIEWS_LOG10_LR: x} for x in (-2.0, 0.0, 2.0)])
     slope = (lr[2] - lr[0]) / 4.0
     assert 0.35 < slope < 0.7, slope

@@ -377,6 +377,12 @@ def _pair_sum(pairs, decision_pairs, validated, key):
 #: Fewest same-person and different-person pairs a decision needs for a model of its own.
 MIN_PAIRS = 10
 
+#: The ``model`` of a ``pair_sum`` model's provenance (the terms' models keep the caller's).
+VIEWS_MODEL = (
+    "logistic regression on the sum of the frontal and the lateral photo's out-of-fold log10 "
+    "LRs (lilium.experiments.calibrate)"
+)
+
 
 def fit_models(decision_pairs, provenance, log=print, validated=None):
     """One :class:`Calibration` per decision, fitted on every pair; a decision with fewer
@@ -385,12 +391,12 @@ def fit_models(decision_pairs, provenance, log=print, validated=None):
     without it, none)."""
     models = {}
     for key, pairs in sorted(decision_pairs.items()):
-        names, ridge = CALIBRATED_TERMS, RIDGE
+        names, ridge, origin = CALIBRATED_TERMS, RIDGE, dict(provenance, decision=key[2])
         if key[2] == "pair_sum":
             if validated is None or key not in validated:
                 continue
             pairs = views_pairs(pairs, validated[key]["added"])
-            names, ridge = VIEWS_TERMS, VIEWS_RIDGE
+            names, ridge, origin["model"] = VIEWS_TERMS, VIEWS_RIDGE, VIEWS_MODEL
         train = [p for p in pairs if p["terms"] is not None]
         same = [p["same"] for p in train]
         if min(sum(same), len(same) - sum(same)) < MIN_PAIRS:
@@ -398,7 +404,7 @@ def fit_models(decision_pairs, provenance, log=print, validated=None):
                 f"different-person pairs, fewer than {MIN_PAIRS}: no model")
             continue
         models["/".join(key)] = fit(
-            [p["terms"] for p in train], same, names, dict(provenance, decision=key[2]), ridge
+            [p["terms"] for p in train], same, names, origin, ridge
         )
     return models
 

@@ -234,11 +234,6 @@ def calibrate_databases(dbs, out_dir, dataset=None, log=print):
     models = fit_models(decision_pairs, provenance, log, validated)
     for key, model in models.items():
         perf = validated[tuple(key.split("/"))]["performance"]
-        if key.endswith("/pair_sum"):
-            model.provenance["model"] = (
-                "logistic regression on the sum of the frontal and the lateral photo's "
-                "out-of-fold log10 LRs (lilium.experiments.calibrate)"
-            )
         model.provenance.update(
             pairs_same=model.n_same,
             pairs_different=model.n_diff,
