@@ -41,7 +41,7 @@ from ..identification.calibration import (
     cross_validated,
     fit,
     performance,
-    subject_folds,
+    subject_splits,
 )
 from ..identification.cohort import Cohort
 from ..identification.score import identification_terms, pll_face, with_skull_cohort
@@ -318,22 +318,16 @@ def _nested_views_lr(pairs, added, decision_pairs, key, folds):
     (the two views' models cross-validated again within the other folds' pairs) and scores
     fold ``k``'s own sums ``added`` (P,) of its cross-validated LRs. NaN where an SFO failed,
     or a fold's training pairs lack a class."""
-    fold_of = subject_folds([p["person"] for p in pairs] + [p["skull"] for p in pairs], folds)
     out = np.full(len(pairs), np.nan)
-
-    def training(items, k):
-        return [p for p in items if fold_of[p["person"]] != k and fold_of[p["skull"]] != k]
-
-    for k in sorted(set(fold_of.values())):
+    for _, training, test in subject_splits(pairs, folds):
         inner_pairs, inner_lr = {}, {}
         for view in ("frontal", "lateral"):
             view_key = (key[0], key[1], view)
-            inner_pairs[view_key] = training(decision_pairs.get(view_key, []), k)
+            inner_pairs[view_key] = training(decision_pairs.get(view_key, []))
             inner_lr[view_key] = {"log10_lr": cross_validated(inner_pairs[view_key], folds)}
-        train = training(pairs, k)
+        train = training(pairs)
         inner = views_pairs(train, _pair_sum(train, inner_pairs, inner_lr, key))
         inner = [p for p in inner if p["terms"] is not None]
-        test = [i for i, p in enumerate(pairs) if fold_of[p["person"]] == k]
         if not test or {p["same"] for p in inner} != {True, False}:
             continue
         model = fit([p["terms"] for p in inner], [p["same"] for p in inner], VIEWS_TERMS,

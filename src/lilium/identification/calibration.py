@@ -236,6 +236,20 @@ def subject_folds(subjects, folds=FOLDS):
     return {s: i % folds for i, s in enumerate(sorted(set(subjects)))}
 
 
+def subject_splits(pairs, folds=FOLDS):
+    """The cross-validation's splits of ``pairs`` by subject: for each fold ``k``, ``(k,
+    training, test)`` with ``training(items)`` the items (pairs of any decision on the same
+    subjects) whose photo's subject and skull's subject are both outside fold ``k``, and
+    ``test`` the indices of the ``pairs`` whose photo's subject is in it."""
+    fold_of = subject_folds([p["person"] for p in pairs] + [p["skull"] for p in pairs], folds)
+    for k in sorted(set(fold_of.values())):
+
+        def training(items, k=k):
+            return [p for p in items if fold_of[p["person"]] != k and fold_of[p["skull"]] != k]
+
+        yield k, training, [i for i, p in enumerate(pairs) if fold_of[p["person"]] == k]
+
+
 def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS, ridge=RIDGE):
     """Cross-validated log10 LR of every pair: each scored by a model that never saw its
     photo's subject (nor any pair with that subject's skull).
@@ -252,19 +266,10 @@ def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS, ridge=RIDGE):
         NaN for a failed SFO, and for the pairs of a fold whose training pairs lack one of
         the two classes (too few pairs to calibrate).
     """
-    fold_of = subject_folds([p["person"] for p in pairs] + [p["skull"] for p in pairs], folds)
     out = np.full(len(pairs), np.nan)
-    for k in sorted(set(fold_of.values())):
-        train = [
-            p
-            for p in pairs
-            if p["terms"] is not None
-            and fold_of[p["person"]] != k
-            and fold_of[p["skull"]] != k
-        ]
-        test = [i for i, p in enumerate(pairs) if fold_of[p["person"]] == k]
-        labels = {p["same"] for p in train}
-        if not test or labels != {True, False}:
+    for _, training, test in subject_splits(pairs, folds):
+        train = [p for p in training(pairs) if p["terms"] is not None]
+        if not test or {p["same"] for p in train} != {True, False}:
             continue  # nothing to score, or too few pairs to fit: left NaN
         model = fit([p["terms"] for p in train], [p["same"] for p in train], names, ridge=ridge)
         out[test] = model.log10_lr([pairs[i]["terms"] for i in test])
