@@ -224,8 +224,9 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
         dbs, out_dir, log=lambda line: None
     )
     print("| decision | method | pairs same / different | failed | Cllr | Cllr_min | "
-          "misleading same | misleading different |", file=file)
-    print("|---|---|---|---|---|---|---|---|", file=file)
+          "misleading same | misleading different | wrong conclusion same | "
+          "wrong conclusion different |", file=file)
+    print("|---|---|---|---|---|---|---|---|---|---|", file=file)
     for (method, variant, decision), v in sorted(validated.items()):
         rows = [(decision, v["performance"])]
         if "performance_added" in v:  # the plain sum beside the calibrated one
@@ -234,7 +235,9 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
             print(
                 f"| {label} | {method_label(method, variant)} | {p['n_same']} / {p['n_diff']} "
                 f"| {p['failed']} | {p['cllr']:.3f} | {p['cllr_min']:.3f} | "
-                f"{100 * p['misleading_same']:.1f} % | {100 * p['misleading_diff']:.1f} % |",
+                f"{100 * p['misleading_same']:.1f} % | {100 * p['misleading_diff']:.1f} % | "
+                f"{100 * p['wrong_conclusion_same']:.1f} % | "
+                f"{100 * p['wrong_conclusion_diff']:.1f} % |",
                 file=file,
             )
     print(file=file)

@@ -124,6 +124,14 @@ def test_cross_validation_and_performance():
     assert perf["failed"] == 1
     assert perf["cllr_min"] <= perf["cllr"] < 0.6
     assert perf["misleading_same"] <= 0.2 and perf["misleading_diff"] <= 0.1
+    # A wrong conclusion is a misleading LR beyond the undetermined band (|log10 LR| >= 0.5).
+    assert perf["wrong_conclusion_same"] <= perf["misleading_same"]
+    assert perf["wrong_conclusion_diff"] <= perf["misleading_diff"]
+    bands = performance([-0.6, -0.4, 0.2, 0.4, 0.5, 1.5, -3.0], [1, 1, 1, 0, 0, 0, 0])
+    assert bands["misleading_same"] == pytest.approx(2 / 3)
+    assert bands["wrong_conclusion_same"] == pytest.approx(1 / 3)
+    assert bands["misleading_diff"] == pytest.approx(3 / 4)
+    assert bands["wrong_conclusion_diff"] == pytest.approx(2 / 4)
     # An uninformative system costs 1 bit; PAV of random scores cannot do much better.
     same = np.array([p["same"] for p in pairs])
     assert cllr(np.zeros(len(same)), same) == pytest.approx(1.0)

@@ -16,7 +16,7 @@ def register(subparsers):
             "soft tissue shared, the same pair's two LRs added and calibrated, joint), "
             "cross-validated by subject, and writes OUT/calibration.json (give it to lilium "
             "sfo/case/lineup with --calibration) and OUT/calibration.csv (Cllr, Cllr_min, "
-            "rates of misleading evidence)."
+            "rates of misleading evidence and of wrong conclusions)."
         ),
     )
     p.add_argument("db", type=Path, nargs="+", help="results databases of lilium experiment")

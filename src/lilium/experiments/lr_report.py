@@ -1,7 +1,7 @@
 """Files of the identification's calibration (SPEC section 12): ``calibration.json``,
-``calibration.csv`` (Cllr, Cllr_min, rates of misleading evidence per decision), the Tippett
-plot, and the ranking of every photo's skulls by the cross-validated log10 LR beside the
-ranking by the methods' own scores (``identification.csv``).
+``calibration.csv`` (Cllr, Cllr_min, rates of misleading evidence and of wrong conclusions per
+decision), the Tippett plot, and the ranking of every photo's skulls by the cross-validated
+log10 LR beside the ranking by the methods' own scores (``identification.csv``).
 
 Used by ``lilium calibrate`` (:func:`calibrate_databases`) and ``lilium report``
 (:func:`lr_identification`).
@@ -161,7 +161,8 @@ def write_calibration_csv(path, validated):
     for t in table:
         t["label"] = decision_label(t["method"], t["variant"], t["decision"])
     keys = ["label", "method", "variant", "decision", "cllr", "cllr_min", "misleading_same",
-            "misleading_diff", "n_same", "n_diff", "failed"]
+            "misleading_diff", "wrong_conclusion_same", "wrong_conclusion_diff", "n_same",
+            "n_diff", "failed"]
     with Path(path).open("w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")
         writer.writeheader()

@@ -537,8 +537,9 @@ def write_report(db, out_dir):
         identification += lr_table
         lr_note = (
             "\n\nRanked by the identification log10 LR (SPEC section 12): each pair scored by "
-            "a calibration that never saw its subject (cross-validated); Cllr, Cllr_min and "
-            "the rates of misleading evidence in calibration.csv, the Tippett plot:\n\n"
+            "a calibration that never saw its subject (cross-validated); Cllr, Cllr_min, "
+            "the rates of misleading evidence and of conclusions that support the wrong "
+            "proposition in calibration.csv, the Tippett plot:\n\n"
             "![Tippett plot](tippett.png)\n"
         )
     except (ValueError, OSError) as exc:

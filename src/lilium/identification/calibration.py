@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .conclusion import UNDETERMINED, level
 from .terms import CALIBRATED_TERMS
 
 #: The feature of :data:`VIEWS_TERMS`.
@@ -313,7 +314,11 @@ def performance(log10_lr, same):
     dict
         ``cllr``, ``cllr_min``, ``misleading_same`` (share of same-person pairs with
         log10 LR < 0), ``misleading_diff`` (different-person pairs with log10 LR > 0),
-        ``n_same``, ``n_diff``, ``failed``.
+        ``wrong_conclusion_same`` / ``wrong_conclusion_diff`` (the shares whose LR falls in a
+        band of the verbal scale that supports the other proposition: same-person pairs at
+        "support for exclusion", log10 LR <= -0.5, and different-person pairs at "support",
+        >= 0.5; :mod:`lilium.identification.conclusion`, before any cap), ``n_same``,
+        ``n_diff``, ``failed``.
     """
     log10_lr = np.asarray(log10_lr, float)
     same = np.asarray(same, bool)
@@ -322,12 +327,16 @@ def performance(log10_lr, same):
     if not s.any() or s.all():
         nan = float("nan")
         return dict(cllr=nan, cllr_min=nan, misleading_same=nan, misleading_diff=nan,
+                    wrong_conclusion_same=nan, wrong_conclusion_diff=nan,
                     n_same=int(s.sum()), n_diff=int((~s).sum()), failed=int((~ok).sum()))
+    band = np.array([level(x) for x in v])
     return {
         "cllr": float(cllr(v, s)),
         "cllr_min": float(cllr(pav_log10_lr(v, s), s)),
         "misleading_same": float(np.mean(v[s] < 0)) if s.any() else float("nan"),
         "misleading_diff": float(np.mean(v[~s] > 0)) if (~s).any() else float("nan"),
+        "wrong_conclusion_same": float(np.mean(band[s] < UNDETERMINED)),
+        "wrong_conclusion_diff": float(np.mean(band[~s] > UNDETERMINED)),
         "n_same": int(s.sum()),
         "n_diff": int((~s).sum()),
         "failed": int((~ok).sum()),
