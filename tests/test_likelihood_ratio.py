@@ -478,3 +478,29 @@ def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeyp
     two_frontal = identify(skull, [frontal, frontal], [result, result], calibrations)
     assert two_frontal["calibration"]["model"] == "posest-sfo//pair"
     assert "these photos differ" in two_frontal["note"]
+
+
+def test_report_states_the_models_known_error_rates():
+    from lilium.report.conclusion_html import conclusion_section
+
+    provenance = {"cv_wrong_conclusion_same": 0.019, "cv_wrong_conclusion_diff": 0.044,
+                  "pairs_same": 52, "pairs_different": 892}
+    record = {"conclusion": "limited support", "log10_lr": 0.7,
+              "calibration": {"model": "lilium/skof+pll/frontal", "provenance": provenance}}
+    html = conclusion_section([("f00", "", record)])
+    assert "1.9 % of same-person and 4.4 % of different-person pairs" in html
+    assert "on 52 same- and 892 different-person pairs" in html
+    record["calibration"]["provenance"] = {"pairs_same": 52}  # an older calibration file
+    assert "known error rate" not in conclusion_section([("f00", "", record)])
+
+
+def test_shipped_calibration_states_its_error_rates():
+    from lilium.experiments.lr_report import CV_RATES
+    from lilium.io.calibration import read_calibration
+
+    models, _ = read_calibration()
+    lilium = [m for key, m in models.items() if key.startswith("lilium/")]
+    assert lilium
+    for model in lilium:
+        for name in CV_RATES:
+            assert 0.0 <= model.provenance[f"cv_{name}"] <= 1.0

@@ -39,6 +39,12 @@ def decision_label(method, variant, decision):
     }.get(decision, label)
 
 
+#: The cross-validated error rates each fitted model's provenance carries (beside its Cllr),
+#: the known error rates a case's report states next to its conclusion.
+CV_RATES = ("misleading_same", "misleading_diff", "wrong_conclusion_same",
+            "wrong_conclusion_diff")
+
+
 #: Weight of the tie-break in :func:`ranking_rows`: far below any difference of two LRs that
 #: are not equal, so it only orders LRs tied at the calibration's bound.
 TIE_BREAK = 1e-9
@@ -240,6 +246,7 @@ def calibrate_databases(dbs, out_dir, dataset=None, log=print):
             pairs_different=model.n_diff,
             cv_cllr=round(perf["cllr"], 4),
             cv_cllr_min=round(perf["cllr_min"], 4),
+            **{f"cv_{name}": round(perf[name], 4) for name in CV_RATES},
         )
     paths["calibration.json"] = out_dir / "calibration.json"
     write_calibration(paths["calibration.json"], models, provenance)

@@ -62,7 +62,7 @@ VIEWS_TERMS = (VIEWS_LOG10_LR,)
 RIDGE = 1e-2
 
 #: The views' model's (one feature): with :data:`RIDGE` its slope shrank and its
-#: cross-validated Cllr rose from 0.25 to 0.30 on the shipped calibration's 52 subjects; a
+#: cross-validated Cllr rose from 0.25 to 0.30 on the 52 subjects it was first fitted on; a
 #: trace of a penalty keeps the slope finite where a small calibration set separates.
 VIEWS_RIDGE = 1e-4
 

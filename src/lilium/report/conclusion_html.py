@@ -34,6 +34,22 @@ def _why(record):
     return "<br>".join(parts) or "&ndash;"
 
 
+def _error_rates(provenance):
+    """The model's known error rates (cross-validated on its calibration data), when its
+    calibration file states them."""
+    rates = [provenance.get(f"cv_wrong_conclusion_{side}") for side in ("same", "diff")]
+    if None in rates:
+        return ""
+    same, diff = (100 * r for r in rates)
+    n = provenance.get("pairs_same"), provenance.get("pairs_different")
+    pairs = f" on {n[0]} same- and {n[1]} different-person pairs" if None not in n else ""
+    return (
+        f"<br><span class='muted'>known error rate (cross-validated{escape(pairs)}): a wrong "
+        f"conclusion for {same:.1f} % of same-person and {diff:.1f} % of different-person "
+        "pairs</span>"
+    )
+
+
 def conclusion_section(decisions):
     """HTML of the conclusions (empty when the page has none).
 
@@ -54,11 +70,13 @@ def conclusion_section(decisions):
         if record.get("conclusion_uncapped") not in (None, conclusion):
             alone = escape(record["conclusion_uncapped"])
             capped = f"<br><span class='muted'>(LR alone: {alone})</span>"
-        model = escape((record.get("calibration") or {}).get("model", ""))
+        calibration = record.get("calibration") or {}
+        model = f"<code>{escape(calibration.get('model', ''))}</code>"
+        model += _error_rates(calibration.get("provenance") or {})
         rows.append(
             f"<tr><td>{name}</td><td class='conclusion {_SIDE.get(conclusion, '')}'>"
             f"<b>{escape(conclusion)}</b>{capped}</td><td>{_lr_text(record)}</td>"
-            f"<td>{_why(record)}</td><td><code>{model}</code></td></tr>"
+            f"<td>{_why(record)}</td><td>{model}</td></tr>"
         )
     head = ("<tr><th>decision</th><th>conclusion</th><th>log10 LR</th>"
             "<th>caps and consistency</th><th>calibration</th></tr>")
