@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .conclusion import UNDETERMINED, level
-from .terms import CALIBRATED_TERMS
+from .terms import CALIBRATED_TERMS, DERIVED_TERMS
 
 #: The feature of :data:`VIEWS_TERMS`.
 VIEWS_LOG10_LR = "views_log10_lr"
@@ -49,6 +49,7 @@ FEATURES = {
     "cohort_sd": lambda v: np.log(np.maximum(v, 1e-6)),
     "skull_mean": lambda v: v,
     "skull_sd": lambda v: np.log(np.maximum(v, 1e-6)),
+    "landmark_snorm": lambda v: v,
     # Not a term: the frontal and the lateral photo's log10 LRs added, the one feature of the
     # model that turns them into one decision's LR (:data:`VIEWS_TERMS`).
     VIEWS_LOG10_LR: lambda v: v,
@@ -70,6 +71,13 @@ VIEWS_RIDGE = 1e-4
 FOLDS = 5
 
 
+def _column(terms_list, name):
+    """The raw values ``(P,)`` of one term (stored, or :data:`DERIVED_TERMS`), NaN where
+    missing."""
+    get = DERIVED_TERMS.get(name, lambda t: t.get(name))
+    return np.array([np.nan if get(t) is None else float(get(t)) for t in terms_list], float)
+
+
 def features(terms_list, names, fill):
     """Feature matrix ``(P, len(names))`` of several term dictionaries.
 
@@ -79,9 +87,7 @@ def features(terms_list, names, fill):
     """
     X = np.empty((len(terms_list), len(names)))
     for j, name in enumerate(names):
-        col = np.array(
-            [np.nan if t.get(name) is None else float(t[name]) for t in terms_list], float
-        )
+        col = _column(terms_list, name)
         with np.errstate(invalid="ignore", divide="ignore"):
             col = FEATURES[name](col)
         col[np.isposinf(col)] = np.nanmax(np.where(np.isfinite(col), col, np.nan), initial=0.0)
@@ -189,9 +195,7 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=RIDGE):
         raise ValueError("a calibration needs both same- and different-person pairs")
     raw = {}
     for name in names:
-        col = np.array(
-            [np.nan if t.get(name) is None else float(t[name]) for t in terms_list], float
-        )
+        col = _column(terms_list, name)
         with np.errstate(invalid="ignore", divide="ignore"):
             col = FEATURES[name](col)
         if np.isfinite(col).sum() >= 2 and np.nanstd(np.where(np.isfinite(col), col, np.nan)) > 0:

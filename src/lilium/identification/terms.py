@@ -100,7 +100,26 @@ CALIBRATED_TERMS = (
     "cohort_sd",
     "skull_mean",
     "skull_sd",
+    "landmark_snorm",
 )
+
+
+def landmark_snorm(terms):
+    """The landmark term normalised by both cohorts (S-norm): ``(ln chi2 - cohort_mean) /
+    cohort_sd + (ln chi2 - skull_mean) / skull_sd``, how unusual the candidate's fit is for
+    this photo and for this skull at once; None when a part is missing. Derived from stored
+    terms (:data:`DERIVED_TERMS`), so it needs nothing computed again."""
+    parts = [terms.get(n) for n in ("landmark_chi2", *COHORT_TERMS)]
+    if any(v is None or not np.isfinite(v) for v in parts) or min(parts[2], parts[4]) <= 0:
+        return None
+    chi2, c_mean, c_sd, s_mean, s_sd = parts
+    log_chi2 = np.log(max(chi2, 1e-6))
+    return float((log_chi2 - c_mean) / c_sd + (log_chi2 - s_mean) / s_sd)
+
+
+#: Calibration features computed from the terms rather than stored with them:
+#: ``{name: function(terms dict) -> float or None}``.
+DERIVED_TERMS = {"landmark_snorm": landmark_snorm}
 
 
 @dataclass(frozen=True)
