@@ -319,7 +319,7 @@ def _nested_views_lr(pairs, added, decision_pairs, key, folds):
     fold ``k``'s own sums ``added`` (P,) of its cross-validated LRs. NaN where an SFO failed,
     or a fold's training pairs lack a class."""
     out = np.full(len(pairs), np.nan)
-    for _, training, test in subject_splits(pairs, folds):
+    for training, test in subject_splits(pairs, folds):
         inner_pairs, inner_lr = {}, {}
         for view in ("frontal", "lateral"):
             view_key = (key[0], key[1], view)

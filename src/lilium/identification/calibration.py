@@ -75,7 +75,8 @@ def _column(terms_list, name):
     """The raw values ``(P,)`` of one term (stored, or :data:`DERIVED_TERMS`), NaN where
     missing."""
     get = DERIVED_TERMS.get(name, lambda t: t.get(name))
-    return np.array([np.nan if get(t) is None else float(get(t)) for t in terms_list], float)
+    values = (get(t) for t in terms_list)
+    return np.array([np.nan if v is None else float(v) for v in values], float)
 
 
 def features(terms_list, names, fill):
@@ -242,17 +243,17 @@ def subject_folds(subjects, folds=FOLDS):
 
 
 def subject_splits(pairs, folds=FOLDS):
-    """The cross-validation's splits of ``pairs`` by subject: for each fold ``k``, ``(k,
-    training, test)`` with ``training(items)`` the items (pairs of any decision on the same
-    subjects) whose photo's subject and skull's subject are both outside fold ``k``, and
-    ``test`` the indices of the ``pairs`` whose photo's subject is in it."""
+    """The cross-validation's splits of ``pairs`` by subject: for each fold ``k``, ``(training,
+    test)`` with ``training(items)`` the items (pairs of any decision on the same subjects)
+    whose photo's subject and skull's subject are both outside fold ``k``, and ``test`` the
+    indices of the ``pairs`` whose photo's subject is in it."""
     fold_of = subject_folds([p["person"] for p in pairs] + [p["skull"] for p in pairs], folds)
     for k in sorted(set(fold_of.values())):
 
         def training(items, k=k):
             return [p for p in items if fold_of[p["person"]] != k and fold_of[p["skull"]] != k]
 
-        yield k, training, [i for i, p in enumerate(pairs) if fold_of[p["person"]] == k]
+        yield training, [i for i, p in enumerate(pairs) if fold_of[p["person"]] == k]
 
 
 def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS, ridge=RIDGE):
@@ -272,7 +273,7 @@ def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS, ridge=RIDGE):
         the two classes (too few pairs to calibrate).
     """
     out = np.full(len(pairs), np.nan)
-    for _, training, test in subject_splits(pairs, folds):
+    for training, test in subject_splits(pairs, folds):
         train = [p for p in training(pairs) if p["terms"] is not None]
         if not test or {p["same"] for p in train} != {True, False}:
             continue  # nothing to score, or too few pairs to fit: left NaN
