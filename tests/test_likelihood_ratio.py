@@ -520,3 +520,48 @@ def test_landmark_snorm_is_derived_from_the_stored_terms():
         p["terms"].update(cohort_mean=0.0, cohort_sd=1.0, skull_mean=0.0, skull_sd=1.0)
     model = fit([p["terms"] for p in pairs], [p["same"] for p in pairs])
     assert "landmark_snorm" in model.names
+
+
+def test_landmark_tension_is_what_a_camera_off_the_landmarks_costs():
+    """The landmarks' own best fit (``landmark_refit``) under a camera moved off the one that
+    fits them: the refit finds the landmark optimum again, so the tension grows with the
+    move, and is near 0 at the camera the landmarks were drawn with."""
+    from lilium.identification.cohort import refit_views
+    from lilium.identification.terms import CALIBRATED_TERMS, landmark_tension
+
+    rng = np.random.default_rng(8)
+    view = _view(rng)
+    cam = view.camera
+    tensions = []
+    for angle in (0.0, 0.01, 0.03):
+        moved = Camera.from_rt(_rotation([angle, 0.0, 0.0]) @ cam.R, cam.t, cam.focal_px,
+                               cam.principal_point_px)
+        chi2 = landmark_chi2([replace(view, camera=moved)])[0]
+        refit = landmark_chi2(refit_views([replace(view, camera=moved)]))[0]
+        assert refit <= chi2 + 1e-9  # the refit only accepts better fits
+        tensions.append(landmark_tension({"landmark_chi2": chi2, "landmark_refit": refit}))
+    assert tensions[0] < 0.1 < tensions[1] < tensions[2]
+    assert landmark_tension({"landmark_chi2": 1.0}) is None  # older terms: filled by the model
+    assert "landmark_tension" in CALIBRATED_TERMS
+
+
+def test_older_terms_are_completed_with_the_late_terms_only(case):
+    """Terms stored before the skull cohort and the landmarks' refit get those computed;
+    every stored term is kept as it was."""
+    from lilium.geometry.camera import principal_point_of
+    from lilium.identification.score import LATE_TERMS, identification_terms, with_late_terms
+    from lilium.io.calibration import shipped_cohort
+    from lilium.io.case import read_photo, read_skull
+
+    subject_dir, photo_dir = case
+    skull, photo = read_skull(subject_dir), read_photo(photo_dir)
+    truth = json.loads((photo_dir / "photo.json").read_text())["ground_truth"]
+    camera = Camera(np.array(truth["skull2cam"]), truth["focal_px"],
+                    principal_point_of(photo.image_size_wh))
+    full = identification_terms(skull, [photo], [camera], None, cohort=shipped_cohort())
+    old = {k: v for k, v in full.items() if k not in LATE_TERMS}
+    old["pll_face"] = 123.0  # a stored term is not computed again
+    done = with_late_terms(old, skull, [photo], [camera], cohort=shipped_cohort())
+    assert done["pll_face"] == 123.0
+    for name in LATE_TERMS:
+        assert done[name] == pytest.approx(full[name], rel=1e-9)

@@ -44,7 +44,7 @@ from ..identification.calibration import (
     subject_splits,
 )
 from ..identification.cohort import Cohort
-from ..identification.score import identification_terms, pll_face, with_skull_cohort
+from ..identification.score import LATE_TERMS, identification_terms, pll_face, with_late_terms
 from ..identification.terms import TERM_NAMES, eye_corner_px
 from ..inputs import correspondences
 from ..io.calibration import shipped_cohort
@@ -161,15 +161,12 @@ def _complete(terms):
     return terms is not None and all(name in terms for name in TERM_NAMES)
 
 
-#: The terms added last: stored terms lacking only these are completed, not computed again.
-SKULL_COHORT_TERMS = ("skull_mean", "skull_sd")
-
-
 def _completed(terms, skull, photos, cameras):
-    """Stored terms lacking only :data:`SKULL_COHORT_TERMS`, completed; else None."""
-    if terms is None or not all(n in terms for n in TERM_NAMES if n not in SKULL_COHORT_TERMS):
+    """Stored terms lacking only some of :data:`~lilium.identification.score.LATE_TERMS`,
+    completed; else None."""
+    if terms is None or not all(n in terms for n in TERM_NAMES if n not in LATE_TERMS):
         return None
-    return with_skull_cohort(terms, skull, photos, cameras, cohort=shipped_cohort())
+    return with_late_terms(terms, skull, photos, cameras, cohort=shipped_cohort())
 
 
 def single_terms(rows, inputs=None, cohort_cache=None):

@@ -170,6 +170,34 @@ def refit_cameras(R0, t0, f0, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
     return _cameras(R0, t0, f0, p)
 
 
+def refit_views(views):
+    """The candidate's views with each camera refitted to its photo's landmarks alone
+    (:func:`refit_cameras` from the SFO's camera): the best fit the landmarks allow this
+    skull, whatever its outline does on the photo.
+
+    Parameters
+    ----------
+    views : sequence of View
+
+    Returns
+    -------
+    list of View
+        The same views, each with its refitted camera.
+    """
+    refitted = []
+    for view in views:
+        cam = view.camera
+        R, t, f = refit_cameras(
+            cam.R[None], cam.t[None], np.array([cam.focal_px]), cam.principal_point_px,
+            view.cranial_mm[None], view.axes[None], view.depth_mean_mm, view.depth_sd_mm,
+            view.uv_px, landmark_sigma_px(view),
+        )
+        refitted.append(
+            replace(view, camera=Camera.from_rt(R[0], t[0], f[0], cam.principal_point_px))
+        )
+    return refitted
+
+
 def _aligned(views, cohort):
     """The cohort members with every landmark of ``views`` and the rigid fit ``(R, t)`` of each
     onto the candidate skull (cohort frame -> candidate frame, by their common landmarks)."""

@@ -15,9 +15,9 @@ from ..methods.checks import scd_point_mm
 from ..methods.lilium_terms import PllTerm, TermOff
 from ..softtissue.depths import depth_stats
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from .cohort import cohort_terms, skull_cohort_terms
+from .cohort import cohort_terms, refit_views, skull_cohort_terms
 from .terms import (
-    COHORT_TERMS,
+    REFERENCE_TERMS,
     TERM_NAMES,
     eye_corner_px,
     landmark_chi2,
@@ -56,14 +56,30 @@ def pll_face(skull, photo, camera, eye_px):
     return float(term(camera.as_batch())[0]) / eye_px
 
 
+def outside_fraction(skull, photo, camera):
+    """The share of the skull's pixels outside the photo's head mask under one camera (None
+    when the photo has no mask)."""
+    if photo.face_mask is None:
+        return None
+    counts = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
+    return counts.outside_px / counts.skull_px if counts.skull_px else 1.0
+
+
 def image_consistency(skull, photo, camera, eye_px):
     """``outside_fraction`` and ``pll_face`` of one photo under one camera (None when the
     photo has no mask / P_pll cannot apply)."""
-    outside = None
-    if photo.face_mask is not None:
-        counts = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
-        outside = counts.outside_px / counts.skull_px if counts.skull_px else 1.0
-    return outside, pll_face(skull, photo, camera, eye_px)
+    return outside_fraction(skull, photo, camera), pll_face(skull, photo, camera, eye_px)
+
+
+def refit_terms(skull, photos, views):
+    """``landmark_refit`` and ``outside_refit``: the candidate's landmark term and outside
+    fraction (mean over the photos with a mask) under cameras refitted to the landmarks alone
+    (:func:`lilium.identification.cohort.refit_views`)."""
+    refitted = refit_views(views)
+    outside = [outside_fraction(skull, photo, view.camera)
+               for photo, view in zip(photos, refitted, strict=True)]
+    outside = [o for o in outside if o is not None]
+    return float(landmark_chi2(refitted)[0]), (float(np.mean(outside)) if outside else None)
 
 
 def identification_terms(
@@ -127,6 +143,9 @@ def identification_terms(
     skull_mean = skull_sd = None
     if cohort is not None and np.isfinite(chi2):
         skull_mean, skull_sd = skull_cohort_terms(views, cohort)
+    refit = outside_refit = None
+    if np.isfinite(chi2):
+        refit, outside_refit = refit_terms(skull, photos, views)
     st = _soft_tissue_term(skull, facial_landmarks_mm or {}, depth_table)
 
     def mean(values):
@@ -147,6 +166,8 @@ def identification_terms(
         cohort_sd=cohort_sd,
         skull_mean=skull_mean,
         skull_sd=skull_sd,
+        landmark_refit=refit,
+        outside_refit=outside_refit,
     )
     assert tuple(out) == TERM_NAMES
     out["nll"] = nll
@@ -154,25 +175,41 @@ def identification_terms(
     return out
 
 
-def with_skull_cohort(terms, skull, photos, cameras, depth_table=None, cohort=None):
-    """Terms stored by a version before the skull cohort terms, completed: ``skull_mean`` and
-    ``skull_sd`` computed (:func:`lilium.identification.cohort.skull_cohort_terms`), every
-    other term kept as stored (arguments as in :func:`identification_terms`)."""
-    mean = sd = None
-    if cohort is not None and np.isfinite(terms.get("landmark_chi2") or np.nan):
-        views = [
-            make_view(camera, correspondences(skull, photo), photo.landmark_sources, depth_table)
-            for photo, camera in zip(photos, cameras, strict=True)
-        ]
-        mean, sd = skull_cohort_terms(views, cohort)
-    return {**terms, "skull_mean": mean, "skull_sd": sd}
+#: The terms added last, in the order they came: stored terms lacking only these are
+#: completed (:func:`with_late_terms`), not computed again.
+LATE_TERMS = ("skull_mean", "skull_sd", "landmark_refit", "outside_refit")
+
+
+def with_late_terms(terms, skull, photos, cameras, depth_table=None, cohort=None):
+    """Terms stored by an older version, completed: each of :data:`LATE_TERMS` they lack
+    computed (``skull_mean`` and ``skull_sd`` by
+    :func:`lilium.identification.cohort.skull_cohort_terms`, ``landmark_refit`` and
+    ``outside_refit`` by :func:`refit_terms`), every other term kept as stored
+    (arguments as in :func:`identification_terms`)."""
+    out = dict(terms)
+    missing = [n for n in LATE_TERMS if n not in terms]
+    if not missing:
+        return out
+    for name in missing:
+        out[name] = None
+    if not np.isfinite(terms.get("landmark_chi2") or np.nan):
+        return out
+    views = [
+        make_view(camera, correspondences(skull, photo), photo.landmark_sources, depth_table)
+        for photo, camera in zip(photos, cameras, strict=True)
+    ]
+    if cohort is not None and {"skull_mean", "skull_sd"} & set(missing):
+        out["skull_mean"], out["skull_sd"] = skull_cohort_terms(views, cohort)
+    if {"landmark_refit", "outside_refit"} & set(missing):
+        out["landmark_refit"], out["outside_refit"] = refit_terms(skull, photos, views)
+    return out
 
 
 def nll_score(terms):
     """The unweighted identification score (lower = more likely the same person): the
     landmarks' chi^2 per coordinate plus the other terms of the skull as they are (a None
-    counts 0; the cohort terms are left out: they say how to read the others)."""
-    return float(sum(terms[k] or 0.0 for k in TERM_NAMES if k not in COHORT_TERMS))
+    counts 0; the reference terms are left out: they say how to read the others)."""
+    return float(sum(terms[k] or 0.0 for k in TERM_NAMES if k not in REFERENCE_TERMS))
 
 
 def cameras_of(result):

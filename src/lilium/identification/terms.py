@@ -39,6 +39,14 @@ The terms (all "lower is better", dimensionless):
   candidate's ``ln landmark_chi2`` against the cohort's faces, each a noise-free photo with
   the real photo's landmarks under the SFO's camera (:func:`lilium.identification.cohort.
   skull_cohort_terms`); a skull that fits anyone's landmarks weighs its own fit less.
+- ``landmark_refit``: ``landmark_chi2`` of the candidate skull with each camera refitted to
+  its photo's landmarks alone (:func:`lilium.identification.cohort.refit_views`), the best the
+  landmarks allow whatever the outlines say. Not evidence by itself: the calibration reads
+  its gap to ``landmark_chi2`` (:func:`landmark_tension`), what the outlines cost the landmark
+  fit.
+- ``outside_refit``: ``outside_fraction`` under those refitted cameras: where the landmarks
+  alone would put this skull's outline. The true skull's lies inside its own face; a wrong
+  skull that fits the landmarks often pokes out of the head.
 
 A term whose input is missing (no mask, no curve, no prior) is None; the calibration
 (:mod:`lilium.identification.calibration`) reads a None as the term's typical value and says so.
@@ -80,6 +88,8 @@ TERM_NAMES = (
     "cohort_sd",
     "skull_mean",
     "skull_sd",
+    "landmark_refit",
+    "outside_refit",
 )
 
 #: The cohort terms: the photo(s) against other people's skulls, the skull against other
@@ -87,10 +97,15 @@ TERM_NAMES = (
 #: the calibration how to read ``landmark_chi2``.
 COHORT_TERMS = ("cohort_mean", "cohort_sd", "skull_mean", "skull_sd")
 
+#: The terms that say how to read ``landmark_chi2`` and are not evidence by themselves: the
+#: cohort terms and the landmarks' own best fit (left out of the unweighted score).
+REFERENCE_TERMS = (*COHORT_TERMS, "landmark_refit")
+
 #: The terms the calibration uses. ``soft_tissue_z2`` is reported but left out: measured on 20
 #: generated subjects (docs/method.md, Identification) it lowered Lilium's frontal per-photo
 #: AUC from 0.963 to 0.939; the soft tissue's plausibility is already in the marginal
-#: landmark term.
+#: landmark term. ``landmark_refit`` enters through its gap to ``landmark_chi2``
+#: (``landmark_tension``, docs/method.md: "The landmarks' own fit").
 CALIBRATED_TERMS = (
     "landmark_chi2",
     "outside_fraction",
@@ -101,6 +116,8 @@ CALIBRATED_TERMS = (
     "skull_mean",
     "skull_sd",
     "landmark_snorm",
+    "landmark_tension",
+    "outside_refit",
 )
 
 
@@ -117,9 +134,24 @@ def landmark_snorm(terms):
     return float((log_chi2 - c_mean) / c_sd + (log_chi2 - s_mean) / s_sd)
 
 
+def landmark_tension(terms):
+    """What the outlines cost the landmark fit: ``ln landmark_chi2 - ln landmark_refit``, the
+    candidate's landmark term under the SFO's camera(s) against the same skull's under cameras
+    refitted to the landmarks alone; None when either is missing or not finite.
+
+    For the true skull the camera that fits the outlines (P_skof, P_pll) also fits the
+    landmarks, so the two terms are close; a wrong skull whose landmarks could be fitted
+    only by a camera that puts its outline off the face pays for it here. Derived from
+    stored terms (:data:`DERIVED_TERMS`)."""
+    chi2, refit = terms.get("landmark_chi2"), terms.get("landmark_refit")
+    if chi2 is None or refit is None or not (np.isfinite(chi2) and np.isfinite(refit)):
+        return None
+    return float(np.log(max(chi2, 1e-6)) - np.log(max(refit, 1e-6)))
+
+
 #: Calibration features computed from the terms rather than stored with them:
 #: ``{name: function(terms dict) -> float or None}``.
-DERIVED_TERMS = {"landmark_snorm": landmark_snorm}
+DERIVED_TERMS = {"landmark_snorm": landmark_snorm, "landmark_tension": landmark_tension}
 
 
 @dataclass(frozen=True)
