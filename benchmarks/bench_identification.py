@@ -254,13 +254,14 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
 
 def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):
     """On the headsq CT (real anatomy, ``benchmarks/headsq_case.py``): its frontal and lateral
-    photo against its own skull and against a generated one, through ``lilium case`` (the full
-    budget, both methods): each photo's and the pair's conclusion. Skipped without the CT."""
+    photo against its own skull, complete and without the mandible, and against a generated
+    one, through ``lilium case`` (the full budget, both methods): each photo's and the pair's
+    conclusion. Skipped without the CT."""
     from headsq_case import build_headsq_dataset
     from lilium.casework.case import run_case
     from lilium.casework.identify import Calibrations, identify
 
-    root = build_headsq_dataset(Path(out_dir) / "dataset", 1, 0, variants=("hq",))
+    root = build_headsq_dataset(Path(out_dir) / "dataset", 1, 0, variants=("hq", "hq_nm"))
     if root is None:
         print("headsq CT not found (../shared/data/headsq): skipped", file=file)
         return
@@ -268,9 +269,13 @@ def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):
     print("| skull | method | decision | conclusion | log10 LR | capped by |", file=file)
     print("|---|---|---|---|---|---|", file=file)
     calibrations = Calibrations(calibration)
-    skulls = (("headsq (true)", root / "subjects" / "hq"), ("generated", other_skull))
-    for name, skull_dir in skulls:
-        entries = run_case(skull_dir, photos, Path(out_dir) / name.split()[0],
+    skulls = (
+        ("headsq (true)", "hq", root / "subjects" / "hq"),
+        ("headsq without mandible (true)", "hq_nm", root / "subjects" / "hq_nm"),
+        ("generated", "generated", other_skull),
+    )
+    for name, folder, skull_dir in skulls:
+        entries = run_case(skull_dir, photos, Path(out_dir) / folder,
                            methods=("lilium", "posest-sfo"), calibration=calibration,
                            log=lambda line: None)
         by_method = defaultdict(list)
