@@ -565,3 +565,44 @@ def test_older_terms_are_completed_with_the_late_terms_only(case):
     assert done["pll_face"] == 123.0
     for name in LATE_TERMS:
         assert done[name] == pytest.approx(full[name], rel=1e-9)
+
+
+def test_two_photos_reuse_each_photos_own_decision(case, tmp_path, monkeypatch):
+    """A frontal and a lateral photo's decision reads each photo's LR from the record its
+    result already carries (same calibration file and model), not from a second
+    computation; the decision is the one computed from scratch."""
+    from dataclasses import replace
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    import lilium.casework.identify as identify_module
+    from lilium.casework.identify import Calibrations, identify
+    from lilium.io.case import read_photo, read_skull
+
+    subject_dir, photo_dir = case
+    assert main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
+                 "--photo", str(photo_dir), "--out", str(tmp_path / "out")]) == 0
+    data = json.loads((tmp_path / "out" / "result.json").read_text())
+    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[], extra={},
+                             camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
+    skull, frontal = read_skull(subject_dir), read_photo(photo_dir)
+    lateral = replace(frontal, view="lateral_left")
+    calibrations = Calibrations()
+    scratch = identify(skull, [frontal, lateral], [result, result], calibrations)
+    # What with_identification stores in a result's extra.
+    own = [SimpleNamespace(**{**vars(result), "extra": {
+        "identification": identify(skull, [p], [result], calibrations)}})
+        for p in (frontal, lateral)]
+    calls = []
+    real = identify_module.identification_terms
+    monkeypatch.setattr(identify_module, "identification_terms",
+                        lambda *a, **k: calls.append(len(a[1])) or real(*a, **k))
+    reused = identify(skull, [frontal, lateral], own, calibrations)
+    assert calls == [2]  # the pair's own terms only
+    assert reused["log10_lr"] == pytest.approx(scratch["log10_lr"], abs=1e-12)
+    assert reused["views_log10_lr"] == pytest.approx(scratch["views_log10_lr"], abs=1e-12)
+    (tmp_path / "other.json").write_bytes(Path(calibrations.path).read_bytes())
+    other = Calibrations(tmp_path / "other.json")  # another file: computed again
+    calls.clear()
+    identify(skull, [frontal, lateral], own, other)
+    assert calls == [2, 1, 1]

@@ -75,6 +75,22 @@ def _inconsistent(results, terms):
     return out
 
 
+def _own_record(photo, result, calibrations):
+    """The photo's own decision already in its result (``extra["identification"]``, written by
+    :func:`with_identification` with the same calibration file and the photo's single-photo
+    model), or None: what ``identify(skull, [photo], [result], calibrations)`` would give,
+    not computed a second time."""
+    record = (getattr(result, "extra", None) or {}).get("identification")
+    if not record:
+        return None
+    calibration = record.get("calibration") or {}
+    same_file = calibration.get("file") == str(calibrations.path)
+    same_model = calibration.get("model") == decision_key(
+        result.method, result.variant, [photo], False
+    )
+    return record if same_file and same_model else None
+
+
 def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joint=False):
     """The ``"identification"`` record of one decision.
 
@@ -139,7 +155,8 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
     if adds_views(photos, joint):
         # Each photo's LR from its own SFO's soft tissue, as the views' models were fitted.
         parts = [
-            identify(skull, [p], [r], calibrations) for p, r in zip(photos, results, strict=True)
+            _own_record(p, r, calibrations) or identify(skull, [p], [r], calibrations)
+            for p, r in zip(photos, results, strict=True)
         ]
         lrs = [part["log10_lr"] for part in parts]
         lr, note = _views_lr(
