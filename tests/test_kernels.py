@@ -293,6 +293,46 @@ def test_pll_kernels_give_the_numpy_trims_pairs_and_terms(view):
     assert (terms.p_conv > 0).any()
 
 
+
+@needs_numba
+@pytest.mark.parametrize("view", ["frontal", "lateral_left", "lateral_right"])
+def test_pll_in_one_call_is_the_kernels_one_by_one(view):
+    """``PllContext.terms_cameras`` (one compiled call from the cameras to the terms) gives
+    the projection and the kernels called one by one, bit for bit, awkward cameras included."""
+    from lilium.fitness.pll_context import PllContext
+    from lilium.geometry.camera import Cameras
+
+    vertices, faces = shell_skull(n_lat=30, n_lon=40, rng=12)
+    low = vertices[faces].mean(axis=1)[:, 1] < -20.0
+    used, region = np.unique(faces[low], return_inverse=True)
+    vertices = vertices[used]
+    rng = np.random.default_rng(12)
+    turn = {"frontal": [0.3, 0, 0], "lateral_left": [0, -1.4, 0], "lateral_right": [0, 1.4, 0]}
+    R = np.array([rotvec_to_matrix(turn[view] + rng.normal(scale=0.05, size=3)) for _ in range(30)])
+    t = np.column_stack([rng.normal(scale=8.0, size=(30, 2)), rng.uniform(800, 900, 30)])
+    focal = t[:, 2] * rng.uniform(1.8, 2.2, 30)
+    R2, t2, focal2 = cameras(10, rng=13)  # far off, clipped, behind the camera
+    t2[0, 2] = -2000.0  # the whole region behind the camera: no curve
+    population = Cameras(
+        np.vstack([R, R2]), np.vstack([t, t2]), np.concatenate([focal, focal2]), CENTRE
+    )
+    span_mm = None if view == "frontal" else vertices[:2]
+    probe = PllContext.build(region.reshape(-1, 3), np.zeros((0, 2)), view, (HEIGHT, WIDTH))
+    c = probe.skull_curve(population[0].project(vertices))
+    face = c[len(c) // 5 : len(c) - len(c) // 6] + [3.0, 5.0]
+    context = PllContext.build(region.reshape(-1, 3), face, view, (HEIGHT, WIDTH))
+    one_call = context.terms_cameras(vertices, population, span_mm)
+    span_v = None if span_mm is None else population.project(span_mm)[..., 1]
+    by_steps = context.terms_batch(population.project(vertices), span_v)
+    for a, b in zip(vars(one_call).values(), vars(by_steps).values(), strict=True):
+        assert a.dtype == b.dtype
+        np.testing.assert_array_equal(a, b)
+    assert (by_steps.n_pairs > 0).sum() >= 20 and (by_steps.n_pairs == 0).any()
+    with jit.kernels("numpy"):  # the numpy path: projection and steps in numpy, same terms
+        reference = context.terms_cameras(vertices, population, span_mm)
+    np.testing.assert_array_equal(reference.n_pairs, by_steps.n_pairs)
+    np.testing.assert_allclose(reference.total, by_steps.total, rtol=1e-9)
+
 @needs_numba
 def test_distance_to_background_is_scipys_exactly():
     """The compiled distance transform of the face mask index is scipy's EDT, exactly."""

@@ -61,6 +61,33 @@ def edge_face_table(topology):
 
 
 @njit
+def _contour_edges(um, vm, corners, edge_face, edge_dir, sign, mult, touched):
+    """One member's contour edges: the face signs ``sign`` (F + 1,) of the projected faces,
+    then each edge's multiplicity ``mult[e]`` (the sum of ``sign[f] * dir`` over its faces) and
+    the edges where it is not 0 in ``touched``; returns their count."""
+    for f in range(corners.shape[1]):
+        i0, i1, i2 = corners[0, f], corners[1, f], corners[2, f]
+        du1, dv1 = um[i1] - um[i0], vm[i1] - vm[i0]
+        du2, dv2 = um[i2] - um[i0], vm[i2] - vm[i0]
+        area = du1 * dv2 - du2 * dv1
+        sign[f] = 1.0 if area > 0.0 else (-1.0 if area < 0.0 else 0.0)
+    E, D = edge_face.shape
+    n_touched = 0
+    for e in range(E):
+        if D == 2:  # a manifold region: no inner loop
+            w = sign[edge_face[e, 0]] * edge_dir[e, 0] + sign[edge_face[e, 1]] * edge_dir[e, 1]
+        else:
+            w = 0.0
+            for k in range(D):
+                w += sign[edge_face[e, k]] * edge_dir[e, k]
+        if w != 0.0:
+            mult[e] = w
+            touched[n_touched] = e
+            n_touched += 1
+    return n_touched
+
+
+@njit
 def boundary_kernel(u, v, corners, edge_face, edge_dir, edges_a, edges_b, lo, hi, todo, view):
     """Skin-side boundary pixels of S projected regions.
 
@@ -93,7 +120,6 @@ def boundary_kernel(u, v, corners, edge_face, edge_dir, edges_a, edges_b, lo, hi
     S = u.shape[0]
     F = corners.shape[1]
     E = edges_a.shape[0]
-    D = edge_face.shape[1]
     sign = np.zeros(F + 1)  # sign[F] = 0: the padding face of edge_face
     mult = np.zeros(E)
     touched = np.empty(E, np.int64)
@@ -103,30 +129,20 @@ def boundary_kernel(u, v, corners, edge_face, edge_dir, edges_a, edges_b, lo, hi
     runs = np.empty((1024, 3), np.int64)
     out_member = np.empty(1024, np.int64)
     out = np.empty((1024, 2))
+    # Per-member scratch, allocated once for the largest window.
+    size = 0
+    for m in range(S):
+        if todo[m]:
+            size = max(size, hi[m, 0] - lo[m, 0] + 1, hi[m, 1] - lo[m, 1] + 2)
+    row_start = np.empty(size + 1, np.int64)
+    lowest = np.empty(size, np.int64)
+    nxt = np.empty(size + 1, np.int64)
     total = 0
     for m in range(S):
         if not todo[m]:
             continue
         um, vm = u[m], v[m]
-        for f in range(F):
-            i0, i1, i2 = corners[0, f], corners[1, f], corners[2, f]
-            du1, dv1 = um[i1] - um[i0], vm[i1] - vm[i0]
-            du2, dv2 = um[i2] - um[i0], vm[i2] - vm[i0]
-            area = du1 * dv2 - du2 * dv1
-            sign[f] = 1.0 if area > 0.0 else (-1.0 if area < 0.0 else 0.0)
-        n_touched = 0
-        for e in range(E):
-            if D == 2:
-                w = sign[edge_face[e, 0]] * edge_dir[e, 0]
-                w += sign[edge_face[e, 1]] * edge_dir[e, 1]
-            else:
-                w = 0.0
-                for k in range(D):
-                    w += sign[edge_face[e, k]] * edge_dir[e, k]
-            if w != 0.0:
-                mult[e] = w
-                touched[n_touched] = e
-                n_touched += 1
+        n_touched = _contour_edges(um, vm, corners, edge_face, edge_dir, sign, mult, touched)
         u0, v0 = lo[m, 0], lo[m, 1]
         w, h = hi[m, 0] - u0, hi[m, 1] - v0
         buf, n = edge_crossings(
@@ -149,7 +165,7 @@ def boundary_kernel(u, v, corners, edge_face, edge_dir, edges_a, edges_b, lo, hi
                 runs[n_runs, 1] = start - u0
                 runs[n_runs, 2] = stop - u0
                 n_runs += 1
-        row_start = np.zeros(h + 2, np.int64)  # runs of window row r: row_start[r]..[r + 1]
+        row_start[: h + 2] = 0  # runs of window row r: row_start[r]..[r + 1]
         for k in range(n_runs):
             row_start[runs[k, 0] + 1] += 1
         for r in range(h + 1):
@@ -165,8 +181,9 @@ def boundary_kernel(u, v, corners, edge_face, edge_dir, edges_a, edges_b, lo, hi
             out_member = grown_m
         if view == 0:
             # Rows bottom-up; nxt[c] leads to the first column >= c without a boundary pixel.
-            lowest = np.full(w, -1, np.int64)
-            nxt = np.arange(w + 1)
+            lowest[:w] = -1
+            for c in range(w + 1):
+                nxt[c] = c
             for r in range(h - 1, -1, -1):
                 for k in range(row_start[r], row_start[r + 1]):
                     c = _find(nxt, runs[k, 1])

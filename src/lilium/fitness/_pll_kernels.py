@@ -15,7 +15,9 @@ import math
 
 import numpy as np
 
+from ..geometry._projection_kernels import pinhole
 from ..jit import njit
+from ._curve_kernels import boundary_kernel, span_join_kernel, windows_kernel
 
 #: Fraction of a curve's length whose mean tangent defines its end normal (pll.END_FRACTION).
 END_FRACTION = 0.2
@@ -307,3 +309,60 @@ def terms_kernel(skull, face, distance, offset, side, no_curve):
         p_int[m] = INTERSECTION_WEIGHT * bad
         total[m] = delta_d[m] + conv + p_int[m]
     return delta_d, p_conv, p_int, total, n_pairs
+
+
+@njit
+def population_kernel(
+    vertices, span_mm, has_span, R, t, f, c0, c1, height, width, max_window,
+    corners, edge_face, edge_dir, edges_a, edges_b, view,
+    face, ends, has_ends, table, u0, v0, side, no_curve,
+):  # fmt: skip
+    """P_pll of a region under ``S`` cameras in one call: the projection, the skull curves
+    (:func:`~lilium.fitness._curve_kernels.windows_kernel`, ``boundary_kernel``,
+    ``span_join_kernel``) and the three steps (:func:`trim_kernel`, :func:`pair_kernel`,
+    :func:`terms_kernel`), the kernels :meth:`lilium.fitness.pll_context.PllContext.terms_batch`
+    calls one by one, in the same order on the same arrays (so the same numbers).
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (K, 3)
+        The region's vertices (skull frame, mm).
+    span_mm : ndarray of shape (2, 3)
+        Glabella and metopion (the forehead's span, when ``has_span``).
+    R, t, f : ndarray of shape (S, 3, 3), (S, 3), (S,)
+    c0, c1 : float
+        Principal point.
+    height, width : int
+        The image (``height`` < 0: no image to clip the windows to).
+    max_window : int
+    corners, edge_face, edge_dir, edges_a, edges_b, view
+        As :func:`~lilium.fitness._curve_kernels.boundary_kernel`.
+    face, ends, has_ends, table, u0, v0, side, no_curve
+        As :func:`trim_kernel`, :func:`pair_kernel` and :func:`terms_kernel`.
+
+    Returns
+    -------
+    delta_d, p_conv, p_int, total, n_pairs : ndarray of shape (S,)
+    """
+    S, K = R.shape[0], vertices.shape[0]
+    u = np.empty((S, K))
+    v = np.empty((S, K))
+    span_v = np.zeros((S, 2))
+    for s in range(S):
+        for k in range(K):
+            x, y, z = vertices[k, 0], vertices[k, 1], vertices[k, 2]
+            u[s, k], v[s, k] = pinhole(x, y, z, R[s], t[s], f[s], c0, c1)
+        if has_span:
+            for j in range(2):
+                x, y, z = span_mm[j, 0], span_mm[j, 1], span_mm[j, 2]
+                span_v[s, j] = pinhole(x, y, z, R[s], t[s], f[s], c0, c1)[1]
+    lo, hi, empty, _ = windows_kernel(u, v, height, width, max_window)
+    member, points = boundary_kernel(
+        u, v, corners, edge_face, edge_dir, edges_a, edges_b, lo, hi, ~empty, view
+    )
+    points, offset = span_join_kernel(member, points, span_v, has_span, S)
+    points, offset, face_lo, face_hi = trim_kernel(points, offset, face, ends, has_ends)
+    skull, face_xy, distance, pair_offset = pair_kernel(
+        points, offset, face, face_lo, face_hi, table, u0, v0
+    )
+    return terms_kernel(skull, face_xy, distance, pair_offset, side, no_curve)

@@ -7,10 +7,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import jit
 from ..imaging.raster import mesh_edge_topology
-from ._curve_kernels import edge_face_table
-from .curves import check_view, detect_curves_batch, refine_curve
-from .pll import FaceCurveIndex, _failed, face_curve_index, pll_terms_batch
+from ._curve_kernels import VIEW_CODES, edge_face_table
+from ._pll_kernels import SIDE_CODES, population_kernel
+from .curves import MAX_WINDOW_PX, check_view, detect_curves_batch, refine_curve
+from .pll import PLL_NO_CURVE, FaceCurveIndex, PllTerms, _failed, face_curve_index, pll_terms_batch
 
 
 @dataclass(frozen=True)
@@ -97,6 +99,66 @@ class PllContext:
             self.face_index if self.face_index is not None else face_curve_index(self.face_curve)
         )
         return pll_terms_batch(self.skull_curves(region_uv, span_v), index, self.view)
+
+    def terms_cameras(self, vertices_mm, cameras, span_mm=None):
+        """:meth:`terms_batch` of the region's vertices projected by a population's cameras.
+
+        Compiled, the projection, the curves and the terms run in one call
+        (:func:`~lilium.fitness._pll_kernels.population_kernel`, the same kernels in the same
+        order as :meth:`terms_batch`: the same numbers, without the glue between them).
+
+        Parameters
+        ----------
+        vertices_mm : ndarray of shape (K, 3)
+            The region's vertices (skull frame), indexed by :attr:`faces`.
+        cameras : lilium.geometry.camera.Cameras
+            ``S`` cameras.
+        span_mm : ndarray of shape (2, 3), optional
+            Forehead only: the cranial glabella and metopion.
+        """
+        S = len(cameras)
+        if not (jit.compiled() and S and self.topology.n_faces and len(self.face_curve)):
+            uv = cameras.project(vertices_mm)
+            span_v = None if span_mm is None else cameras.project(span_mm)[..., 1]
+            return self.terms_batch(uv, span_v)
+        index = self.face_index
+        if index is None:
+            index = face_curve_index(self.face_curve)
+        edge_face, edge_dir = (
+            edge_face_table(self.topology) if self.edge_faces is None else self.edge_faces
+        )
+        height, width = (-1, -1) if self.image_shape is None else self.image_shape
+        c = np.asarray(cameras.principal_point_px, dtype=float)
+        has_ends = index.ends is not None
+        return PllTerms(
+            *population_kernel(
+                np.ascontiguousarray(vertices_mm, dtype=float),
+                np.zeros((2, 3)) if span_mm is None else np.asarray(span_mm, dtype=float),
+                span_mm is not None,
+                np.ascontiguousarray(cameras.R, dtype=float),
+                np.ascontiguousarray(cameras.t, dtype=float),
+                np.ascontiguousarray(cameras.focal_px, dtype=float),
+                float(c[0]),
+                float(c[1]),
+                int(height),
+                int(width),
+                MAX_WINDOW_PX,
+                self.topology.corners,
+                edge_face,
+                edge_dir,
+                self.topology.edges_a,
+                self.topology.edges_b,
+                VIEW_CODES[self.view],
+                np.ascontiguousarray(index.curve, dtype=float),
+                np.array(index.ends, float) if has_ends else np.zeros((4, 2)),
+                has_ends,
+                np.ascontiguousarray(index.table, np.int64),
+                int(index.origin[0]),
+                int(index.origin[1]),
+                SIDE_CODES[self.view],
+                PLL_NO_CURVE,
+            )
+        )
 
     def evaluate_batch(self, region_uv, span_v=None):
         """Totals ``(S,)`` for a population: ``region_uv`` (S, K, 2), ``span_v`` (S, 2) or None."""

@@ -205,9 +205,7 @@ class PllTerm:
 
     def parts(self, cameras):
         """:class:`~lilium.fitness.pll.PllTerms` (fields ``(S,)``) under ``cameras``."""
-        uv = cameras.project(self.region_vertices_mm)
-        span_v = None if self.span_mm is None else cameras.project(self.span_mm)[..., 1]
-        return self.context.terms_batch(uv, span_v)
+        return self.context.terms_cameras(self.region_vertices_mm, cameras, self.span_mm)
 
     def curves(self, camera):
         """Skull and face curves ``(K, 2)``, ``(M, 2)`` under one :class:`Camera` (overlays)."""
