@@ -576,3 +576,21 @@ def test_camera_checks_kernel_matches_the_numpy_rules():
     assert camera_checks_kernel(
         R, t, none_ok, cost, sq.copy(), origin, anterior, rule.cos_max, cap, run_off, True
     )[0]
+
+
+@needs_numba
+@pytest.mark.parametrize("cell_mm", [0.5, 4.0, 2000.0])
+def test_vertex_clustering_kernel_is_numpys_bit_for_bit(cell_mm):
+    """Dense cell numbering (a compact shell) and sorted numbering (a few vertices spread over a
+    bounding box of far more cells than the table may hold)."""
+    from lilium.geometry.mesh import cluster_vertices
+
+    vertices, faces = shell_skull(n_lat=30, n_lon=40, rng=14)
+    spread = np.vstack([vertices, vertices[:50] * 400.0])
+    for v, f in ((vertices, faces), (spread, faces)):
+        compiled = cluster_vertices(v, f, cell_mm)
+        with jit.kernels("numpy"):
+            reference = cluster_vertices(v, f, cell_mm)
+        for a, b in zip(compiled, reference, strict=True):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import jit
 from ..constants import MIN_DEPTH_MM
 from ..geometry._projection_kernels import pinhole
 from ..imaging._raster_kernels import accumulate_face, edge_crossings, sort_rows
@@ -256,6 +257,17 @@ class SkofScratch:
         return first
 
 
+@njit
+def _centroids(vertices_mm, faces):
+    """Face centroids ``(F, 3)``: ``vertices_mm[faces].mean(axis=1)``, the same sums."""
+    out = np.empty((faces.shape[0], 3))
+    for f in range(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        for k in range(3):
+            out[f, k] = (vertices_mm[a, k] + vertices_mm[b, k] + vertices_mm[c, k]) / 3.0
+    return out
+
+
 def face_clusters(vertices_mm, faces, leaf_faces=LEAF_FACES, fan_out=FAN_OUT):
     """Build the :class:`FaceClusters` of a mesh (once per skull).
 
@@ -271,7 +283,12 @@ def face_clusters(vertices_mm, faces, leaf_faces=LEAF_FACES, fan_out=FAN_OUT):
     vertices_mm = np.asarray(vertices_mm, dtype=float)
     faces = np.asarray(faces, dtype=np.int64)
     n = len(faces)
-    centroids = vertices_mm[faces].mean(axis=1) if n else np.zeros((0, 3))
+    if not n:
+        centroids = np.zeros((0, 3))
+    elif jit.compiled():
+        centroids = _centroids(vertices_mm, faces)
+    else:
+        centroids = vertices_mm[faces].mean(axis=1)
     order = (
         _kd_order(np.ascontiguousarray(centroids), int(leaf_faces)) if n else np.zeros(0, np.int64)
     )

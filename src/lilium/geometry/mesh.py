@@ -6,6 +6,9 @@ synthetic generator and the fitness terms alike.
 
 import numpy as np
 
+from .. import jit
+from ._mesh_kernels import cluster_kernel
+
 
 def keep_largest_component(vertices, faces):
     """Keep the connected component with the most faces (vertices re-indexed).
@@ -83,10 +86,14 @@ def cluster_vertices(vertices_mm, faces, cell_mm):
         The faces whose corners stay in three different cells (orientation kept).
     """
     v = np.asarray(vertices_mm, float)
+    dense_limit = 4 * len(v) + 1e6  # cells of the bounding box numbered through a table
+    if jit.compiled() and len(v):  # the same steps, compiled (geometry/_mesh_kernels.py)
+        faces = np.ascontiguousarray(faces, dtype=np.int64)
+        return cluster_kernel(np.ascontiguousarray(v), faces, float(cell_mm), dense_limit)
     key = np.floor((v - v.min(axis=0)) / cell_mm).astype(np.int64)
     dims = key.max(axis=0) + 1
     flat = (key[:, 0] * dims[1] + key[:, 1]) * dims[2] + key[:, 2]
-    if np.prod(dims.astype(float)) <= 4 * len(v) + 1e6:
+    if np.prod(dims.astype(float)) <= dense_limit:
         # Dense cells: ids in cell order without sorting.
         used = np.zeros(int(np.prod(dims)), bool)
         used[flat] = True
