@@ -190,13 +190,13 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
     """
     R = np.array(R, dtype=float)
     S = R.shape[0]
+    if jit.compiled():  # the same iterations, compiled (pose/_refine_kernels.py)
+        return _refine_compiled(uv_centred_px, points_mm, weights, R, t, focal_px, options)
     P = np.broadcast_to(np.asarray(points_mm, dtype=float), (S,) + np.shape(points_mm)[-2:])
     N = P.shape[1]
     uv_c = np.broadcast_to(np.asarray(uv_centred_px, dtype=float), (S, N, 2))
     w = np.ones((S, N)) if weights is None else np.broadcast_to(np.asarray(weights, float), (S, N))
     t = np.array(np.broadcast_to(np.asarray(t, dtype=float), (S, 3)))  # the caller's copy
-    if jit.compiled():  # the same iterations, compiled (pose/_refine_kernels.py)
-        return _refine_compiled(uv_c, P, w, R, t, focal_px, options)
     w_sqrt = np.sqrt(w)
     log_f = np.log(np.asarray(focal_px, dtype=float))
 
@@ -267,15 +267,30 @@ def refine_batch(uv_centred_px, points_mm, R, t, focal_px, weights=None, options
     return BatchRefineResult(R, t, np.exp(log_f), sq, cost, iteration)
 
 
+def _batched(a, shape):
+    """``a`` as a writeable C array of floats of ``shape``: itself when it is one already, else
+    a broadcast copy (one compiled signature for every call)."""
+    a = np.asarray(a, dtype=float)
+    if a.shape == shape and a.flags.c_contiguous and a.flags.writeable:
+        return a
+    return np.ascontiguousarray(np.broadcast_to(a, shape))
+
+
 def _refine_compiled(uv_c, P, w, R, t, focal_px, options):
-    """:func:`refine_batch` by :func:`~lilium.pose._refine_kernels.refine_kernel` (``R`` and
-    ``t`` are the caller's copies, refined in place)."""
-    f = np.array(np.broadcast_to(np.asarray(focal_px, dtype=float), (len(R),)))
-    # Writeable C arrays (a broadcast view is read-only): one compiled signature, not two.
+    """:func:`refine_batch` by :func:`~lilium.pose._refine_kernels.refine_kernel` (``R`` is the
+    caller's copy, refined in place; ``uv_c``, ``P``, ``w`` and ``t`` as :func:`refine_batch`
+    takes them)."""
+    S = len(R)
+    P = _batched(P, (S,) + np.shape(P)[-2:])
+    N = P.shape[1]
+    uv_c = _batched(uv_c, (S, N, 2))
+    w = np.ones((S, N)) if w is None else _batched(w, (S, N))
+    t = np.array(np.broadcast_to(np.asarray(t, dtype=float), (S, 3)))  # the caller's copy
+    f = np.array(np.broadcast_to(np.asarray(focal_px, dtype=float), (S,)))
     cost, iterations, sq = refine_kernel(
-        np.require(uv_c, float, ["C", "W"]),
-        np.require(P, float, ["C", "W"]),
-        np.require(w, float, ["C", "W"]),
+        uv_c,
+        P,
+        w,
         R,
         t,
         f,
