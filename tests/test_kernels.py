@@ -594,3 +594,39 @@ def test_vertex_clustering_kernel_is_numpys_bit_for_bit(cell_mm):
         for a, b in zip(compiled, reference, strict=True):
             assert a.dtype == b.dtype
             np.testing.assert_array_equal(a, b)
+
+
+@needs_numba
+def test_camera_stage_in_one_call_is_the_steps_one_by_one(case):
+    """A generation's camera terms in one compiled call (``LiliumProblem.evaluate`` with
+    members) equal the kernels called one by one (``camera_terms``) bit for bit: members
+    lending their camera to those without one, a warm start that breaks (a camera behind the
+    skull: its own POSEST on the numpy path), the capped fit noted."""
+    from lilium.io.case import read_photo, read_skull
+    from lilium.methods import SfoOptions
+    from lilium.methods.lilium import LiliumProblem
+
+    skull, photo = read_skull(case[0]), read_photo(case[1])
+    results = []
+    for one_call in (True, False):
+        problem = LiliumProblem(skull, photo, SfoOptions("base"), rng=0)
+        genes = np.random.default_rng(15).random((60, problem.cones.n_genes))
+        first = problem.evaluate(genes)
+        members = {k: np.asarray(first[k])[::-1].copy() for k in ("R", "t", "focal_px", "success")}
+        members["success"][:5] = False  # they take the first valid member's camera
+        trials = np.random.default_rng(16).random(genes.shape)
+        for broken in (False, True):
+            if broken:
+                members["t"][7] = [0.0, 0.0, -1000.0]  # behind the skull: the refinement breaks
+                members["success"][7] = True
+            if one_call:
+                terms = problem.evaluate(trials, members)
+            else:
+                terms = problem.camera_terms(problem.facial_landmarks(trials), members)
+            results.append((terms, problem.n_fallbacks, problem.capped_mse))
+    for (a, fa, ma), (b, fb, mb) in zip(results[:2], results[2:], strict=True):
+        assert fa == fb and ma == mb
+        for key in ("fitness", "mse_pix", "p_cam", "R", "t", "focal_px", "success"):
+            np.testing.assert_array_equal(a[key], b[key])
+    assert results[0][1] == 0 and results[1][1] > 0  # the broken start went to POSEST
+    assert results[0][0]["success"].any() and not results[0][0]["success"].all()

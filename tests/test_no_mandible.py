@@ -71,6 +71,15 @@ def _runs_off(monkeypatch, own_posest=False):
         )
 
     monkeypatch.setattr(lilium, "refine_batch", run_off)
+    # The compiled camera stage refines inside its kernel: take the steps one by one (the same
+    # numbers, tests/test_kernels.py) so that the patched refinement applies.
+    monkeypatch.setattr(
+        lilium,
+        "camera_terms_compiled",
+        lambda problem, genes, members: problem.camera_terms(
+            problem.facial_landmarks(genes), members
+        ),
+    )
     if not own_posest:
         monkeypatch.setattr(lilium.LiliumProblem, "_posest", lambda self, facial_mm: None)
 

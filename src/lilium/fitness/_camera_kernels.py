@@ -16,6 +16,8 @@ import numpy as np
 from ..constants import C_INF, FOCAL_MIN_PX
 from ..geometry._rotation_kernels import relative_angle_axis
 from ..jit import njit
+from ..pose._refine_kernels import refine_kernel
+from ..softtissue._cone_kernels import decode_kernel
 
 
 @njit
@@ -163,3 +165,83 @@ def camera_checks_kernel(R, t, f, cost, sq, origin, anterior, cos_max, cap, run_
             for n in range(N):
                 sq[s, n] = np.inf
     return True, ok, capped, capped_mse
+
+
+@njit
+def camera_stage_kernel(
+    genes, cranial, cones, uv, w, R0, t0, f0, success, refine, origin, anterior, cos_max, cap,
+    run_off_cap, scd_index, focal, scd, head, tol,
+):  # fmt: skip
+    """The cheap terms of a population of trials in one call: its facial landmarks (the
+    genes decoded, :func:`~lilium.softtissue._cone_kernels.decode_kernel`), its cameras refined
+    from the members' (:func:`~lilium.pose._refine_kernels.refine_kernel`), their checks
+    (:func:`camera_checks_kernel`) and MSE_pix and P_cam (:func:`camera_terms_kernel`): the
+    kernels :meth:`lilium.methods.lilium.LiliumProblem.camera_terms` calls one by one, in the
+    same order on the same arrays.
+
+    Parameters
+    ----------
+    genes : ndarray of shape (S, 3N)
+    cranial : ndarray of shape (N, 3)
+    cones : tuple
+        :func:`lilium.softtissue.cones.decode_arguments`.
+    uv, w : ndarray of shape (S, N, 2), (S, N)
+        Centred landmarks and weights of the refinement.
+    R0, t0, f0 : ndarray of shape (S, 3, 3), (S, 3), (S,)
+        The members' cameras (not changed): each trial starts from its member's.
+    success : ndarray of shape (S,) of bool
+        The members with a valid camera; the others start from the first valid one's.
+    refine : tuple
+        ``(min_rms_px, max_iterations, initial_lambda, cost_tol, gradient_tol, max_lambda,
+        log_focal_stop)`` of :class:`lilium.pose.refine.RefineOptions`.
+    origin, anterior, cos_max, cap, run_off_cap
+        As :func:`camera_checks_kernel` (``lender``: some member has a valid camera).
+    scd_index : ndarray of shape (K,) of int64
+        The landmarks whose mean is the SCD's centre.
+    focal, scd, head, tol
+        As :func:`camera_terms_kernel` (``cap`` the same).
+
+    Returns
+    -------
+    facial, R, t, f, cost, sq
+        Facial landmarks ``(S, N, 3)``, refined cameras, refinement cost ``(S,)``, squared
+        errors ``(S, N)``.
+    done : bool
+        False when a camera must be replaced by its own POSEST (the numpy path does that from
+        the refined cameras; the outputs below are then not computed).
+    ok : ndarray of shape (S,) of bool
+    capped, capped_mse : int, float
+    mse_pix, p_cam : ndarray of shape (S,)
+    """
+    S, N = w.shape
+    facial = decode_kernel(genes, *cones)
+    for s in range(S):
+        for n in range(N):
+            for j in range(3):
+                facial[s, n, j] = cranial[n, j] + facial[s, n, j]
+    R, t, f = R0.copy(), t0.copy(), f0.copy()
+    lent = -1
+    for s in range(S):
+        if success[s]:
+            lent = s
+            break
+    if lent >= 0:
+        for s in range(S):
+            if not success[s]:
+                R[s], t[s], f[s] = R0[lent], t0[lent], f0[lent]
+    cost, _, sq = refine_kernel(uv, facial, w, R, t, f, *refine)
+    done, ok, capped, capped_mse = camera_checks_kernel(
+        R, t, f, cost, sq, origin, anterior, cos_max, cap, run_off_cap, lent >= 0
+    )
+    mse, p_cam = np.empty(S), np.empty(S)
+    if done:
+        K = scd_index.shape[0]
+        centre = np.zeros((S, 3))
+        for s in range(S):
+            for j in range(3):
+                total = facial[s, scd_index[0], j]
+                for k in range(1, K):
+                    total += facial[s, scd_index[k], j]
+                centre[s, j] = total / K if K > 1 else total
+        mse, p_cam = camera_terms_kernel(sq, ok, R, t, f, centre, focal, scd, head, tol, cap)
+    return facial, R, t, f, cost, sq, done, ok, capped, capped_mse, mse, p_cam

@@ -31,7 +31,7 @@ import numpy as np
 
 from .. import jit
 from ..constants import C_INF, FOCAL_MIN_PX, focal_cap_px
-from ..fitness._camera_kernels import camera_checks_kernel, camera_terms_kernel
+from ..fitness._camera_kernels import camera_terms_kernel
 from ..fitness.camera_penalty import camera_penalty_from_priors, prior_arrays
 from ..geometry.camera import Cameras, principal_point_of
 from ..inputs import correspondences
@@ -42,6 +42,7 @@ from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode, encode_depth_only, make_cones, midsagittal_plane
 from ..softtissue.depths import depth_stats
 from .checks import facing_check
+from .lilium_cameras import camera_terms_compiled, checks_compiled
 from .lilium_outcome import outcome_fitness, photo_outcome
 from .lilium_terms import image_terms, prior_terms_off
 from .options import SfoOptions, with_focal_cap
@@ -128,6 +129,7 @@ class LiliumProblem:
         # Lowest MSE (px^2) of a camera refused for the focal cap, and its focal length.
         self.capped_mse, self.capped_focal_px = np.inf, None
         self.prior_arrays = prior_arrays(photo.priors)
+        self._stage = {}  # camera_stage_kernel's fixed arguments, per population size
 
     def level_extra(self):
         """The working level of the DE and the result's outside count, for ``SfoResult.extra``:
@@ -202,12 +204,18 @@ class LiliumProblem:
                 j = np.flatnonzero(ok)[0]
                 R0[~ok], t0[~ok], f0[~ok] = R0[j], t0[j], f0[j]
         ref = refine_batch(self.uv_c, facial_mm, R0, t0, f0, options=self.options.refine)
-        R, t, f = ref.R, ref.t, ref.focal_px
         lender = members is not None and bool(np.any(members["success"]))
         if jit.compiled():  # the checks below, compiled, unless a camera must be replaced
-            ok = self._checks_compiled(ref, lender)
+            ok = checks_compiled(self, ref, lender)
             if ok is not None:
-                return R, t, f, ok, ref.sq_err_px2
+                return ref.R, ref.t, ref.focal_px, ok, ref.sq_err_px2
+        return self._checked(facial_mm, ref, lender)
+
+    def _checked(self, facial_mm, ref, lender):
+        """:meth:`cameras`' checks of refined cameras ``ref`` (:class:`BatchRefineResult`) on
+        the numpy path, each broken camera replaced by its own POSEST; ``lender``: some member
+        has a valid camera. Returns :meth:`cameras`' tuple."""
+        R, t, f = ref.R, ref.t, ref.focal_px
         # Numerical failure (a point behind the camera): fall back to full POSEST.
         broken = ~np.isfinite(ref.cost) | ~np.all(np.isfinite(ref.sq_err_px2), axis=1)
         self._own_posest(facial_mm, R, t, f, broken, broken)
@@ -238,28 +246,6 @@ class LiliumProblem:
         self._note_capped(f, facing, sq)
         sq[~ok] = np.inf
         return R, t, f, ok, sq
-
-    def _checks_compiled(self, ref, lender):
-        """:meth:`cameras`' checks of refined cameras by
-        :func:`~lilium.fitness._camera_kernels.camera_checks_kernel`: the validity ``(S,)``
-        (``ref.sq_err_px2`` set to inf where invalid, the best capped fit noted), or None when
-        a camera must be replaced by its own POSEST (the numpy path does that)."""
-        rule = self.facing
-        if rule is None:
-            origin, anterior, cos_max = np.zeros(3), np.zeros(3), np.nan
-        else:
-            origin, anterior = rule.directions.origin_mm, rule.directions.anterior
-            cos_max = rule.cos_max
-        cap = self.focal_cap_px
-        done, ok, k, mse = camera_checks_kernel(
-            ref.R, ref.t, ref.focal_px, ref.cost, ref.sq_err_px2, origin, anterior, cos_max,
-            cap, RUN_OFF_FACTOR * cap, lender,
-        )  # fmt: skip
-        if not done:
-            return None
-        if k >= 0 and mse < self.capped_mse:
-            self.capped_mse, self.capped_focal_px = float(mse), float(ref.focal_px[k])
-        return ok
 
     def _own_posest(self, facial_mm, R, t, f, which, lost):
         """Replace the cameras of members ``which`` by their own POSEST (in place, in member
@@ -314,7 +300,10 @@ class LiliumProblem:
             ``fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (NaN when off or
             skipped), ``success`` and the cameras ``R``, ``t``, ``focal_px``.
         """
-        terms = self.camera_terms(self.facial_landmarks(genes), members)
+        if members is not None and jit.compiled():
+            terms = camera_terms_compiled(self, genes, members)
+        else:
+            terms = self.camera_terms(self.facial_landmarks(genes), members)
         return self.add_image_terms(terms, thresholds)
 
     def camera_terms(self, facial_mm, members=None):

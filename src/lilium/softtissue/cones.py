@@ -169,6 +169,21 @@ def hybrid_genes(genes, pairs):
     return g
 
 
+def decode_arguments(cones):
+    """The arguments of :func:`~lilium.softtissue._cone_kernels.decode_kernel` after the genes:
+    the cones' arrays and the decoding's constants (a tuple, built once per SFO)."""
+    return (
+        np.ascontiguousarray(cones.axes, dtype=float),
+        np.ascontiguousarray(cones.u, dtype=float),
+        np.ascontiguousarray(cones.v, dtype=float),
+        np.ascontiguousarray(cones.depth_min_mm, dtype=float),
+        np.ascontiguousarray(cones.depth_max_mm, dtype=float),
+        np.asarray(cones.pairs, np.int64).reshape(-1, 2),
+        BILATERAL_LEFT_WEIGHT,
+        float(np.radians(CONE_MAX_POLAR_DEG)),
+    )
+
+
 def decode(genes, cones):
     """Soft-tissue vectors of a population.
 
@@ -186,17 +201,7 @@ def decode(genes, cones):
     genes = np.asarray(genes, dtype=float)
     single = genes.ndim == 1
     if jit.compiled():  # the same formulas, compiled (softtissue/_cone_kernels.py)
-        st = decode_kernel(
-            np.ascontiguousarray(np.atleast_2d(genes)),
-            cones.axes,
-            cones.u,
-            cones.v,
-            cones.depth_min_mm,
-            cones.depth_max_mm,
-            np.asarray(cones.pairs, np.int64).reshape(-1, 2),
-            BILATERAL_LEFT_WEIGHT,
-            float(np.radians(CONE_MAX_POLAR_DEG)),
-        )
+        st = decode_kernel(np.ascontiguousarray(np.atleast_2d(genes)), *decode_arguments(cones))
         return st[0] if single else st
     g = hybrid_genes(np.atleast_2d(genes), cones.pairs)
     depth = cones.depth_min_mm + g[..., 0] * (cones.depth_max_mm - cones.depth_min_mm)
