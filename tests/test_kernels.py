@@ -630,3 +630,19 @@ def test_camera_stage_in_one_call_is_the_steps_one_by_one(case):
             np.testing.assert_array_equal(a[key], b[key])
     assert results[0][1] == 0 and results[1][1] > 0  # the broken start went to POSEST
     assert results[0][0]["success"].any() and not results[0][0]["success"].all()
+
+
+@needs_numba
+def test_vertex_normals_kernel_is_numpys_bit_for_bit():
+    """Area-weighted vertex normals, an unused vertex (0) and a degenerate face included."""
+    from lilium.imaging.shading import vertex_normals
+
+    vertices, faces = shell_skull(n_lat=20, n_lon=30, rng=17)
+    vertices = np.vstack([vertices, [[1e3, 0.0, 0.0]]])  # unused: a zero normal
+    faces = np.vstack([faces, [[0, 0, 1]]])  # degenerate: adds nothing
+    compiled = vertex_normals(vertices, faces)
+    with jit.kernels("numpy"):
+        reference = vertex_normals(vertices, faces)
+    np.testing.assert_array_equal(compiled, reference)
+    assert not compiled[-1].any()
+    np.testing.assert_allclose(np.linalg.norm(compiled[:-1], axis=1), 1.0, rtol=1e-12)

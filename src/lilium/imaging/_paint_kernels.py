@@ -158,3 +158,42 @@ def surface_kernel(rows, cols, face, uv, faces, X, normals_cam, c0, c1, focal, h
         for j in range(3):
             normal_cam[r, col, j] = n[j]
     return depth_mm, normal_cam
+
+
+@njit
+def normals_kernel(vertices_mm, faces):
+    """:func:`lilium.imaging.shading.vertex_normals` (its numpy steps in their order: each
+    face's cross product, summed per vertex corner by corner in face order, normalised), the
+    same numbers bit for bit."""
+    V, F = vertices_mm.shape[0], faces.shape[0]
+    face_n = np.empty((F, 3))
+    for f in range(F):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        e0 = vertices_mm[b, 0] - vertices_mm[a, 0]
+        e1 = vertices_mm[b, 1] - vertices_mm[a, 1]
+        e2 = vertices_mm[b, 2] - vertices_mm[a, 2]
+        g0 = vertices_mm[c, 0] - vertices_mm[a, 0]
+        g1 = vertices_mm[c, 1] - vertices_mm[a, 1]
+        g2 = vertices_mm[c, 2] - vertices_mm[a, 2]
+        face_n[f, 0] = e1 * g2 - e2 * g1
+        face_n[f, 1] = e2 * g0 - e0 * g2
+        face_n[f, 2] = e0 * g1 - e1 * g0
+    normals = np.zeros((V, 3))
+    corner = np.empty((V, 3))
+    for k in range(3):  # one bincount per corner, added in corner order
+        corner[:] = 0.0
+        for f in range(F):
+            v = faces[f, k]
+            for j in range(3):
+                corner[v, j] += face_n[f, j]
+        for v in range(V):
+            for j in range(3):
+                normals[v, j] += corner[v, j]
+    for v in range(V):
+        x, y, z = normals[v, 0], normals[v, 1], normals[v, 2]
+        norm = np.sqrt(x * x + y * y + z * z)
+        if norm > 1e-12:
+            normals[v, 0], normals[v, 1], normals[v, 2] = x / norm, y / norm, z / norm
+        else:
+            normals[v, 0] = normals[v, 1] = normals[v, 2] = 0.0
+    return normals

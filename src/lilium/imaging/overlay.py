@@ -49,15 +49,20 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh, *, topology=No
     faces = np.asarray(faces, dtype=np.int64)
     uv = camera.project(vertices_mm)
     covered = skull_raster(uv, faces, (height, width), topology=topology)
-    tri = camera.to_camera_frame(vertices_mm)[faces]
+    X = camera.to_camera_frame(vertices_mm)
+    # The nearest triangle at each pixel centre (a compiled depth buffer; depth = the mean of
+    # the corners' depths).
+    index = nearest_face_index(
+        uv, faces, X[faces, 2].mean(axis=1), (height, width), covered=covered
+    )
+    # Lambert intensity of the triangles seen (the others are never looked up).
+    seen = np.unique(index[index >= 0])
+    tri = X[faces[seen]]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
+    intensity = np.zeros(len(faces), np.float32)
     # Two-sided lighting: a skull mesh may be wound either way.
-    intensity = (0.25 + 0.75 * np.abs(normal @ LIGHT_DIR_CAM)).astype(np.float32)
-    # The nearest triangle at each pixel centre (a compiled depth buffer).
-    index = nearest_face_index(
-        uv, faces, tri[..., 2].mean(axis=1), (height, width), covered=covered
-    )
+    intensity[seen] = (0.25 + 0.75 * np.abs(normal @ LIGHT_DIR_CAM)).astype(np.float32)
     shade = np.where(index >= 0, intensity[index], np.float32(0.0))
     shade[~covered] = 0.0
     return shade, covered

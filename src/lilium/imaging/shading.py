@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 
 from .. import jit
-from ._paint_kernels import nearest_face_index, surface_kernel
+from ._paint_kernels import nearest_face_index, normals_kernel, surface_kernel
 from .raster import content_key, skull_raster
 
 #: Direction towards the key light in the camera frame (x right, y down, z forward): upper
@@ -96,6 +96,10 @@ def cached_vertex_normals(vertices_mm, faces):
 
 def vertex_normals(vertices_mm, faces):
     """Area-weighted unit vertex normals ``(V, 3)`` (0 for an unused vertex)."""
+    if jit.compiled():  # the same steps, compiled (imaging/_paint_kernels.py)
+        return normals_kernel(
+            np.ascontiguousarray(vertices_mm, dtype=float), np.ascontiguousarray(faces, np.int64)
+        )
     tri = vertices_mm[faces]
     face_n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])  # length = 2 x area
     n = len(vertices_mm)
