@@ -597,19 +597,27 @@ def test_vertex_clustering_kernel_is_numpys_bit_for_bit(cell_mm):
 
 
 @needs_numba
-def test_camera_stage_in_one_call_is_the_steps_one_by_one(case):
+@pytest.mark.parametrize("nasion", [True, False])
+def test_camera_stage_in_one_call_is_the_steps_one_by_one(case, nasion):
     """A generation's camera terms in one compiled call (``LiliumProblem.evaluate`` with
     members) equal the kernels called one by one (``camera_terms``) bit for bit: members
     lending their camera to those without one, a warm start that breaks (a camera behind the
-    skull: its own POSEST on the numpy path), the capped fit noted."""
+    skull: its own POSEST on the numpy path), the capped fit noted; the subject-to-camera
+    distance from the nasion or, without it, from the mean of every facial landmark."""
+    from dataclasses import replace
+
     from lilium.io.case import read_photo, read_skull
     from lilium.methods import SfoOptions
     from lilium.methods.lilium import LiliumProblem
 
     skull, photo = read_skull(case[0]), read_photo(case[1])
+    if not nasion:
+        landmarks = {k: v for k, v in photo.landmarks_uv.items() if k != "nasion"}
+        photo = replace(photo, landmarks_uv=landmarks)
     results = []
     for one_call in (True, False):
         problem = LiliumProblem(skull, photo, SfoOptions("base"), rng=0)
+        assert (len(problem.scd_index) == 1) == nasion
         genes = np.random.default_rng(15).random((60, problem.cones.n_genes))
         first = problem.evaluate(genes)
         members = {k: np.asarray(first[k])[::-1].copy() for k in ("R", "t", "focal_px", "success")}

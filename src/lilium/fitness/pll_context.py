@@ -133,7 +133,7 @@ class PllContext:
         return PllTerms(
             *population_kernel(
                 np.ascontiguousarray(vertices_mm, dtype=float),
-                np.zeros((2, 3)) if span_mm is None else np.asarray(span_mm, dtype=float),
+                np.zeros((2, 3)) if span_mm is None else np.ascontiguousarray(span_mm, dtype=float),
                 span_mm is not None,
                 np.ascontiguousarray(cameras.R, dtype=float),
                 np.ascontiguousarray(cameras.t, dtype=float),
