@@ -106,6 +106,15 @@ def view_rotation(anterior, up, view):
     return np.stack([right, down, forward])
 
 
+def _column_bounds(a):
+    """``(min, max)`` of each column of ``a`` (N, k): ``a.min(axis=0)``, ``a.max(axis=0)``,
+    column by column (numpy reduces a few wide columns about twenty times slower along
+    axis 0: 11 against 0.5 ms for 300k vertices)."""
+    lo = np.array([a[:, k].min() for k in range(a.shape[1])])
+    hi = np.array([a[:, k].max() for k in range(a.shape[1])])
+    return lo, hi
+
+
 def fit_camera(vertices_mm, R, size_wh, margin=VIEW_MARGIN, distance_mm=VIEW_DISTANCE_MM):
     """A camera with rotation ``R`` that frames the whole mesh in a picture of ``size_wh``.
 
@@ -124,11 +133,11 @@ def fit_camera(vertices_mm, R, size_wh, margin=VIEW_MARGIN, distance_mm=VIEW_DIS
     Camera
     """
     vertices_mm = np.asarray(vertices_mm, dtype=float)
-    centre = (vertices_mm.min(axis=0) + vertices_mm.max(axis=0)) / 2
+    lo, hi = _column_bounds(vertices_mm)
+    centre = (lo + hi) / 2
     t = np.array([0.0, 0.0, distance_mm]) - R @ centre
     X = vertices_mm @ R.T + t
-    xy = X[:, :2] / X[:, 2:3]
-    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    lo, hi = _column_bounds(X[:, :2] / X[:, 2:3])
     w, h = size_wh
     span = np.maximum(hi - lo, 1e-9)
     focal = min(w * (1 - 2 * margin) / span[0], h * (1 - 2 * margin) / span[1])
