@@ -654,3 +654,26 @@ def test_vertex_normals_kernel_is_numpys_bit_for_bit():
     np.testing.assert_array_equal(compiled, reference)
     assert not compiled[-1].any()
     np.testing.assert_allclose(np.linalg.norm(compiled[:-1], axis=1), 1.0, rtol=1e-12)
+
+
+@needs_numba
+def test_nearest_point_table_kernel_is_the_k_d_trees():
+    """The facial curve's nearest-point table by the compiled bucket search equals the numpy
+    path's (k-d tree candidates, ties settled by brute force): integer and sub-pixel curves,
+    many coincident points (ties to the lowest index), margins from 0 to 70 px."""
+    from lilium.fitness.pll import face_curve_index
+
+    rng = np.random.default_rng(18)
+    for trial in range(24):
+        n = int(rng.integers(1, 300))
+        points = np.round(rng.uniform(0, rng.uniform(5, 400), (n, 2)))
+        if trial % 3 == 0:
+            points += rng.uniform(-0.5, 0.5, points.shape)
+        if trial % 4 == 0:
+            points[: n // 2] = points[0]
+        margin = int(rng.integers(0, 70))
+        compiled = face_curve_index(points, margin_px=margin)
+        with jit.kernels("numpy"):
+            reference = face_curve_index(points, margin_px=margin)
+        assert compiled.origin == reference.origin
+        np.testing.assert_array_equal(compiled.table, reference.table)

@@ -10,16 +10,25 @@
 - :mod:`lilium.experiments.report`  the paper's tables, Wilcoxon tests and plots
 """
 
-from .config import PRESETS, ExperimentConfig, load_config
-from .runner import enumerate_tasks, run_experiment, run_task
-from .store import ResultStore
+import importlib
 
-__all__ = [
-    "PRESETS",
-    "ExperimentConfig",
-    "ResultStore",
-    "enumerate_tasks",
-    "load_config",
-    "run_experiment",
-    "run_task",
-]
+#: The package's names and the modules that define them, imported on first use: every
+#: ``lilium`` command registers ``lilium experiment`` (its presets, from ``config``), and the
+#: runner and the store (about 25 ms of imports) are for ``lilium experiment`` alone.
+_EXPORTS = {
+    "PRESETS": "config",
+    "ExperimentConfig": "config",
+    "load_config": "config",
+    "enumerate_tasks": "runner",
+    "run_experiment": "runner",
+    "run_task": "runner",
+    "ResultStore": "store",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name):
+    if name in _EXPORTS:
+        return getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

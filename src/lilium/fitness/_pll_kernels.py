@@ -366,3 +366,67 @@ def population_kernel(
         points, offset, face, face_lo, face_hi, table, u0, v0
     )
     return terms_kernel(skull, face_xy, distance, pair_offset, side, no_curve)
+
+
+#: Side (pixels) of the buckets of :func:`nearest_table_kernel`.
+NEAREST_BUCKET_PX = 16
+
+
+@njit
+def nearest_table_kernel(points, u0, v0, height, width):
+    """The nearest-point table of :func:`lilium.fitness.pll.face_curve_index`: for every pixel
+    ``(u0 + c, v0 + r)`` of a ``height`` x ``width`` box, the index of the nearest of ``points``
+    (M, 2) (lowest index on ties), the same squared distances as the numpy path's.
+
+    The points go into square buckets of :data:`NEAREST_BUCKET_PX`; each pixel searches rings
+    of buckets outwards and stops once every point left is farther than its best (a point in
+    ring ``r + 1`` lies more than ``r`` bucket sides away), so the answer is exact.
+    """
+    B = NEAREST_BUCKET_PX
+    M = points.shape[0]
+    gw, gh = (width + B - 1) // B, (height + B - 1) // B
+    bx = np.empty(M, np.int64)
+    by = np.empty(M, np.int64)
+    start = np.zeros(gw * gh + 1, np.int64)
+    for j in range(M):
+        bx[j] = min(max(np.int64(np.floor((points[j, 0] - u0) / B)), 0), gw - 1)
+        by[j] = min(max(np.int64(np.floor((points[j, 1] - v0) / B)), 0), gh - 1)
+        start[by[j] * gw + bx[j] + 1] += 1
+    for b in range(gw * gh):
+        start[b + 1] += start[b]
+    fill = start[:-1].copy()
+    members = np.empty(M, np.int64)  # each bucket's points in index order
+    for j in range(M):
+        b = by[j] * gw + bx[j]
+        members[fill[b]] = j
+        fill[b] += 1
+    table = np.empty((height, width), np.int64)
+    rings = max(gw, gh)
+    for r in range(height):
+        y = float(v0 + r)
+        cy = r // B
+        for c in range(width):
+            x = float(u0 + c)
+            cx = c // B
+            best, at = np.inf, -1
+            for ring in range(rings):
+                if ring > 0 and best < float((ring - 1) * B) ** 2:
+                    break  # every point not seen is farther than the best
+                for qy in range(cy - ring, cy + ring + 1):
+                    if qy < 0 or qy >= gh:
+                        continue
+                    edge_row = qy == cy - ring or qy == cy + ring
+                    step = 1 if edge_row else 2 * ring
+                    qx = cx - ring
+                    while qx <= cx + ring:
+                        if 0 <= qx < gw:
+                            b = qy * gw + qx
+                            for k in range(start[b], start[b + 1]):
+                                j = members[k]
+                                du, dv = x - points[j, 0], y - points[j, 1]
+                                d2 = du * du + dv * dv
+                                if d2 < best or (d2 == best and j < at):
+                                    best, at = d2, j
+                        qx += step
+            table[r, c] = at
+    return table
