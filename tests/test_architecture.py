@@ -100,6 +100,7 @@ LAZY_LIBRARIES = (
     "matplotlib",
     "dask",
     "lilium.synthetic",
+    "lilium.experiments.runner",
 )
 
 
@@ -115,3 +116,26 @@ def test_sfo_command_imports_stay_light():
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     ).stdout
     assert out.strip() == "[]", out
+
+
+
+def test_the_compiled_curve_index_does_not_import_scipy_spatial():
+    """P_pll's nearest-point table is a compiled bucket search: building it (once per SFO with
+    P_pll) loads no k-d tree (scipy.spatial, about 0.1 s of a process's start)."""
+    from lilium import jit
+
+    if not jit.compiled():
+        return  # the numpy reference path builds the table with a k-d tree
+    code = (
+        "import sys\n"
+        "import numpy as np\n"
+        "from lilium.fitness.pll import face_curve_index\n"
+        "u = np.arange(200.0)\n"
+        "index = face_curve_index(np.column_stack([u, np.round(300 + (u - 100) ** 2 / 80)]))\n"
+        "assert index.table.size > 0\n"
+        "print('scipy.spatial' in sys.modules)\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout
+    assert out.strip() == "False", out
