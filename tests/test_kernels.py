@@ -677,3 +677,30 @@ def test_nearest_point_table_kernel_is_the_k_d_trees():
             reference = face_curve_index(points, margin_px=margin)
         assert compiled.origin == reference.origin
         np.testing.assert_array_equal(compiled.table, reference.table)
+
+
+@needs_numba
+def test_whitened_residuals_kernel_matches_numpy():
+    """The identification refits' whitened residuals: compiled and numpy agree to rounding,
+    cameras with a landmark behind them (1e3 everywhere) and one photo per camera included."""
+    from lilium.identification.cohort import _whitened
+    from lilium.identification.terms import soft_tissue_covariance
+
+    rng = np.random.default_rng(19)
+    K, N = 12, 15
+    R = np.array([rotvec_to_matrix(rng.normal(scale=0.2, size=3)) for _ in range(K)])
+    t = np.column_stack([rng.normal(scale=20.0, size=(K, 2)), rng.uniform(600, 1500, K)])
+    t[3, 2] = -800.0  # every landmark behind the camera
+    f = rng.uniform(1500, 4000, K)
+    points = rng.normal(scale=60.0, size=(K, N, 3))
+    axes = rng.normal(size=(K * N, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    cov = soft_tissue_covariance(axes, rng.uniform(3, 15, K * N), rng.uniform(1, 4, K * N))
+    cov = cov.reshape(K, N, 3, 3)
+    sigma = rng.uniform(1.5, 6.0, N)
+    for uv in (rng.uniform(0, 2000, (N, 2)), rng.uniform(0, 2000, (K, N, 2))):
+        compiled = _whitened(R, t, f, np.array([960.0, 540.0]), points, cov, uv, sigma)
+        with jit.kernels("numpy"):
+            reference = _whitened(R, t, f, np.array([960.0, 540.0]), points, cov, uv, sigma)
+        assert np.all(compiled[3] == 1e3) and np.all(reference[3] == 1e3)
+        np.testing.assert_allclose(compiled, reference, rtol=1e-12, atol=1e-12)
