@@ -704,3 +704,34 @@ def test_whitened_residuals_kernel_matches_numpy():
             reference = _whitened(R, t, f, np.array([960.0, 540.0]), points, cov, uv, sigma)
         assert np.all(compiled[3] == 1e3) and np.all(reference[3] == 1e3)
         np.testing.assert_allclose(compiled, reference, rtol=1e-12, atol=1e-12)
+
+
+@needs_numba
+def test_identification_refit_kernel_matches_numpy():
+    """A whole camera refit of the identification (moves of the cameras and whitened residuals
+    compiled together) agrees with the numpy path's (one photo per camera, each made by its
+    skull: a well-posed refit; an ill-posed one may follow another Levenberg-Marquardt path
+    from a difference of rounding, as any reordering of its sums would)."""
+    from lilium.identification.cohort import refit_cameras
+
+    rng = np.random.default_rng(20)
+    K, N = 10, 14
+    R0 = np.array([rotvec_to_matrix(rng.normal(scale=0.1, size=3)) for _ in range(K)])
+    t0 = np.column_stack([rng.normal(scale=5.0, size=(K, 2)), rng.uniform(900, 1100, K)])
+    f0 = rng.uniform(2500, 3500, K)
+    cranial = rng.normal(scale=50.0, size=(K, N, 3))
+    axes = rng.normal(size=(K, N, 3))
+    axes /= np.linalg.norm(axes, axis=2, keepdims=True)
+    mean_mm, sd_mm = rng.uniform(4, 12, N), rng.uniform(1, 3, N)
+    truth = np.einsum("kij,knj->kni", R0, cranial + mean_mm[:, None] * axes) + t0[:, None]
+    uv = truth[..., :2] * (f0[:, None, None] / truth[..., 2:3]) + [960.0, 540.0]
+    uv += rng.normal(scale=2, size=uv.shape)
+    f0 = f0 * rng.uniform(0.9, 1.1, K)  # start away from the cameras that made the photos
+    sigma = np.full(N, 3.0)
+    args = (R0, t0, f0, np.array([960.0, 540.0]), cranial, axes, mean_mm, sd_mm, uv, sigma)
+    compiled = refit_cameras(*args)
+    with jit.kernels("numpy"):
+        reference = refit_cameras(*args)
+    for a, b in zip(compiled, reference, strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-7, atol=1e-7)
+    assert not np.allclose(compiled[2], f0)  # the refit moved the cameras

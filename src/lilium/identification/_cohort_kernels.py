@@ -76,3 +76,48 @@ def whitened_kernel(R, t, f, c0, c1, points, cov, uv, sigma_px):
             for m in range(2 * N):
                 w[k, m] = 1e3
     return w
+
+
+@njit
+def refit_whitened_kernel(p, R0, t0, f0, c0, c1, points, cov, uv, sigma_px):
+    """:func:`whitened_kernel` of the cameras ``p`` (K, 7) moves from ``(R0, t0, f0)``
+    (``cohort._cameras``: rotation vector, translation, log focal; Rodrigues' formula as
+    :func:`lilium.geometry.rotations.rotvec_to_matrix` writes it)."""
+    K = p.shape[0]
+    R = np.empty((K, 3, 3))
+    t = np.empty((K, 3))
+    f = np.empty(K)
+    dR = np.empty((3, 3))
+    for k in range(K):
+        x, y, z = p[k, 0], p[k, 1], p[k, 2]
+        theta_sq = x * x + y * y + z * z
+        theta = np.sqrt(theta_sq)
+        if theta < 1e-8:
+            a = 1.0 - theta_sq / 6.0
+            b = 0.5 - theta_sq / 24.0
+        else:
+            a = np.sin(theta) / theta
+            b = (1.0 - np.cos(theta)) / theta**2
+        v = (x, y, z)
+        for i in range(3):
+            for j in range(3):
+                dR[i, j] = (b * v[i]) * v[j]
+        diag = 1.0 - b * theta_sq
+        ax, ay, az = a * x, a * y, a * z
+        dR[0, 0] += diag
+        dR[1, 1] += diag
+        dR[2, 2] += diag
+        dR[0, 1] -= az
+        dR[1, 0] += az
+        dR[0, 2] += ay
+        dR[2, 0] -= ay
+        dR[1, 2] -= ax
+        dR[2, 1] += ax
+        for i in range(3):
+            for j in range(3):
+                R[k, i, j] = (
+                    dR[i, 0] * R0[k, 0, j] + dR[i, 1] * R0[k, 1, j] + dR[i, 2] * R0[k, 2, j]
+                )
+            t[k, i] = t0[k, i] + p[k, 3 + i]
+        f[k] = f0[k] * np.exp(p[k, 6])
+    return whitened_kernel(R, t, f, c0, c1, points, cov, uv, sigma_px)

@@ -36,7 +36,7 @@ import numpy as np
 from .. import jit
 from ..geometry.camera import Camera, project_points, to_camera_frame
 from ..geometry.rotations import rotvec_to_matrix
-from ._cohort_kernels import whitened_kernel
+from ._cohort_kernels import refit_whitened_kernel, whitened_kernel
 from .terms import (
     landmark_chi2,
     landmark_sigma_px,
@@ -155,11 +155,28 @@ def refit_cameras(R0, t0, f0, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
     K = len(R0)
     cov = soft_tissue_covariance(axes.reshape(-1, 3), np.tile(mean_mm, K), np.tile(sd_mm, K))
     args = (pp, cranial + mean_mm[None, :, None] * axes, cov.reshape(K, -1, 3, 3), uv, sigma_px)
+    if jit.compiled():  # the cameras' moves and the residuals in one call per evaluation
+        c = np.asarray(pp, dtype=float)
+        fixed = (
+            np.ascontiguousarray(R0, dtype=float), np.ascontiguousarray(t0, dtype=float),
+            np.ascontiguousarray(f0, dtype=float), float(c[0]), float(c[1]),
+            np.ascontiguousarray(args[1], dtype=float), np.ascontiguousarray(args[2], dtype=float),
+            np.ascontiguousarray(uv if uv.ndim == 3 else np.broadcast_to(uv, (K,) + uv.shape)),
+            np.ascontiguousarray(sigma_px, dtype=float),
+        )  # fmt: skip
+
+        def whitened(q):
+            return refit_whitened_kernel(np.ascontiguousarray(q), *fixed)
+    else:
+
+        def whitened(q):
+            return _whitened(*_cameras(R0, t0, f0, q), *args)
+
     # A trial step that runs off (a focal overflowing, a point behind the camera) is scored
     # 1e3 per residual by _whitened and rejected; its floating-point warnings say nothing more.
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         p = np.zeros((K, 7))
-        w = _whitened(*_cameras(R0, t0, f0, p), *args)
+        w = whitened(p)
         cost = np.sum(w**2, axis=1)
         lam = np.full(K, 1e-3)
         for _ in range(REFIT_ITERATIONS):
@@ -167,14 +184,14 @@ def refit_cameras(R0, t0, f0, pp, cranial, axes, mean_mm, sd_mm, uv, sigma_px):
             for j in range(7):
                 q = p.copy()
                 q[:, j] += FD_STEPS[j]
-                J[:, :, j] = (_whitened(*_cameras(R0, t0, f0, q), *args) - w) / FD_STEPS[j]
+                J[:, :, j] = (whitened(q) - w) / FD_STEPS[j]
             JtJ = np.swapaxes(J, 1, 2) @ J
             g = np.einsum("kmj,km->kj", J, w)
             A = JtJ + lam[:, None, None] * (np.eye(7) * np.diagonal(JtJ, axis1=1, axis2=2)[:, None]
                                             + 1e-9 * np.eye(7))
             step = -np.linalg.solve(A, g[..., None])[..., 0]
             trial = p + step
-            w_trial = _whitened(*_cameras(R0, t0, f0, trial), *args)
+            w_trial = whitened(trial)
             cost_trial = np.sum(w_trial**2, axis=1)
             better = cost_trial < cost
             p[better], w[better], cost[better] = trial[better], w_trial[better], cost_trial[better]
