@@ -13,6 +13,7 @@ import numpy as np
 
 from ..constants import MIN_DEPTH_MM
 from ..geometry._projection_kernels import pinhole
+from ..geometry._rotation_kernels import rotvec_to_matrix_kernel
 from ..jit import njit
 
 
@@ -89,30 +90,7 @@ def refit_whitened_kernel(p, R0, t0, f0, c0, c1, points, cov, uv, sigma_px):
     f = np.empty(K)
     dR = np.empty((3, 3))
     for k in range(K):
-        x, y, z = p[k, 0], p[k, 1], p[k, 2]
-        theta_sq = x * x + y * y + z * z
-        theta = np.sqrt(theta_sq)
-        if theta < 1e-8:
-            a = 1.0 - theta_sq / 6.0
-            b = 0.5 - theta_sq / 24.0
-        else:
-            a = np.sin(theta) / theta
-            b = (1.0 - np.cos(theta)) / theta**2
-        v = (x, y, z)
-        for i in range(3):
-            for j in range(3):
-                dR[i, j] = (b * v[i]) * v[j]
-        diag = 1.0 - b * theta_sq
-        ax, ay, az = a * x, a * y, a * z
-        dR[0, 0] += diag
-        dR[1, 1] += diag
-        dR[2, 2] += diag
-        dR[0, 1] -= az
-        dR[1, 0] += az
-        dR[0, 2] += ay
-        dR[2, 0] -= ay
-        dR[1, 2] -= ax
-        dR[2, 1] += ax
+        rotvec_to_matrix_kernel(p[k, 0], p[k, 1], p[k, 2], dR)
         for i in range(3):
             for j in range(3):
                 R[k, i, j] = (

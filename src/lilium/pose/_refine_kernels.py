@@ -19,37 +19,8 @@ import numpy as np
 
 from ..constants import MIN_DEPTH_MM
 from ..geometry._projection_kernels import pinhole
+from ..geometry._rotation_kernels import rotvec_to_matrix_kernel
 from ..jit import njit
-
-_SMALL_ANGLE = 1e-8  # as lilium.geometry.rotations
-
-
-@njit
-def _rotvec_to_matrix(w0, w1, w2, out):
-    """Rodrigues' formula, as :func:`lilium.geometry.rotations.rotvec_to_matrix`."""
-    theta_sq = w0 * w0 + w1 * w1 + w2 * w2
-    theta = np.sqrt(theta_sq)
-    if theta < _SMALL_ANGLE:
-        a = 1.0 - theta_sq / 6.0
-        b = 0.5 - theta_sq / 24.0
-    else:
-        a = np.sin(theta) / theta
-        b = (1.0 - np.cos(theta)) / (theta * theta)
-    w = (w0, w1, w2)
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = (b * w[i]) * w[j]
-    diag = 1.0 - b * theta_sq
-    x, y, z = a * w0, a * w1, a * w2
-    out[0, 0] += diag
-    out[1, 1] += diag
-    out[2, 2] += diag
-    out[0, 1] -= z
-    out[1, 0] += z
-    out[0, 2] += y
-    out[2, 0] -= y
-    out[1, 2] -= x
-    out[2, 1] += x
 
 
 @njit
@@ -156,7 +127,7 @@ def _normal_equations(J, r, rows, JtJ, g):
 def _apply_step(R, c, log_f, delta, dR, R_new, c_new):
     """The camera after an increment ``delta`` (7,) of the unknowns (module
     :mod:`lilium.pose.refine`): ``R_new``, ``c_new`` filled; returns the new log focal length."""
-    _rotvec_to_matrix(delta[0], delta[1], delta[2], dR)
+    rotvec_to_matrix_kernel(delta[0], delta[1], delta[2], dR)
     for i in range(3):
         for j in range(3):
             R_new[i, j] = dR[i, 0] * R[0, j] + dR[i, 1] * R[1, j] + dR[i, 2] * R[2, j]
