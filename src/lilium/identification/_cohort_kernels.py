@@ -1,12 +1,16 @@
 """Compiled whitened residuals of the identification's camera refits
-(:func:`lilium.identification.cohort._whitened`); numba, see :mod:`lilium.jit`.
+(:func:`lilium.identification.cohort._whitened`, and :func:`refit_whitened_kernel`, which first
+moves the cameras as ``cohort._cameras`` does: one call per evaluation of a refit); numba, see
+:mod:`lilium.jit`.
 
 Per camera and landmark, element by element, the numpy path's steps: the mean facial point in
 the camera's frame and its pinhole projection (:func:`lilium.geometry._projection_kernels.pinhole`,
 the projection the numpy path calls too), the projection's Jacobian, the marginal covariance
 ``S = J Sigma J^T + sigma^2 I`` and its Cholesky whitening. The numpy path takes the camera-frame
 point of the Jacobian from a matrix product, this kernel from the pinhole's own sums, so the two
-agree to rounding (about 1e-15 relative), not bit for bit (``tests/test_kernels.py``).
+agree to rounding (about 1e-15 relative), not bit for bit (``tests/test_kernels.py``); a refit's
+accept / reject steps can carry such a difference further (docs/method.md, "The identification's
+camera refits compiled").
 """
 
 import numpy as np
