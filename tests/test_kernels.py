@@ -681,8 +681,10 @@ def test_nearest_point_table_kernel_is_the_k_d_trees():
 
 @needs_numba
 def test_whitened_residuals_kernel_matches_numpy():
-    """The identification refits' whitened residuals: compiled and numpy agree to rounding,
-    cameras with a landmark behind them (1e3 everywhere) and one photo per camera included."""
+    """The identification refits' whitened residuals: compiled (the refit's kernel with the
+    cameras not moved) and numpy agree to rounding, cameras with a landmark behind them (1e3
+    everywhere) and one photo per camera included."""
+    from lilium.identification._cohort_kernels import refit_whitened_kernel
     from lilium.identification.cohort import _whitened
     from lilium.identification.terms import soft_tissue_covariance
 
@@ -699,9 +701,11 @@ def test_whitened_residuals_kernel_matches_numpy():
     cov = cov.reshape(K, N, 3, 3)
     sigma = rng.uniform(1.5, 6.0, N)
     for uv in (rng.uniform(0, 2000, (N, 2)), rng.uniform(0, 2000, (K, N, 2))):
-        compiled = _whitened(R, t, f, np.array([960.0, 540.0]), points, cov, uv, sigma)
-        with jit.kernels("numpy"):
-            reference = _whitened(R, t, f, np.array([960.0, 540.0]), points, cov, uv, sigma)
+        uv_k = np.ascontiguousarray(np.broadcast_to(uv, (K, N, 2)))
+        compiled = refit_whitened_kernel(
+            np.zeros((K, 7)), R, t, f, 960.0, 540.0, points, cov, uv_k, sigma
+        )
+        reference = _whitened(R, t, f, np.array([960.0, 540.0]), points, cov, uv, sigma)
         assert np.all(compiled[3] == 1e3) and np.all(reference[3] == 1e3)
         np.testing.assert_allclose(compiled, reference, rtol=1e-12, atol=1e-12)
 

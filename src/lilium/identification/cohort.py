@@ -36,7 +36,7 @@ import numpy as np
 from .. import jit
 from ..geometry.camera import Camera, project_points, to_camera_frame
 from ..geometry.rotations import rotvec_to_matrix
-from ._cohort_kernels import refit_whitened_kernel, whitened_kernel
+from ._cohort_kernels import refit_whitened_kernel
 from .terms import (
     landmark_chi2,
     landmark_sigma_px,
@@ -96,17 +96,8 @@ def _whitened(R, t, f, pp, points, cov, uv, sigma_px):
     f ``(K,)``): ``points`` ``(K, N, 3)`` are the skulls' mean facial points, ``cov``
     ``(K, N, 3, 3)`` their soft-tissue covariances; the marginal covariance
     ``S = J Sigma J^T + sigma^2 I`` of each landmark whitens its residual, so the squared norm
-    is ``sum r^T S^-1 r``."""
-    if jit.compiled():  # the same steps per landmark, compiled (identification/_cohort_kernels)
-        K = len(R)
-        uv_k = uv if uv.ndim == 3 else np.broadcast_to(uv, (K,) + uv.shape)
-        c = np.asarray(pp, dtype=float)
-        return whitened_kernel(
-            np.ascontiguousarray(R, dtype=float), np.ascontiguousarray(t, dtype=float),
-            np.ascontiguousarray(f, dtype=float), float(c[0]), float(c[1]),
-            np.ascontiguousarray(points, dtype=float), np.ascontiguousarray(cov, dtype=float),
-            np.ascontiguousarray(uv_k, dtype=float), np.ascontiguousarray(sigma_px, dtype=float),
-        )  # fmt: skip
+    is ``sum r^T S^-1 r``. The numpy path; compiled, :func:`refit_cameras` calls
+    :func:`~lilium.identification._cohort_kernels.refit_whitened_kernel` instead."""
     r = (uv if uv.ndim == 3 else uv[None]) - project_points(points, R, t, f, pp)  # NaN: behind
     bad = ~np.isfinite(r).all(axis=(1, 2))
     J = projection_jacobians(to_camera_frame(points, R, t), R, f)
