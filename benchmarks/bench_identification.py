@@ -20,6 +20,11 @@ again continues, or only prints when all is stored), and prints:
    the cameras are good but the fitness ranks poorly, the fitness's freedom (three soft-tissue
    genes per landmark fit the landmarks of any skull) is what limits identification.
 
+Then, over every database pooled: each decision's cross-validated log10 LR (Cllr, Cllr_min,
+misleading evidence, wrong conclusions), the shipped logistic calibration beside the
+bi-Gaussianized one (SPEC section 12), the rankings by the LR, and with ``--headsq`` the headsq
+CT's conclusions.
+
 At the full budget (DE 30 x 750, 8 subjects: 128 SFOs per method, 640 in all) it took 438 s on
 2 workers and 936 s on one (measured); ``--generations 3 --subjects 3`` checks the pipeline in
 under a minute. Results and their discussion: docs/method.md, "Identification on frontal photos".
@@ -33,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lilium.experiments.calibrate import DatasetInputs
+from lilium.experiments.calibrate import DatasetInputs, validate
 from lilium.experiments.config import (
     ALL_METHODS,
     DatasetConfig,
@@ -241,6 +246,8 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
                 file=file,
             )
     print(file=file)
+    print_calibration_comparison(decision_pairs, validated, file)
+    print(file=file)
     print("| ranked by identification log10 LR | view | mean rank | rank-1 | AUC | photos |",
           file=file)
     print("|---|---|---|---|---|---|", file=file)
@@ -250,6 +257,24 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
             f"{_f(t['auc'], 3)} | {t['photo_runs']} |",
             file=file,
         )
+
+
+def print_calibration_comparison(decision_pairs, validated, file=sys.stdout):
+    """The shipped calibration (logistic regression) beside the bi-Gaussianized one (Morrison
+    2024; SPEC section 12 names both), the same folds: Cllr and misleading evidence per
+    decision, cross-validated (``validated``: the logistic's, from :func:`validate`)."""
+    warped = validate(decision_pairs, warped={key[2] for key in decision_pairs})
+    print("| decision | method | logistic: Cllr, misleading same / different | "
+          "bi-Gaussianized: Cllr, misleading same / different |", file=file)
+    print("|---|---|---|---|", file=file)
+    for key in sorted(validated):
+        cells = [
+            f"{p['cllr']:.3f}, {100 * p['misleading_same']:.1f} / "
+            f"{100 * p['misleading_diff']:.1f} %"
+            for p in (validated[key]["performance"], warped[key]["performance"])
+        ]
+        print(f"| {key[2]} | {method_label(key[0], key[1])} | {cells[0]} | {cells[1]} |",
+              file=file)
 
 
 def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):

@@ -13,6 +13,7 @@ from lilium.cli.main import main
 from lilium.geometry.camera import Camera
 from lilium.identification.calibration import (
     Calibration,
+    bigaussian_warp,
     cllr,
     cross_validated,
     fit,
@@ -323,6 +324,47 @@ def test_balanced_fit_recovers_the_log_lr_of_imbalanced_classes():
     # The ridge shrinks towards "no evidence" (a conservative LR), never past the true one.
     ratio = got[[0, 1, 3, 4]] / true[[0, 1, 3, 4]]
     assert np.all((ratio > 0.7) & (ratio <= 1.05)), ratio
+
+
+def test_bigaussian_warp_keeps_a_calibrated_system_and_balances_the_errors():
+    """Bi-Gaussianized calibration (Morrison 2024): the log LRs of a perfectly calibrated
+    bi-Gaussian system come back about as they were; LRs whose 1 lies off the equal-error
+    point (every log LR one nat too high) come back in the same order, with same- and
+    different-person pairs misled about equally often."""
+    rng = np.random.default_rng(6)
+    sigma = 3.0
+    same = np.r_[np.ones(2000, bool), np.zeros(20000, bool)]
+    ln_lr = np.where(same, 0.5, -0.5) * sigma**2 + sigma * rng.normal(size=len(same))
+    warp = bigaussian_warp(ln_lr, same)
+    back = np.interp(ln_lr, warp["knots"], warp["ln_lr"])
+    central = np.abs(ln_lr) < 6.0
+    assert np.max(np.abs(back[central] - ln_lr[central])) < 0.3
+    shifted = ln_lr + 1.0
+    warp = bigaussian_warp(shifted, same)
+    out = np.interp(shifted, warp["knots"], warp["ln_lr"])
+    assert np.all(np.diff(out[np.argsort(shifted, kind="stable")]) >= 0)
+    before = np.mean(shifted[same] < 0), np.mean(shifted[~same] > 0)
+    after = np.mean(out[same] < 0), np.mean(out[~same] > 0)
+    assert before[1] > before[0] + 0.05  # the shift misleads different-person pairs more
+    assert abs(after[0] - after[1]) < 0.005, after
+    assert after[1] < before[1] - 0.03
+
+
+def test_a_warped_model_round_trips_and_refuses_a_broken_warp():
+    rng = np.random.default_rng(7)
+    pairs = _synthetic_pairs(rng)
+    terms, same = [p["terms"] for p in pairs], [p["same"] for p in pairs]
+    plain, warped = fit(terms, same), fit(terms, same, warp=True)
+    assert plain.warp is None and warped.warp is not None
+    lr = warped.log10_lr(terms)
+    order = np.argsort(plain.log10_lr(terms), kind="stable")
+    assert np.all(np.diff(lr[order]) >= -1e-12)  # the warp keeps the logistic order
+    again = Calibration.from_dict(json.loads(json.dumps(warped.to_dict())))
+    np.testing.assert_allclose(again.log10_lr(terms), lr)
+    data = warped.to_dict()
+    data["warp"] = {"knots": [0.0, 1.0], "ln_lr": [1.0, 0.0]}
+    with pytest.raises(ValueError, match="increasing"):
+        Calibration.from_dict(data)
 
 
 def _rotation(rotvec):

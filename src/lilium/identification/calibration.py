@@ -11,7 +11,9 @@ prior.
 A model is fitted per method, variant and view (``frontal``, ``lateral``, ``joint``), and one
 per method and variant for a frontal and a lateral photo's separate SFOs: the same logistic
 regression on one feature, the sum of the two photos' log10 LRs (:data:`VIEWS_TERMS`), which
-calibrates their combination instead of assuming them independent.
+calibrates their combination instead of assuming them independent. A model may also carry a
+bi-Gaussianized warp of its LRs (:func:`bigaussian_warp`, Morrison 2024); the benchmark compares
+it with the plain logistic regression, and the shipped models are plain (docs/method.md).
 
 **Bounds.** An LR is never more extreme than the data it was fitted on can support: it is
 clipped to ``[-log10(n_same), log10(n_diff)]`` (a different-person score rarer than
@@ -119,6 +121,10 @@ class Calibration:
         Training pairs.
     provenance : dict
         Where the model comes from (generator, pairs, budget, date...).
+    warp : dict or None
+        The bi-Gaussianized warp of the logistic regression's natural-log LR
+        (:func:`bigaussian_warp`): ``knots`` and ``ln_lr``, increasing, interpolated linearly
+        and held flat beyond the ends; None = the logistic regression's LR as it is.
     """
 
     names: tuple
@@ -130,6 +136,7 @@ class Calibration:
     n_same: int
     n_diff: int
     provenance: dict = field(default_factory=dict)
+    warp: dict | None = None
 
     @property
     def bounds(self):
@@ -145,8 +152,10 @@ class Calibration:
         X = features([terms_list[i] for i in keep], self.names, self.fill)
         z = (X - [self.centre[n] for n in self.names]) / [self.scale[n] for n in self.names]
         logit = z @ [self.weights[n] for n in self.names] + self.intercept
-        value = (logit - np.log(self.n_same / self.n_diff)) / np.log(10.0)
-        out[keep] = np.clip(value, *self.bounds)
+        ln_lr = logit - np.log(self.n_same / self.n_diff)
+        if self.warp is not None:
+            ln_lr = np.interp(ln_lr, self.warp["knots"], self.warp["ln_lr"])
+        out[keep] = np.clip(ln_lr / np.log(10.0), *self.bounds)
         return out
 
     def to_dict(self):
@@ -160,7 +169,7 @@ class Calibration:
             "n_same": self.n_same,
             "n_diff": self.n_diff,
             "provenance": self.provenance,
-        }
+        } | ({} if self.warp is None else {"warp": self.warp})
 
     @classmethod
     def from_dict(cls, data):
@@ -178,10 +187,24 @@ class Calibration:
             int(data["n_same"]),
             int(data["n_diff"]),
             dict(data.get("provenance", {})),
+            _read_warp(data.get("warp")),
         )
 
 
-def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=RIDGE):
+def _read_warp(warp):
+    """A stored :attr:`Calibration.warp` checked (None stays None)."""
+    if warp is None:
+        return None
+    knots = np.asarray(warp["knots"], float)
+    ln_lr = np.asarray(warp["ln_lr"], float)
+    if knots.ndim != 1 or knots.shape != ln_lr.shape or len(knots) < 2:
+        raise ValueError("a calibration warp needs equal lists 'knots' and 'ln_lr' (2+ values)")
+    if np.any(np.diff(knots) <= 0) or np.any(np.diff(ln_lr) < 0):
+        raise ValueError("a calibration warp must be increasing")
+    return {"knots": knots.tolist(), "ln_lr": ln_lr.tolist()}
+
+
+def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=RIDGE, warp=False):
     """Fit a :class:`Calibration` on term dictionaries and their labels.
 
     Parameters
@@ -195,6 +218,9 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=RIDGE):
     provenance : dict, optional
     ridge : float
         L2 penalty on the standardised weights.
+    warp : bool
+        Warp the logistic regression's LRs by :func:`bigaussian_warp` (fitted on the same
+        pairs).
     """
     same = np.asarray(same, bool)
     if same.all() or not same.any():
@@ -227,6 +253,8 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=RIDGE):
     from scipy.optimize import minimize  # 0.12 s to import: fitting only, not scoring
 
     p = minimize(loss, np.zeros(len(used) + 1), jac=True, method="L-BFGS-B").x
+    # Fitted with the classes weighing half each, the logit is the natural-log LR itself.
+    warped = bigaussian_warp(Z @ p[:-1] + p[-1], same) if warp else None
     # Stored with the training prior's log odds, as :meth:`Calibration.log10_lr` reads it.
     p[-1] += np.log(same.sum() / (~same).sum())
     return Calibration(
@@ -239,7 +267,54 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=RIDGE):
         int(same.sum()),
         int((~same).sum()),
         dict(provenance or {}),
+        warped,
     )
+
+
+def _bigaussian_cllr(sigma):
+    """Cllr (bits) of a perfectly calibrated bi-Gaussian system: same-person natural-log LRs
+    ``N(sigma^2 / 2, sigma^2)``, different-person ``N(-sigma^2 / 2, sigma^2)``."""
+    x = np.linspace(-12.0, 12.0, 4001)
+    density = np.exp(-0.5 * x * x) / np.sqrt(2.0 * np.pi)
+    ln_lr = 0.5 * sigma * sigma + sigma * x
+    return float(np.trapezoid(np.logaddexp(0.0, -ln_lr) * density, x) / np.log(2.0))
+
+
+def bigaussian_warp(ln_lr, same):
+    """The bi-Gaussianized calibration (Morrison, Law, Probability and Risk 2024) of natural-log
+    LRs ``ln_lr`` (P,) that are already roughly calibrated (a logistic regression's).
+
+    The perfectly calibrated bi-Gaussian system with the same Cllr as ``ln_lr`` has
+    same-person log LRs ``N(sigma^2 / 2, sigma^2)`` and different-person ``N(-sigma^2 / 2,
+    sigma^2)``; each value is sent to the quantile of that system's two-class mixture at which
+    the pairs' own mixture has the same cumulative share, each class weighing half (``1 / (2 (n
+    + 1))`` per pair, so no share reaches 0 or 1). The warp keeps the order of the pairs and
+    moves LR 1 to where the two classes' error rates meet (the equal-error point), so a
+    same-person pair is misled as often as a different-person one; a logistic regression's LR
+    1 sits where the fitted line crosses, which need not be there.
+
+    Returns
+    -------
+    dict
+        ``knots`` (the distinct input values, increasing) and ``ln_lr`` (their warped
+        natural-log LRs), as :attr:`Calibration.warp` reads them.
+    """
+    from scipy.optimize import brentq
+    from scipy.special import ndtr
+
+    ln_lr = np.asarray(ln_lr, float)
+    same = np.asarray(same, bool)
+    n1, n0 = int(same.sum()), int((~same).sum())
+    c = cllr(ln_lr / np.log(10.0), same)
+    c = min(max(c, 1e-4), 0.999)
+    sigma = brentq(lambda s: _bigaussian_cllr(s) - c, 1e-3, 30.0)
+    knots, inverse = np.unique(ln_lr, return_inverse=True)
+    weight = np.where(same, 0.5 / (n1 + 1), 0.5 / (n0 + 1))
+    share = np.cumsum(np.bincount(inverse, weights=weight))
+    half = 0.5 * sigma * sigma
+    grid = np.linspace(-half - 8.0 * sigma, half + 8.0 * sigma, 20001)
+    mixture = 0.5 * ndtr((grid + half) / sigma) + 0.5 * ndtr((grid - half) / sigma)
+    return {"knots": knots.tolist(), "ln_lr": np.interp(share, mixture, grid).tolist()}
 
 
 def subject_folds(subjects, folds=FOLDS):
@@ -261,7 +336,7 @@ def subject_splits(pairs, folds=FOLDS):
         yield training, [i for i, p in enumerate(pairs) if fold_of[p["person"]] == k]
 
 
-def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS, ridge=RIDGE):
+def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS, ridge=RIDGE, warp=False):
     """Cross-validated log10 LR of every pair: each scored by a model that never saw its
     photo's subject (nor any pair with that subject's skull).
 
@@ -282,7 +357,9 @@ def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS, ridge=RIDGE):
         train = [p for p in training(pairs) if p["terms"] is not None]
         if not test or {p["same"] for p in train} != {True, False}:
             continue  # nothing to score, or too few pairs to fit: left NaN
-        model = fit([p["terms"] for p in train], [p["same"] for p in train], names, ridge=ridge)
+        model = fit(
+            [p["terms"] for p in train], [p["same"] for p in train], names, ridge=ridge, warp=warp
+        )
         out[test] = model.log10_lr([pairs[i]["terms"] for i in test])
     return out
 
