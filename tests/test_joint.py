@@ -11,7 +11,9 @@ from lilium.cli.main import main
 from lilium.io.case import read_photo, read_skull
 from lilium.methods import SfoOptions, run_joint_sfo, run_sfo
 from lilium.methods.joint import (
+    ANGLE_PRIOR_WEIGHT,
     JointLiliumProblem,
+    angle_prior,
     camera_on_priors,
     joint_lilium_sfo,
     photo_scale_px_per_mm,
@@ -90,7 +92,10 @@ def test_fitness_is_the_sum_of_the_photos_fitnesses(pair, camera):
     genes = rng.random((6, problem.n_genes))
     terms = problem.evaluate(genes, members)
     assert terms["R"].shape == (6, 2, 3, 3) and terms["photo_fitness"].shape == (6, 2)
-    np.testing.assert_allclose(terms["fitness"], terms["photo_fitness"].sum(axis=1), rtol=1e-12)
+    prior = angle_prior(genes, ANGLE_PRIOR_WEIGHT)
+    np.testing.assert_allclose(
+        terms["fitness"], terms["photo_fitness"].sum(axis=1) + prior, rtol=1e-12
+    )
     # Each photo's fitness is what its own problem gives for its rows of the shared soft tissue,
     # warm-started from the same members' cameras of that photo (its own chain).
     shared = problem.facial_landmarks(genes)
@@ -103,6 +108,16 @@ def test_fitness_is_the_sum_of_the_photos_fitnesses(pair, camera):
             assert np.all(alone["fitness"] <= least_squares)
         alone = single.add_image_terms(alone)
         np.testing.assert_allclose(terms["photo_fitness"][:, p], alone["fitness"], rtol=1e-9)
+
+
+def test_angle_prior_charges_the_polar_angle_only():
+    """The joint DE's prior: 0 on the cone axes, growing with the square of each polar angle
+    in units of the direction spread; depth and azimuth genes cost nothing."""
+    genes = np.zeros((3, 6))
+    genes[1, [0, 2, 3, 5]] = 0.9  # depths and azimuths only
+    genes[2, 1] = 0.375  # one polar angle of 15 degrees: (15 / 15)^2 over two landmarks
+    np.testing.assert_allclose(angle_prior(genes, 30.0), [0.0, 0.0, 15.0])
+    np.testing.assert_array_equal(angle_prior(genes, 0.0), 0.0)
 
 
 def test_camera_on_priors_lowers_only_what_p_cam_charges(pair):
@@ -146,7 +161,14 @@ def test_joint_result_is_the_member_de_ranked_and_reproducible(pair):
     weighted = sum(w * r.fitness for w, r in zip(a.weights, a.photos, strict=True))
     assert a.fitness == pytest.approx(weighted, rel=1e-12)
     full = joint_lilium_sfo(skull, photos, replace(options, working_face_px=None), seed=4)
-    assert full.fitness == full.extra["history"][-1]  # at full level, the DE's own fitness
+    # At full level the DE's own fitness: the photos' weighted sum and the angular prior.
+    prior = angle_prior(np.array(full.extra["genes"]), ANGLE_PRIOR_WEIGHT)[0]
+    assert full.fitness + prior == pytest.approx(full.extra["history"][-1], rel=1e-12)
+    assert full.extra["angle_prior_weight"] == ANGLE_PRIOR_WEIGHT
+    plain = joint_lilium_sfo(
+        skull, photos, replace(options, working_face_px=None), seed=4, prior_weight=0.0
+    )
+    assert plain.fitness == plain.extra["history"][-1]
     assert a.weights[0] != a.weights[1]  # the toy photos differ in scale
     for r in a.photos:
         assert r.fitness == pytest.approx(sum(v for v in r.terms.values() if v is not None))

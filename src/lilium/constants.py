@@ -22,6 +22,10 @@ MIN_CORRESPONDENCES = 4
 #: Largest soft-tissue polar angle from the cone axis (degrees), SPEC section 3.
 CONE_MAX_POLAR_DEG = 40.0
 
+#: Angular spread (degrees) of a soft-tissue direction about its cone axis: the identification
+#: model's (:mod:`lilium.identification.terms`) and the joint SFO's angular prior's.
+DIRECTION_SD_DEG = 15.0
+
 #: Weight of the bilateral hybrid: right genes = W * left + (1 - W) * right (SPEC section 3).
 BILATERAL_LEFT_WEIGHT = 0.9
 

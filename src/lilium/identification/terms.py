@@ -56,6 +56,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..constants import DIRECTION_SD_DEG
 from ..geometry.rotations import geodesic_angle_deg
 from ..softtissue.depths import depth_stats
 
@@ -71,8 +72,6 @@ SIGMA_FRACTION = {"manual": 0.02, "tracked": 0.03, "template": 0.08}
 #: than this, however small the face.
 SIGMA_FLOOR_PX = 1.5
 
-#: Angular spread (degrees) of the soft-tissue direction about its axis.
-DIRECTION_SD_DEG = 15.0
 
 #: Placement error (mm per coordinate) of a cranial landmark on the skull.
 BONE_SD_MM = 1.0

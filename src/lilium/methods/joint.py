@@ -38,6 +38,15 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   offset): the run is the same, with fewer P_skof/P_pll evaluations. Each term is added for
   every photo before the next (P_pll, then the costlier P_skof), so P_skof's pruning knows
   every photo's P_pll.
+- **Angular prior.** The DE minimises the weighted sum plus ``lambda mean_g (alpha_g /
+  tau)^2`` (:data:`ANGLE_PRIOR_WEIGHT`, ``alpha_g`` the polar angle a gene puts a facial point
+  at from its cone axis, ``tau`` = :data:`~lilium.constants.DIRECTION_SD_DEG`): with one
+  frontal and one lateral photo a shared soft tissue still had the cones' angular freedom to
+  absorb the landmarks' noise (it fitted them tighter than either single SFO), and a real face
+  may lie outside the depth table (the headsq CT's canthi and alare), so the prior is on the
+  direction only. The result's fitness is the photos' weighted sum without it (SPEC section
+  9); ``joint_fitness`` in ``extra`` is the DE's, with it. ``angle_prior=0`` is the design
+  before (docs/method.md, "An angular prior").
 - **Budget.** ``generations_factor`` scales the DE generations (default
   :data:`DEFAULT_GENERATIONS_FACTOR`, 0.5: with the cameras on the priors half the generations
   gave the same BPE as all of them on 8 generated subjects x 3 seeds, complete and
@@ -53,6 +62,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..constants import CONE_MAX_POLAR_DEG, DIRECTION_SD_DEG
 from ..optimisation.de import DifferentialEvolution
 from ..pose.prior_refine import refine_with_priors
 from ..pose.residuals import reprojection_sq_errors
@@ -80,6 +90,25 @@ CAMERAS = ("priors", "least_squares")
 DEFAULT_CAMERA = "priors"
 DEFAULT_WEIGHTING = "scale"
 DEFAULT_GENERATIONS_FACTOR = 0.5
+
+#: Weight ``lambda`` of the joint DE's angular soft-tissue prior (module notes): 0 = none.
+#: Measured as the defaults above (ratios to the independent SFOs, generated complete / without
+#: mandible, headsq ``hq`` / ``hq_nm``): none x0.922 / x0.995 / x1.018 / x1.034; lambda 10
+#: x0.885 / x0.982 / x1.001 / x0.943; 30 x0.866 / x0.978 / x0.969 / x0.979; 100 (mandible-less
+#: only) x1.047.
+ANGLE_PRIOR_WEIGHT = 30.0
+
+
+def angle_prior(genes, weight):
+    """The joint DE's angular soft-tissue prior of a population ``(S, 3U)``: ``(S,)``,
+    ``weight`` times the mean over the genes of ``(alpha / tau)^2``, ``alpha`` the polar angle
+    (degrees) a gene's second component sets (before the bilateral hybrid), ``tau`` =
+    :data:`~lilium.constants.DIRECTION_SD_DEG`."""
+    genes = np.atleast_2d(genes)
+    if not weight:
+        return np.zeros(len(genes))
+    alpha = CONE_MAX_POLAR_DEG * genes[:, 1::3]
+    return weight * np.mean((alpha / DIRECTION_SD_DEG) ** 2, axis=1)
 
 #: Per-photo arrays of the DE payload, shape ``(S, P, ...)``.
 PHOTO_KEYS = ("fitness", "mse_pix", "p_cam", "p_skof", "p_pll", "R", "t", "focal_px", "success")
@@ -128,6 +157,8 @@ class JointLiliumProblem:
     camera : {"priors", "least_squares"}
         ``"priors"``: each photo's least-squares camera is refined further on its MSE_pix +
         P_cam (:func:`camera_on_priors`); ``"least_squares"``: as a single SFO.
+    prior_weight : float
+        :func:`angle_prior`'s weight (:data:`ANGLE_PRIOR_WEIGHT`; 0 = none).
 
     Raises
     ------
@@ -144,6 +175,7 @@ class JointLiliumProblem:
         rng=0,
         weighting=DEFAULT_WEIGHTING,
         camera=DEFAULT_CAMERA,
+        prior_weight=ANGLE_PRIOR_WEIGHT,
     ):
         photos = list(photos)
         if len(photos) < 2:
@@ -158,6 +190,7 @@ class JointLiliumProblem:
         if camera not in CAMERAS:
             raise ValueError(f"unknown camera {camera!r}; use one of {', '.join(CAMERAS)}")
         self.camera = camera
+        self.prior_weight = float(prior_weight)
         self.rng = np.random.default_rng(rng)
         self.skull, self.photos, self.options = skull, photos, options
         self.problems = [LiliumProblem(skull, p, options, rng=self.rng) for p in photos]
@@ -203,11 +236,12 @@ class JointLiliumProblem:
         Returns
         -------
         dict of str -> ndarray
-            ``fitness`` (S,) the joint fitness; per photo (axis 1, in photo order)
-            ``photo_fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (S, P),
+            ``fitness`` (S,) the joint fitness (with :func:`angle_prior`); per photo (axis 1,
+            in photo order) ``photo_fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (S, P),
             ``success`` (S, P), cameras ``R`` (S, P, 3, 3), ``t`` (S, P, 3), ``focal_px`` (S, P).
         """
         facial = self.facial_landmarks(genes)
+        prior = angle_prior(genes, self.prior_weight)
         per = []
         for p, problem in enumerate(self.problems):
             mine = None
@@ -226,10 +260,11 @@ class JointLiliumProblem:
             # then knows every photo's P_pll.
             for name in IMAGE_TERMS:
                 for p, problem in enumerate(self.problems):
-                    offset = np.delete(partial, p, axis=0).sum(axis=0)  # the other photos' bounds
+                    # The other photos' partial sums and the prior bound the trial's rest.
+                    offset = np.delete(partial, p, axis=0).sum(axis=0) + prior
                     problem.add_image_terms(per[p], thresholds, offset, w[p], names=(name,))
                     partial[p] = w[p] * per[p]["fitness"]
-            total = partial.sum(axis=0)
+            total = partial.sum(axis=0) + prior
         out = {k: np.stack([t[k] for t in per], axis=1) for k in PHOTO_KEYS}
         out["photo_fitness"] = out.pop("fitness")
         out["fitness"] = total
@@ -433,6 +468,7 @@ def joint_lilium_sfo(
     weighting=DEFAULT_WEIGHTING,
     generations_factor=DEFAULT_GENERATIONS_FACTOR,
     camera=DEFAULT_CAMERA,
+    prior_weight=ANGLE_PRIOR_WEIGHT,
 ):
     """Run one joint Lilium SFO of a skull against several photos of one person.
 
@@ -451,6 +487,8 @@ def joint_lilium_sfo(
         DE generations = ``round(factor x options.de.max_generations)``.
     camera : {"priors", "least_squares"}
         How each photo's camera is fitted (:class:`JointLiliumProblem`).
+    prior_weight : float
+        The DE's angular soft-tissue prior (:func:`angle_prior`; 0 = none).
 
     Returns
     -------
@@ -461,7 +499,8 @@ def joint_lilium_sfo(
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
     problem = JointLiliumProblem(
-        skull, photos, options, rng=rng, weighting=weighting, camera=camera
+        skull, photos, options, rng=rng, weighting=weighting, camera=camera,
+        prior_weight=prior_weight,
     )
     de_options = options.de
     if generations_factor != 1.0:
@@ -494,9 +533,9 @@ def joint_lilium_sfo(
                 terms_off=dict(single.terms_off),
             )
         )
-    total = de.fun
-    if any(r.camera is not None for r in results) and not all(
-        pr.level.is_full for pr in problem.problems
+    total = de.fun  # the photos' weighted sum, unless the DE's also held the prior
+    if any(r.camera is not None for r in results) and (
+        problem.prior_weight or not all(pr.level.is_full for pr in problem.problems)
     ):
         total = float(sum(w * r.fitness for w, r in zip(problem.weights, results, strict=True)))
     seconds = time.perf_counter() - start
@@ -521,5 +560,6 @@ def joint_lilium_sfo(
         seconds=seconds,
         weights=tuple(float(w) for w in problem.weights),
         extra=de_extra(de, sum(pr.n_fallbacks for pr in problem.problems))
-        | {"weighting": weighting, "camera_fit": problem.camera},
+        | {"weighting": weighting, "camera_fit": problem.camera,
+           "angle_prior_weight": problem.prior_weight},
     )
