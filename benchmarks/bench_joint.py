@@ -6,9 +6,10 @@ variant and seeds, in one run:
 
 - the two independent Lilium SFOs (``lilium.methods.run_sfo``, one per photo);
 - one joint SFO per design (``lilium.methods.joint.joint_lilium_sfo``): a design is
-  ``WEIGHTING:GENERATIONS_FACTOR[:CAMERA]`` (``sum:1``, ``scale:1.25``, ``scale:1:ls``, ...);
-  CAMERA ``ls`` (least-squares cameras, as a single SFO; the library's default) or ``priors``
-  (cameras refined on MSE_pix + P_cam, ``camera="priors"``).
+  ``WEIGHTING:GENERATIONS_FACTOR[:CAMERA[:LAMBDA]]`` (``sum:1``, ``scale:0.5``,
+  ``scale:1:ls``, ``scale:0.5:priors:0``, ...); CAMERA ``priors`` (cameras refined on MSE_pix +
+  P_cam, the library's default) or ``ls`` (least-squares cameras, as a single SFO); LAMBDA the
+  weight of the DE's angular soft-tissue prior (default ``ANGLE_PRIOR_WEIGHT``; 0 = none).
 
 It prints, per method: the mean BPE (mm) of the frontal and the lateral photos and of both, the
 failures (no camera), the implausible SFOs (any skull pixel outside the face mask,
@@ -39,7 +40,7 @@ from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions, run_sfo
-from lilium.methods.joint import DEFAULT_CAMERA, joint_lilium_sfo
+from lilium.methods.joint import ANGLE_PRIOR_WEIGHT, DEFAULT_CAMERA, joint_lilium_sfo
 from lilium.optimisation import DEOptions
 
 #: Issue 16's targets for the joint SFO against the independent ones.
@@ -91,7 +92,7 @@ def run_pair(task):
             | _metrics(result, skull, photo, truth)
         )
     for design in designs:
-        weighting, factor, camera = parse_design(design)
+        weighting, factor, camera, prior = parse_design(design)
         t0 = time.perf_counter()
         joint = joint_lilium_sfo(
             skull,
@@ -101,6 +102,7 @@ def run_pair(task):
             weighting=weighting,
             generations_factor=factor,
             camera=camera,
+            prior_weight=prior,
         )
         seconds = time.perf_counter() - t0
         for result, photo, truth in zip(joint.photos, photos, truths, strict=True):
@@ -124,13 +126,15 @@ DESIGN_CAMERAS = {"priors": "priors", "ls": "least_squares"}
 
 
 def parse_design(design):
-    """``WEIGHTING:FACTOR[:CAMERA]`` -> ``(weighting, factor, camera)``; CAMERA ``priors`` or
-    ``ls`` (least squares, as a single SFO), the library's default when omitted."""
+    """``WEIGHTING:FACTOR[:CAMERA[:LAMBDA]]`` -> ``(weighting, factor, camera, prior_weight)``;
+    CAMERA ``priors`` or ``ls`` (least squares, as a single SFO) and LAMBDA the angular prior's
+    weight (:func:`lilium.methods.joint.angle_prior`), the library's defaults when omitted."""
     parts = design.split(":")
-    if len(parts) not in (2, 3) or (len(parts) == 3 and parts[2] not in DESIGN_CAMERAS):
-        raise ValueError(f"design {design!r}: use WEIGHTING:FACTOR[:priors|ls]")
-    camera = DESIGN_CAMERAS[parts[2]] if len(parts) == 3 else DEFAULT_CAMERA
-    return parts[0], float(parts[1]), camera
+    if len(parts) not in (2, 3, 4) or (len(parts) >= 3 and parts[2] not in DESIGN_CAMERAS):
+        raise ValueError(f"design {design!r}: use WEIGHTING:FACTOR[:priors|ls[:LAMBDA]]")
+    camera = DESIGN_CAMERAS[parts[2]] if len(parts) >= 3 else DEFAULT_CAMERA
+    prior = float(parts[3]) if len(parts) == 4 else ANGLE_PRIOR_WEIGHT
+    return parts[0], float(parts[1]), camera, prior
 
 
 def pairs_of(index, n_subjects):
