@@ -72,7 +72,6 @@ SIGMA_FRACTION = {"manual": 0.02, "tracked": 0.03, "template": 0.08}
 #: than this, however small the face.
 SIGMA_FLOOR_PX = 1.5
 
-
 #: Placement error (mm per coordinate) of a cranial landmark on the skull.
 BONE_SD_MM = 1.0
 

@@ -45,7 +45,7 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   absorb the landmarks' noise (it fitted them tighter than either single SFO), and a real face
   may lie outside the depth table (the headsq CT's canthi and alare), so the prior is on the
   direction only. The result's fitness is the photos' weighted sum without it (SPEC section
-  9); ``joint_fitness`` in ``extra`` is the DE's, with it. ``angle_prior=0`` is the design
+  9); ``joint_fitness`` in ``extra`` is the DE's, with it. ``prior_weight=0`` is the design
   before (docs/method.md, "An angular prior").
 - **Budget.** ``generations_factor`` scales the DE generations (default
   :data:`DEFAULT_GENERATIONS_FACTOR`, 0.5: with the cameras on the priors half the generations
@@ -109,6 +109,7 @@ def angle_prior(genes, weight):
         return np.zeros(len(genes))
     alpha = CONE_MAX_POLAR_DEG * genes[:, 1::3]
     return weight * np.mean((alpha / DIRECTION_SD_DEG) ** 2, axis=1)
+
 
 #: Per-photo arrays of the DE payload, shape ``(S, P, ...)``.
 PHOTO_KEYS = ("fitness", "mse_pix", "p_cam", "p_skof", "p_pll", "R", "t", "focal_px", "success")
