@@ -15,10 +15,18 @@ It prints, per method: the mean BPE (mm) of the frontal and the lateral photos a
 failures (no camera), the implausible SFOs (any skull pixel outside the face mask,
 ``lilium.evaluation.outside_face``) and their mean % outside, and the time; then each joint
 design's ratios against the independent runs (mean BPE, and time against the two independent
-SFOs together), with the issue's targets (BPE <= 0.9 x, no more failures, time <= 1.25 x).
+SFOs together), with issue 27's targets (BPE <= 0.95 x, no more failures; time <= 1.25 x where
+a budget change is the fix; issue 16 asked for 0.9 x).
 
     python benchmarks/bench_joint.py --subjects 8 --jobs 2
     python benchmarks/bench_joint.py --dataset DIR --generations 150 --designs scale:1:ls scale:1
+
+``--priors off-centre`` moves each photo's focal-length and subject-to-camera distance
+intervals (same widths) so that the truth lies at a uniform position in the central 80 % of
+each, drawn per photo from ``--priors-seed`` (the same priors for the independent and the
+joint SFOs); the paper's protocol (the default, ``centred``) centres them on the truth, which
+an estimate from EXIF or a network does not (docs/method.md, "The joint SFO's cameras on the
+edge of the priors"). The head orientation prior stays the true rotation.
 
 ``--headsq DIR`` adds the headsq real-anatomy case (issue 27, ``benchmarks/headsq_case.py``; its
 dataset built in DIR when absent): each frontal photo paired with the lateral one of the same
@@ -27,9 +35,11 @@ after the generated subjects (``--subjects 0``: headsq alone).
 """
 
 import argparse
+import dataclasses
 import statistics
 import tempfile
 import time
+import zlib
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -43,8 +53,8 @@ from lilium.methods import SfoOptions, run_sfo
 from lilium.methods.joint import ANGLE_PRIOR_WEIGHT, DEFAULT_CAMERA, joint_lilium_sfo
 from lilium.optimisation import DEOptions
 
-#: Issue 16's targets for the joint SFO against the independent ones.
-TARGET_BPE_RATIO = 0.9
+#: Issue 27's targets for the joint SFO against the independent ones (issue 16's BPE was 0.9 x).
+TARGET_BPE_RATIO = 0.95
 TARGET_TIME_RATIO = 1.25
 
 
@@ -69,15 +79,36 @@ def _metrics(result, skull, photo, truth):
     )
 
 
+#: Where the truth may lie in an off-centre prior interval (fractions of its width).
+OFF_CENTRE_RANGE = (0.1, 0.9)
+
+
+def off_centre_priors(photo, seed):
+    """The photo with its focal and distance intervals moved (same widths) so that their centre
+    (the truth, in the paper's protocol) lies at ``q`` of each, ``q`` uniform in
+    :data:`OFF_CENTRE_RANGE`, drawn from ``seed`` and the photo's id."""
+    rng = np.random.default_rng([seed, zlib.crc32(photo.id.encode())])
+    moved = {}
+    for key in ("focal_px", "scd_mm"):
+        interval = getattr(photo.priors, key)
+        if interval is not None:
+            lo, hi = interval
+            q = rng.uniform(*OFF_CENTRE_RANGE)
+            moved[key] = ((lo + hi) / 2 - q * (hi - lo), (lo + hi) / 2 + (1 - q) * (hi - lo))
+    return dataclasses.replace(photo, priors=dataclasses.replace(photo.priors, **moved))
+
+
 def run_pair(task):
     """The independent and joint SFOs of one subject's frontal + lateral pair, one seed."""
-    root, subject, photo_ids, axes_set, variant, de, seed, designs = task
+    root, subject, photo_ids, axes_set, variant, de, seed, designs, priors_seed = task
     _one_thread()
     subject_dir = root / "subjects" / subject
     skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{axes_set}.json")
     index = {p["id"]: p for p in read_json(root / "dataset.json")["photos"]}
     dirs = [root / index[i]["paths"]["C"] for i in photo_ids]
     photos = [read_photo(d) for d in dirs]
+    if priors_seed is not None:
+        photos = [off_centre_priors(p, priors_seed) for p in photos]
     truths = [read_ground_truth(d, subject_dir) for d in dirs]
     options = SfoOptions(variant, de)
     rows = []
@@ -238,7 +269,15 @@ def main(argv=None):
     p.add_argument("--jobs", type=int, default=1)
     p.add_argument("--headsq", type=Path, metavar="DIR", help="also the headsq case (see above)")
     p.add_argument("--headsq-photos", type=int, default=3, help="its photos per view if built")
+    p.add_argument(
+        "--priors",
+        choices=("centred", "off-centre"),
+        default="centred",
+        help="focal and distance priors centred on the truth (the paper's) or off centre",
+    )
+    p.add_argument("--priors-seed", type=int, default=0, help="draws of --priors off-centre")
     args = p.parse_args(argv)
+    args.priors_seed = args.priors_seed if args.priors == "off-centre" else None
     de = DEOptions(
         population_size=args.population, max_generations=args.generations, max_seconds=None
     )
@@ -260,7 +299,17 @@ def _headsq(args, de):
     index = read_json(root / "dataset.json")
     for sid, label in (("hq", "complete skull"), ("hq_nm", "without mandible")):
         tasks = [
-            (root, subject, ids, args.axes_set, args.variant, de, seed, args.designs)
+            (
+                root,
+                subject,
+                ids,
+                args.axes_set,
+                args.variant,
+                de,
+                seed,
+                args.designs,
+                args.priors_seed,
+            )
             for subject, ids in headsq_pairs(index, sid)
             for seed in args.seeds
         ]
@@ -269,7 +318,7 @@ def _headsq(args, de):
         print(
             f"\nheadsq real anatomy, {label} ({sid}): {len(tasks)} pairs (frontal k + lateral "
             f"k x {len(args.seeds)} seed(s)), Lilium {args.variant}, DE {args.population} x "
-            f"{args.generations}, axes C{args.axes_set}"
+            f"{args.generations}, axes C{args.axes_set}, priors {args.priors}"
         )
         summarise(_run_tasks(tasks, args.jobs), args.designs)
 
@@ -283,14 +332,14 @@ def _generated(args, de):
         generate_dataset(root, args.subjects, 1, seed=0, experiments=("C",), workers=args.jobs)
     index = read_json(root / "dataset.json")
     tasks = [
-        (root, subject, ids, args.axes_set, args.variant, de, seed, args.designs)
+        (root, subject, ids, args.axes_set, args.variant, de, seed, args.designs, args.priors_seed)
         for subject, ids in pairs_of(index, args.subjects)
         for seed in args.seeds
     ]
     print(
         f"{len(tasks)} pairs ({args.subjects} subjects x {len(args.seeds)} seed(s)), Lilium "
         f"{args.variant}, DE {args.population} x {args.generations}, axes C{args.axes_set}, "
-        f"{args.jobs} job(s)"
+        f"priors {args.priors}, {args.jobs} job(s)"
     )
     summarise(_run_tasks(tasks, args.jobs), args.designs)
 

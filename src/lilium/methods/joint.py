@@ -300,7 +300,9 @@ def camera_on_priors(problem, facial_mm, terms, members=None):
     iterations, started from the camera of the member the trial competes with, the previous
     such refinement, where it has a valid one, else from the least-squares camera). A member
     whose least-squares camera is valid and inside every prior (P_cam = 0) keeps it; a refined
-    camera replaces it only when it is valid and lowers MSE_pix + P_cam.
+    camera replaces it only when it is valid and lowers MSE_pix + P_cam. Where the shared soft
+    tissue's least-squares camera lies outside a prior, the refined one stops on its edge: most
+    joint cameras do (docs/method.md, "The joint SFO's cameras on the edge of the priors").
 
     Parameters
     ----------
