@@ -25,8 +25,8 @@ a budget change is the fix; issue 16 asked for 0.9 x).
 intervals (same widths) so that the truth lies at a uniform position in the central 80 % of
 each, drawn per photo from ``--priors-seed`` (the same priors for the independent and the
 joint SFOs); the paper's protocol (the default, ``centred``) centres them on the truth, which
-an estimate from EXIF or a network does not (docs/method.md, "The joint SFO's cameras on the
-edge of the priors"). The head orientation prior stays the true rotation.
+a case's priors do not promise (docs/method.md, "The joint SFO's cameras on the edge of the
+priors"). The head orientation prior stays the true rotation.
 
 ``--headsq DIR`` adds the headsq real-anatomy case (issue 27, ``benchmarks/headsq_case.py``; its
 dataset built in DIR when absent): each frontal photo paired with the lateral one of the same

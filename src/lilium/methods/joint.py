@@ -300,9 +300,10 @@ def camera_on_priors(problem, facial_mm, terms, members=None):
     iterations, started from the camera of the member the trial competes with, the previous
     such refinement, where it has a valid one, else from the least-squares camera). A member
     whose least-squares camera is valid and inside every prior (P_cam = 0) keeps it; a refined
-    camera replaces it only when it is valid and lowers MSE_pix + P_cam. Where the shared soft
-    tissue's least-squares camera lies outside a prior, the refined one stops on its edge: most
-    joint cameras do (docs/method.md, "The joint SFO's cameras on the edge of the priors").
+    camera replaces it only when it is valid and lowers MSE_pix + P_cam. Along a dolly zoom the
+    landmarks hardly tell focal lengths apart, so most refined cameras stop on an edge of the
+    focal prior, at little cost in BPE (docs/method.md, "The joint SFO's cameras on the edge of
+    the priors").
 
     Parameters
     ----------
