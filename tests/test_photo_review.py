@@ -8,23 +8,21 @@ the saved file in ``<pre id="saved">`` and in the download link's ``data:`` URL.
 import html
 import json
 import re
-import shutil
-import subprocess
 import urllib.parse
 
 import numpy as np
 import pytest
 from PIL import Image
 
+from browser import needs_chromium, run_chromium
+
 pytest.importorskip("ai_edge_litert")
 
 from lilium.cli.main import main  # noqa: E402
 from lilium.io.case import read_photo  # noqa: E402
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
-
-@pytest.mark.skipif(CHROMIUM is None, reason="needs Chromium for the headless browser test")
+@needs_chromium
 def test_drag_save_and_read_back(tmp_path):
     from skimage import data
 
@@ -32,12 +30,8 @@ def test_drag_save_and_read_back(tmp_path):
     out = tmp_path / "photo"
     assert main(["photo", str(tmp_path / "a.png"), "--out", str(out)]) == 0
     before = json.loads((out / "photo.json").read_text())
-    dom = subprocess.run(
-        [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-         f"--user-data-dir={tmp_path / 'chromium-profile'}", "--dump-dom",
-         (out / "review.html").as_uri() + "?test"],
-        capture_output=True, text=True, timeout=120, check=True,
-    ).stdout  # fmt: skip
+    page = (out / "review.html").as_uri() + "?test"
+    dom = run_chromium("--dump-dom", page, tmp_path=tmp_path).stdout
     saved = json.loads(html.unescape(re.search(r'<pre id="saved">(.*?)</pre>', dom, re.S)[1]))
     href = html.unescape(re.search(r'id="download"[^>]*href="([^"]+)"', dom)[1])
     assert href.startswith("data:application/json")

@@ -3,12 +3,11 @@
 import html
 import json
 import re
-import shutil
-import subprocess
 
 import numpy as np
 import pytest
 
+from browser import needs_chromium, run_chromium
 from lilium.io.case import read_photo, read_skull
 from lilium.io.provenance import sha256_of
 from lilium.methods.posest_sfo import posest_sfo
@@ -19,14 +18,6 @@ from lilium.report.pictures import (
     picture_size,
     sfo_pictures,
     view_box,
-)
-
-CHROMIUM = next(
-    (shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)),
-    None,
-)
-needs_chromium = pytest.mark.skipif(
-    CHROMIUM is None, reason="no chromium (apt-get install chromium)"
 )
 
 
@@ -173,28 +164,12 @@ window.addEventListener('load', function () {
 """
 
 
-def _chromium(*args, tmp_path):
-    cmd = [
-        CHROMIUM,
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        "--no-first-run",
-        f"--user-data-dir={tmp_path / 'chromium-profile'}",
-        *args,
-    ]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=120, check=True)
-
-
 @needs_chromium
-def test_controls_change_what_is_shown_in_headless_chromium(report, tmp_path):
+def test_controls_change_what_is_shown_in_headlessrun_chromium(report, tmp_path):
     path, _ = report
     probe = path.with_name("probe.html")
     probe.write_text(path.read_text().replace("</body>", _PROBE + "</body>"))
-    dom = _chromium(
+    dom = run_chromium(
         "--window-size=1400,1000",
         "--virtual-time-budget=5000",
         "--dump-dom",
@@ -230,7 +205,7 @@ def test_screenshot_shows_the_skull_over_the_photo(report, tmp_path):
 
     path, _ = report
     shot = tmp_path / "shot.png"
-    _chromium(
+    run_chromium(
         "--window-size=1400,1100",
         "--hide-scrollbars",
         f"--screenshot={shot}",
