@@ -171,52 +171,12 @@ def test_two_views_that_repeat_each_other_are_not_counted_twice():
     assert both["performance"]["cllr"] < both["performance_added"]["cllr"] - 0.02
     models = fit_models(decision_pairs, {}, log=lambda line: None, validated=validated)
     model = models["m//pair_sum"]
-    # No ``pair`` decision here: the shared-soft-tissue feature never varies, so it is dropped.
-    assert model.names == (VIEWS_LOG10_LR,) and VIEWS_TERMS[0] == VIEWS_LOG10_LR
+    assert model.names == VIEWS_TERMS
     assert model.provenance["model"] == VIEWS_MODEL
     lr = model.log10_lr([{VIEWS_LOG10_LR: x} for x in (-2.0, 0.0, 2.0)])
     slope = (lr[2] - lr[0]) / 4.0
     assert 0.35 < slope < 0.7, slope
     assert "m//pair_sum" not in fit_models(decision_pairs, {}, log=lambda line: None)
-
-
-def test_the_calibrated_sum_reads_the_shared_soft_tissue_lr():
-    """Where the two SFOs taken with one shared soft tissue (``pair``) carry evidence the
-    single-photo LRs lack, the ``pair_sum`` model takes their LR as its second feature and
-    costs less than the views' sum alone, cross-validated (nested); a case gives both."""
-    import lilium.experiments.calibrate as calibrate
-    from lilium.identification.calibration import PAIR_LOG10_LR, VIEWS_LOG10_LR
-
-    rng = np.random.default_rng(11)
-    n = 16
-    decision_pairs = {("m", "", d): [] for d in ("frontal", "lateral", "pair", "pair_sum")}
-    for person in range(n):
-        for skull in range(n):
-            same = person == skull
-            base = dict(same=same, person=f"s{person}", skull=f"s{skull}", run=("r",),
-                        photo=f"s{person}_frontal")
-            for view, shift in (("frontal", 0.6), ("lateral", 0.6), ("pair", 2.0)):
-                chi2 = np.exp(rng.normal(0.0 if same else shift, 0.5))
-                decision_pairs[("m", "", view)].append(
-                    base | {"terms": {"landmark_chi2": chi2}}
-                    | ({"photo": f"s{person}_lateral"} if view == "lateral" else {})
-                )
-            decision_pairs[("m", "", "pair_sum")].append(base)
-    new = calibrate.validate(decision_pairs, folds=4)[("m", "", "pair_sum")]
-    assert np.isfinite(new["pair_lr"]).all()
-    try:
-        calibrate.VIEWS_TERMS = (VIEWS_LOG10_LR,)  # the model before 2026-12-04
-        old = calibrate.validate(decision_pairs, folds=4)[("m", "", "pair_sum")]
-    finally:
-        calibrate.VIEWS_TERMS = (VIEWS_LOG10_LR, PAIR_LOG10_LR)
-    assert new["performance"]["cllr"] < old["performance"]["cllr"] - 0.05
-    validated = calibrate.validate(decision_pairs, folds=4)
-    model = calibrate.fit_models(decision_pairs, {}, log=lambda line: None, validated=validated)[
-        "m//pair_sum"
-    ]
-    assert model.names == (VIEWS_LOG10_LR, PAIR_LOG10_LR) and model.weights[PAIR_LOG10_LR] > 0
-    # Without the shared LR (no pair model in a user's file) the model reads its median.
-    assert np.isfinite(model.log10_lr([{VIEWS_LOG10_LR: 1.0}])[0])
 
 
 def test_conclusion_scale_caps_and_consistency():
@@ -530,11 +490,7 @@ def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeyp
     assert both["views_log10_lr"] == [one[0]["log10_lr"], one[1]["log10_lr"]]
     views = calibrations.get("posest-sfo//pair_sum")
     assert both["calibration"]["views_model"] == "posest-sfo//pair_sum"
-    # ... with the two SFOs' shared-soft-tissue LR as the model's second feature.
-    shared = calibrations.get("posest-sfo//pair").log10_lr([both["terms"]])[0]
-    assert both["pair_log10_lr"] == pytest.approx(shared)
-    features = {"views_log10_lr": added, "pair_log10_lr": shared}
-    assert both["log10_lr"] == pytest.approx(views.log10_lr([features])[0])
+    assert both["log10_lr"] == pytest.approx(views.log10_lr([{"views_log10_lr": added}])[0])
     assert "calibrated as one decision" in both["note"]
     without = Calibrations()
     del without.models["posest-sfo//pair_sum"]

@@ -8,9 +8,7 @@ photo add the two photos' log10 LRs (each from its own view's model) and calibra
 with ``<method>/<variant>/pair_sum`` (a slope and an offset fitted on same- and
 different-person pairs instead of assuming the photos independent, which they are not: they
 share the soft tissue; Lilium's slope came out above 1, each photo's own model being
-conservative; without that model, the plain sum, and the note says so). Since 2026-12-04 that
-model also reads the two SFOs' log10 LR with one shared soft tissue (the ``pair`` model's on
-the decision's terms), where it was fitted with it.
+conservative; without that model, the plain sum, and the note says so).
 Measured on 52 generated subjects (docs/method.md): Cllr 0.242 against 0.265 for the plain
 sum and 0.417 for one model of both photos with their soft tissue shared. Any other two or
 more photos use ``<method>/<variant>/pair``
@@ -21,7 +19,7 @@ naming the model missing and how to fit it.
 
 from dataclasses import replace
 
-from ..identification.calibration import PAIR_LOG10_LR, VIEWS_LOG10_LR
+from ..identification.calibration import VIEWS_LOG10_LR
 from ..identification.conclusion import conclude, material_caps
 from ..identification.score import identification_terms, nll_score
 from ..inputs import correspondences
@@ -104,10 +102,8 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
         One per photo (a joint SFO's per-photo results, or separate SFOs).
     calibrations : Calibrations
     facial_landmarks_mm : dict, optional
-        The soft tissue of the decision's terms (default: the first frontal photo's result's,
-        else the first result's). A frontal and a lateral photo's separate SFOs each give their
-        LR from their own result's soft tissue, and their shared-soft-tissue LR from these
-        terms.
+        The soft tissue of the decision's terms (default: the first result's). A frontal and a
+        lateral photo's separate SFOs each give their LR from their own result's soft tissue.
     joint : bool
         The results are one joint SFO's.
 
@@ -148,10 +144,7 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
             "inconsistent": {},
             "note": "no camera: the SFO failed, so nothing can be concluded",
         }
-    # Several photos' terms share one soft tissue: the first frontal photo's SFO's, as the
-    # calibration's pairs take it (lilium.experiments.calibrate).
-    own = next((r for p, r in zip(photos, results, strict=True) if _group(p) == "frontal"), None)
-    facial = facial_landmarks_mm or (own or results[0]).facial_landmarks_mm
+    facial = facial_landmarks_mm or results[0].facial_landmarks_mm
     # The built-in depth table, whatever the SFO used: the calibration was fitted on terms
     # computed with it, and a user's table would move the terms off that calibration.
     terms = identification_terms(
@@ -166,15 +159,11 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
             for p, r in zip(photos, results, strict=True)
         ]
         lrs = [part["log10_lr"] for part in parts]
-        shared_model = calibrations.get(f"{method}/{variant or ''}/pair")
-        shared = None if shared_model is None else float(shared_model.log10_lr([terms])[0])
         lr, note = _views_lr(
-            lrs, shared, [p.id for p in photos], calibrations,
-            f"{method}/{variant or ''}/pair_sum", record,
+            lrs, [p.id for p in photos], calibrations, f"{method}/{variant or ''}/pair_sum", record
         )
         note = "; ".join([part["note"] for part in parts if part["note"]] + [note] * bool(note))
         record["views_log10_lr"] = lrs
-        record["pair_log10_lr"] = shared
         record["calibration"].setdefault(
             "provenance", parts[0]["calibration"].get("provenance")
         )
@@ -204,13 +193,11 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
     }
 
 
-def _views_lr(lrs, shared, photo_ids, calibrations, key, record):
+def _views_lr(lrs, photo_ids, calibrations, key, record):
     """The log10 LR of a frontal and a lateral photo's log10 LRs ``lrs`` (None if either is
     missing; ``photo_ids`` in the same order): their sum calibrated by the model ``key``, or
-    the plain sum without one; and the note that says which. ``shared``: the two SFOs' log10
-    LR with their soft tissue shared (the ``pair`` model's; None without it: the model then
-    reads its training median), the views' model's second feature where it has one. Names
-    the model in ``record["calibration"]``."""
+    the plain sum without one; and the note that says which. Names the model in
+    ``record["calibration"]``."""
     model = calibrations.get(key)
     record["calibration"]["views_model"] = None if model is None else key
     if None in lrs:
@@ -223,20 +210,9 @@ def _views_lr(lrs, shared, photo_ids, calibrations, key, record):
         )
     record["calibration"]["provenance"] = model.provenance
     record["calibration"]["model"] += f" -> {key}"
-    features = {VIEWS_LOG10_LR: added}
-    if shared is not None and PAIR_LOG10_LR in model.names:
-        features[PAIR_LOG10_LR] = shared
-    lr = float(model.log10_lr([features])[0])
+    lr = float(model.log10_lr([{VIEWS_LOG10_LR: added}])[0])
     parts = ", ".join(f"{i} {v:+.2f}" for i, v in zip(photo_ids, lrs, strict=True))
-    with_shared = (
-        f" with their shared-soft-tissue log10 LR ({shared:+.2f})"
-        if PAIR_LOG10_LR in features
-        else ""
-    )
-    return lr, (
-        f"the photos' log10 LRs ({parts}) added and calibrated{with_shared} as one decision "
-        f"({key})"
-    )
+    return lr, f"the photos' log10 LRs ({parts}) added and calibrated as one decision ({key})"
 
 
 def conclusion_line(record):

@@ -14,11 +14,11 @@ photo once.
   landmark with **one shared soft tissue** (:func:`lilium.identification.terms.landmark_chi2`),
   the other terms add up; calibrated as a model of its own;
 - ``pair_sum``: the same two SFOs' cross-validated log10 LRs added and calibrated as one
-  decision: a logistic regression on their sum and, since 2026-12-04, on the ``pair``
-  decision's log10 LR (:data:`~lilium.identification.calibration.VIEWS_TERMS`), fitted on
-  out-of-fold LRs, so on LRs like a new case's (stacking). Added alone the two photos would
-  count as independent evidence, which they are not (they share the soft tissue); the fitted
-  weights calibrate the combination instead (for Lilium the sum's slope came out above 1:
+  decision: a logistic regression on their sum
+  (:data:`~lilium.identification.calibration.VIEWS_TERMS`), fitted on out-of-fold
+  single-photo LRs, so on LRs like a new case's (stacking). Added alone they would count the
+  photos as independent evidence, which they are not (they share the soft tissue); the fitted
+  slope and offset calibrate the combination instead (for Lilium the slope came out above 1:
   each photo's model is conservative). Measured beside ``pair`` and beside the plain sum: for
   Lilium better than both, for POSEST-SFO level with the plain sum (docs/method.md); it is
   what a case with one frontal and one lateral photo reports (:mod:`lilium.casework.identify`);
@@ -34,7 +34,6 @@ import numpy as np
 from ..geometry.camera import Camera
 from ..identification.calibration import (
     CALIBRATED_TERMS,
-    PAIR_LOG10_LR,
     RIDGE,
     VIEWS_LOG10_LR,
     VIEWS_RIDGE,
@@ -306,68 +305,48 @@ def validate(decision_pairs, folds=5, warped=None):
             continue
         same = [p["same"] for p in pairs]
         added = _pair_sum(pairs, decision_pairs, out, key)
-        shared = _pair_lr(pairs, decision_pairs, out, key)
-        lr = _nested_views_lr(pairs, added, shared, decision_pairs, key, folds, warped)
+        lr = _nested_views_lr(pairs, added, decision_pairs, key, folds, warped)
         scored = np.where(np.isfinite(lr), added, np.nan)
-        out[key] = {"log10_lr": lr, "performance": performance(lr, same), "added": added,
-                    "pair_lr": shared, "performance_added": performance(scored, same)}
+        out[key] = {"log10_lr": lr, "performance": performance(lr, same),
+                    "added": added, "performance_added": performance(scored, same)}
     return out
 
 
-def _nested_views_lr(pairs, added, shared, decision_pairs, key, folds, warped):
+def _nested_views_lr(pairs, added, decision_pairs, key, folds, warped):
     """Cross-validated calibrated sums of the ``pair_sum`` ``pairs``: for each subject fold
-    ``k``, the views' model is fitted on sums of single-photo LRs and on shared-soft-tissue
-    LRs that never saw fold ``k`` (the views' and the ``pair`` models cross-validated again
-    within the other folds' pairs) and scores fold ``k``'s own features, ``added`` (P,) and
-    ``shared`` (P,), its cross-validated LRs. NaN where an SFO failed, or a fold's training
-    pairs lack a class."""
+    ``k``, the views' model is fitted on sums of single-photo LRs that never saw fold ``k``
+    (the two views' models cross-validated again within the other folds' pairs) and scores
+    fold ``k``'s own sums ``added`` (P,) of its cross-validated LRs. NaN where an SFO failed,
+    or a fold's training pairs lack a class."""
     out = np.full(len(pairs), np.nan)
     for training, test in subject_splits(pairs, folds):
         inner_pairs, inner_lr = {}, {}
-        for decision in ("frontal", "lateral", "pair"):
-            inner_key = (key[0], key[1], decision)
-            inner_pairs[inner_key] = training(decision_pairs.get(inner_key, []))
-            inner_lr[inner_key] = {
-                "log10_lr": cross_validated(inner_pairs[inner_key], folds,
-                                            warp=decision in warped)
+        for view in ("frontal", "lateral"):
+            view_key = (key[0], key[1], view)
+            inner_pairs[view_key] = training(decision_pairs.get(view_key, []))
+            inner_lr[view_key] = {
+                "log10_lr": cross_validated(inner_pairs[view_key], folds, warp=view in warped)
             }
         train = training(pairs)
-        inner = views_pairs(train, _pair_sum(train, inner_pairs, inner_lr, key),
-                            _pair_lr(train, inner_pairs, inner_lr, key))
+        inner = views_pairs(train, _pair_sum(train, inner_pairs, inner_lr, key))
         inner = [p for p in inner if p["terms"] is not None]
         if not test or {p["same"] for p in inner} != {True, False}:
             continue
         model = fit([p["terms"] for p in inner], [p["same"] for p in inner], VIEWS_TERMS,
                     ridge=VIEWS_RIDGE, warp=key[2] in warped)
-        test_pairs = views_pairs([pairs[i] for i in test], added[test], shared[test])
-        out[test] = model.log10_lr([p["terms"] for p in test_pairs])
+        out[test] = model.log10_lr(
+            [{VIEWS_LOG10_LR: added[i]} if np.isfinite(added[i]) else None for i in test]
+        )
     return out
 
 
-def views_pairs(pairs, added, shared):
-    """``pair_sum`` pairs with their features as ``terms``: the sum ``added`` (P,) of their
-    views' log10 LRs and the shared-soft-tissue log10 LR ``shared`` (P,; NaN where it is
-    unknown: the model then reads its training median). None where an SFO failed."""
+def views_pairs(pairs, added):
+    """``pair_sum`` pairs with their one feature, the sum ``added`` (P,) of their views'
+    log10 LRs, as ``terms`` (None where an SFO failed)."""
     return [
-        p | {"terms": None if not np.isfinite(v) else
-             {VIEWS_LOG10_LR: float(v)} | ({PAIR_LOG10_LR: float(w)} if np.isfinite(w) else {})}
-        for p, v, w in zip(pairs, added, shared, strict=True)
+        p | {"terms": None if not np.isfinite(v) else {VIEWS_LOG10_LR: float(v)}}
+        for p, v in zip(pairs, added, strict=True)
     ]
-
-
-def _pair_lr(pairs, decision_pairs, validated, key):
-    """Per ``pair_sum`` pair: the log10 LR of the ``pair`` decision (the same two SFOs with
-    their soft tissue shared) on the same person, skull and photos; NaN where there is none."""
-    pair_key = (key[0], key[1], "pair")
-    lrs = validated.get(pair_key, {}).get("log10_lr", [])
-    table = {
-        (p["run"], p["person"], p["skull"], p["photo"]): v
-        for p, v in zip(decision_pairs.get(pair_key, []), lrs, strict=True)
-    }
-    return np.array(
-        [table.get((p["run"], p["person"], p["skull"], p["photo"]), np.nan) for p in pairs],
-        float,
-    )
 
 
 def _pair_sum(pairs, decision_pairs, validated, key):
@@ -418,7 +397,7 @@ def fit_models(decision_pairs, provenance, log=print, validated=None):
         if key[2] == "pair_sum":
             if validated is None or key not in validated:
                 continue
-            pairs = views_pairs(pairs, validated[key]["added"], validated[key]["pair_lr"])
+            pairs = views_pairs(pairs, validated[key]["added"])
             names, ridge, origin["model"] = VIEWS_TERMS, VIEWS_RIDGE, VIEWS_MODEL
         train = [p for p in pairs if p["terms"] is not None]
         same = [p["same"] for p in train]

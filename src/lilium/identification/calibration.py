@@ -10,9 +10,8 @@ on 40 generated subjects). Its log LR is the posterior log odds minus the prior 
 prior.
 A model is fitted per method, variant and view (``frontal``, ``lateral``, ``joint``), and one
 per method and variant for a frontal and a lateral photo's separate SFOs: the same logistic
-regression on two features, the sum of the two photos' log10 LRs and the same SFOs' log10 LR
-with their soft tissue shared (:data:`VIEWS_TERMS`), which calibrates their combination
-instead of assuming them independent. A model may also carry a
+regression on one feature, the sum of the two photos' log10 LRs (:data:`VIEWS_TERMS`), which
+calibrates their combination instead of assuming them independent. A model may also carry a
 bi-Gaussianized warp of its LRs (:func:`bigaussian_warp`, Morrison 2024); the benchmark compares
 it with the plain logistic regression, and the shipped models are plain (docs/method.md).
 
@@ -38,9 +37,8 @@ import numpy as np
 from .conclusion import UNDETERMINED, level
 from .terms import CALIBRATED_TERMS, DERIVED_TERMS
 
-#: The features of :data:`VIEWS_TERMS`.
+#: The feature of :data:`VIEWS_TERMS`.
 VIEWS_LOG10_LR = "views_log10_lr"
-PAIR_LOG10_LR = "pair_log10_lr"
 
 #: The feature transforms: heavy-tailed terms on a log scale.
 FEATURES = {
@@ -59,18 +57,14 @@ FEATURES = {
     # below 0 reads as none.
     "landmark_tension": lambda v: np.log1p(np.maximum(v, 0.0)),
     "outside_refit": lambda v: np.log1p(100.0 * np.maximum(v, 0.0)),
-    # Not terms: the frontal and the lateral photo's log10 LRs added, and the log10 LR of
-    # the two SFOs with one shared soft tissue, the features of the model that turns them
-    # into one decision's LR (:data:`VIEWS_TERMS`).
+    # Not a term: the frontal and the lateral photo's log10 LRs added, the one feature of the
+    # model that turns them into one decision's LR (:data:`VIEWS_TERMS`).
     VIEWS_LOG10_LR: lambda v: v,
-    PAIR_LOG10_LR: lambda v: v,
 }
 
 #: The features of the model of a frontal and a lateral photo's separate SFOs
-#: (``<method>/<variant>/pair_sum``, :mod:`lilium.experiments.calibrate`): the two photos'
-#: log10 LRs added, and the same two SFOs' log10 LR with their soft tissue shared (the
-#: ``pair`` model's). A model fitted before 2026-12-04 has the first alone.
-VIEWS_TERMS = (VIEWS_LOG10_LR, PAIR_LOG10_LR)
+#: (``<method>/<variant>/pair_sum``, :mod:`lilium.experiments.calibrate`).
+VIEWS_TERMS = (VIEWS_LOG10_LR,)
 
 #: L2 penalty on the standardised weights of the terms' models.
 RIDGE = 1e-2
