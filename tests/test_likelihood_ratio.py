@@ -517,6 +517,11 @@ def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeyp
     identify(skull, [frontal, lateral], [first, second], calibrations)
     singles = {tuple(views): facial for views, facial in seen if len(views) == 1}
     assert singles[("frontal",)] is own and singles[("lateral_left",)] is moved
+    # The photos' terms together take the frontal photo's soft tissue, as the calibration's
+    # pairs do, whichever photo comes first.
+    seen.clear()
+    identify(skull, [lateral, frontal], [second, first], calibrations)
+    assert [facial for views, facial in seen if len(views) == 2] == [own]
     two_frontal = identify(skull, [frontal, frontal], [result, result], calibrations)
     assert two_frontal["calibration"]["model"] == "posest-sfo//pair"
     assert "these photos differ" in two_frontal["note"]

@@ -102,8 +102,9 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
         One per photo (a joint SFO's per-photo results, or separate SFOs).
     calibrations : Calibrations
     facial_landmarks_mm : dict, optional
-        The soft tissue of the decision's terms (default: the first result's). A frontal and a
-        lateral photo's separate SFOs each give their LR from their own result's soft tissue.
+        The soft tissue of the decision's terms (default: the first frontal photo's result's,
+        else the first result's). A frontal and a lateral photo's separate SFOs each give their
+        LR from their own result's soft tissue.
     joint : bool
         The results are one joint SFO's.
 
@@ -144,7 +145,10 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
             "inconsistent": {},
             "note": "no camera: the SFO failed, so nothing can be concluded",
         }
-    facial = facial_landmarks_mm or results[0].facial_landmarks_mm
+    # Several photos' terms share one soft tissue: the first frontal photo's SFO's, as the
+    # calibration's pairs take it (lilium.experiments.calibrate), whatever the photos' order.
+    own = next((r for p, r in zip(photos, results, strict=True) if _group(p) == "frontal"), None)
+    facial = facial_landmarks_mm or (own or results[0]).facial_landmarks_mm
     # The built-in depth table, whatever the SFO used: the calibration was fitted on terms
     # computed with it, and a user's table would move the terms off that calibration.
     terms = identification_terms(
