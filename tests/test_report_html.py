@@ -165,7 +165,7 @@ window.addEventListener('load', function () {
 
 
 @needs_chromium
-def test_controls_change_what_is_shown_in_headlessrun_chromium(report, tmp_path):
+def test_controls_change_what_is_shown_in_headless_chromium(report, tmp_path):
     path, _ = report
     probe = path.with_name("probe.html")
     probe.write_text(path.read_text().replace("</body>", _PROBE + "</body>"))

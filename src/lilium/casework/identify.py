@@ -147,8 +147,10 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
         }
     # Several photos' terms share one soft tissue: the first frontal photo's SFO's, as the
     # calibration's pairs take it (lilium.experiments.calibrate), whatever the photos' order.
-    own = next((r for p, r in zip(photos, results, strict=True) if _group(p) == "frontal"), None)
-    facial = facial_landmarks_mm or (own or results[0]).facial_landmarks_mm
+    frontal = next(
+        (r for p, r in zip(photos, results, strict=True) if _group(p) == "frontal"), results[0]
+    )
+    facial = facial_landmarks_mm or frontal.facial_landmarks_mm
     # The built-in depth table, whatever the SFO used: the calibration was fitted on terms
     # computed with it, and a user's table would move the terms off that calibration.
     terms = identification_terms(
