@@ -98,19 +98,44 @@ def off_centre_priors(photo, seed):
     return dataclasses.replace(photo, priors=dataclasses.replace(photo.priors, **moved))
 
 
+@dataclasses.dataclass(frozen=True)
+class PairTask:
+    """One subject's frontal + lateral pair under one seed, and the run's settings."""
+
+    root: Path
+    subject: str
+    photo_ids: tuple
+    seed: int
+    axes_set: int
+    variant: str
+    de: DEOptions
+    designs: tuple
+    priors_seed: int | None
+
+
+def pair_tasks(root, pairs, args, de):
+    """A :class:`PairTask` per ``(subject, photo ids)`` of ``pairs`` and seed of ``args``."""
+    designs, priors = tuple(args.designs), args.priors_seed
+    return [
+        PairTask(root, subject, ids, seed, args.axes_set, args.variant, de, designs, priors)
+        for subject, ids in pairs
+        for seed in args.seeds
+    ]
+
+
 def run_pair(task):
-    """The independent and joint SFOs of one subject's frontal + lateral pair, one seed."""
-    root, subject, photo_ids, axes_set, variant, de, seed, designs, priors_seed = task
+    """The independent and joint SFOs of one :class:`PairTask`."""
+    root, subject, photo_ids, seed = task.root, task.subject, task.photo_ids, task.seed
     _one_thread()
     subject_dir = root / "subjects" / subject
-    skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{axes_set}.json")
+    skull = read_skull(subject_dir, axes_path=subject_dir / f"axes_C{task.axes_set}.json")
     index = {p["id"]: p for p in read_json(root / "dataset.json")["photos"]}
     dirs = [root / index[i]["paths"]["C"] for i in photo_ids]
     photos = [read_photo(d) for d in dirs]
-    if priors_seed is not None:
-        photos = [off_centre_priors(p, priors_seed) for p in photos]
+    if task.priors_seed is not None:
+        photos = [off_centre_priors(p, task.priors_seed) for p in photos]
     truths = [read_ground_truth(d, subject_dir) for d in dirs]
-    options = SfoOptions(variant, de)
+    options = SfoOptions(task.variant, task.de)
     rows = []
     for photo, truth in zip(photos, truths, strict=True):
         t0 = time.perf_counter()
@@ -122,7 +147,7 @@ def run_pair(task):
             | dict(pair=photo_ids[0])
             | _metrics(result, skull, photo, truth)
         )
-    for design in designs:
+    for design in task.designs:
         weighting, factor, camera, prior = parse_design(design)
         t0 = time.perf_counter()
         joint = joint_lilium_sfo(
@@ -298,21 +323,7 @@ def _headsq(args, de):
         return
     index = read_json(root / "dataset.json")
     for sid, label in (("hq", "complete skull"), ("hq_nm", "without mandible")):
-        tasks = [
-            (
-                root,
-                subject,
-                ids,
-                args.axes_set,
-                args.variant,
-                de,
-                seed,
-                args.designs,
-                args.priors_seed,
-            )
-            for subject, ids in headsq_pairs(index, sid)
-            for seed in args.seeds
-        ]
+        tasks = pair_tasks(root, headsq_pairs(index, sid), args, de)
         if not tasks:
             continue
         print(
@@ -331,11 +342,7 @@ def _generated(args, de):
         root = Path(tempfile.mkdtemp(prefix="bench_joint_"))
         generate_dataset(root, args.subjects, 1, seed=0, experiments=("C",), workers=args.jobs)
     index = read_json(root / "dataset.json")
-    tasks = [
-        (root, subject, ids, args.axes_set, args.variant, de, seed, args.designs, args.priors_seed)
-        for subject, ids in pairs_of(index, args.subjects)
-        for seed in args.seeds
-    ]
+    tasks = pair_tasks(root, pairs_of(index, args.subjects), args, de)
     print(
         f"{len(tasks)} pairs ({args.subjects} subjects x {len(args.seeds)} seed(s)), Lilium "
         f"{args.variant}, DE {args.population} x {args.generations}, axes C{args.axes_set}, "
