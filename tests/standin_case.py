@@ -6,6 +6,7 @@ camera. Deliberately simple and quick to build (about 1 s); the realistic subjec
 :mod:`lilium.synthetic` serve the demo and the benchmarks.
 """
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -129,3 +130,31 @@ def make_standin_case(folder, seed=0):
         },
     )
     return subject_dir, photo_dir
+
+
+def scaled_photo(photo_dir, folder, factor):
+    """Another photo of the stand-in: its image and mask resized by ``factor``, its landmarks
+    and focal prior scaled with them (no ground truth). Not a copy: its bytes differ.
+
+    Returns
+    -------
+    Path
+        ``folder``.
+    """
+    from PIL import Image
+
+    photo_dir, folder = Path(photo_dir), Path(folder)
+    folder.mkdir(parents=True)
+    for name in ("image.png", "face_mask.png"):
+        image = Image.open(photo_dir / name)
+        size = (round(image.width * factor), round(image.height * factor))
+        image.resize(size).save(folder / name)
+    data = json.loads((photo_dir / "photo.json").read_text())
+    data["landmarks"] = {
+        k: [(u + 0.5) * factor - 0.5, (v + 0.5) * factor - 0.5]
+        for k, (u, v) in data["landmarks"].items()
+    }
+    data["priors"]["focal_px"] = [f * factor for f in data["priors"]["focal_px"]]
+    data.pop("ground_truth", None)
+    write_json(folder / "photo.json", data)
+    return folder

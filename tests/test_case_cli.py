@@ -12,6 +12,7 @@ from PIL.TiffImagePlugin import IFDRational
 from cli_helpers import _one_line_error, _run
 from lilium.cli.main import main
 from lilium.io.mesh import write_mesh
+from standin_case import scaled_photo
 
 #: Literature-style names for the plain-file case (canonical -> as a user might write it).
 FACIAL_ALIASES = {"nasion": "n", "exocanthion_l": "exL", "exocanthion_r": "ex_r", "subnasale": "sn"}
@@ -43,7 +44,9 @@ def files(case, tmp_path):
 def test_folders_two_photos_one_report(case, tmp_path, capsys):
     subject_dir, photo_dir = case
     out = tmp_path / "out"
-    argv = ["case", "--skull", subject_dir, "--photo", photo_dir, "--photo", photo_dir]
+    # The same person in another photo, in a folder of the same name (its id gets "_2").
+    other = scaled_photo(photo_dir, tmp_path / "b" / photo_dir.name, 0.75)
+    argv = ["case", "--skull", subject_dir, "--photo", photo_dir, "--photo", other]
     code, stdout, err = _run(argv + ["--method", "posest-sfo", "--out", out], capsys)
     assert code == 0, err
     for photo_id in ("standin_frontal", "standin_frontal_2"):
@@ -57,6 +60,18 @@ def test_folders_two_photos_one_report(case, tmp_path, capsys):
     assert "2470-2730 px (photo.json)" in text
     assert "report:" in stdout
 
+
+
+def test_a_photo_given_twice_is_refused(case, tmp_path, capsys):
+    # Counted twice it would be a second view: the single-photo cap lifted, a stronger support.
+    subject_dir, photo_dir = case
+    copy = tmp_path / "copy"
+    shutil.copytree(photo_dir, copy)
+    for second in (photo_dir, copy):
+        argv = ["case", "--skull", subject_dir, "--photo", photo_dir, "--photo", second]
+        argv += ["--method", "posest-sfo", "--out", tmp_path / "out"]
+        _one_line_error(capsys, argv, f"--photo {second}", "give each photo of the person once")
+    assert not (tmp_path / "out").exists()
 
 def test_plain_files_with_aliases_and_both_methods(files, tmp_path, capsys):
     out = tmp_path / "out"
@@ -203,8 +218,8 @@ def test_command_line_mistakes(files, case, tmp_path, capsys):
         _argv(files, tmp_path) + ["--scd-mm", "0", "900"],
         "--scd-mm must be a finite interval [lo, hi] with 0 < lo <= hi, got [0, 900]",
     )
-    _, photo_dir = case
-    argv = _argv(files, tmp_path) + ["--photo", photo_dir, "--photo-landmarks", files / "x.csv"]
+    other = scaled_photo(case[1], tmp_path / "other", 0.75)  # front.png is the stand-in's image
+    argv = _argv(files, tmp_path) + ["--photo", other, "--photo-landmarks", files / "x.csv"]
     _one_line_error(capsys, argv, "--photo-landmarks given 2 times for 1 photo", "once per")
 
 

@@ -24,6 +24,7 @@ from lilium.io.formats import name_error
 from lilium.io.images import image_size_wh, read_image, read_mask
 from lilium.io.paths import path_id, safe_id
 from lilium.report.html import relative_href
+from standin_case import scaled_photo
 
 
 def _png_header(path, width, height):
@@ -404,9 +405,8 @@ def test_suggestions_keep_the_side(written, kind, suggestion):
 def test_bad_third_photo_fails_before_any_sfo(case, tmp_path, capsys, monkeypatch):
     subject_dir, photo_dir = case
     photos = []
-    for k in range(3):
-        folder = tmp_path / f"photo{k}"
-        shutil.copytree(photo_dir, folder)
+    for k in range(3):  # three different photos of the stand-in (a repeated one is refused)
+        folder = scaled_photo(photo_dir, tmp_path / f"photo{k}", 1.0 - 0.1 * k)
         photos += ["--photo", folder]
     # Three landmarks left: fewer than four pairs, the one case no term set can run. (A term
     # the variant asks for that cannot apply, P_skof without the mask of photo 0, say, is

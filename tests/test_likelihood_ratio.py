@@ -28,6 +28,7 @@ from lilium.identification.terms import (
     soft_tissue_covariance,
 )
 from lilium.inputs import Priors
+from standin_case import scaled_photo
 
 
 def _view(rng, scale=1.0, n=40, camera=None, noise=True, sigma_px=None):
@@ -217,8 +218,9 @@ def test_case_without_a_calibrated_model_says_so(case, tmp_path, capsys):
     calibration = tmp_path / "empty.json"
     calibration.write_text(json.dumps({"format": "lilium-calibration", "models": {}}))
     out = tmp_path / "out"
+    other = scaled_photo(photo_dir, tmp_path / "other", 0.75)
     code = main(["case", "--skull", str(subject_dir), "--photo", str(photo_dir),
-                 "--photo", str(photo_dir), "--method", "posest-sfo",
+                 "--photo", str(other), "--method", "posest-sfo",
                  "--calibration", str(calibration), "--out", str(out)])
     stdout = capsys.readouterr().out
     assert code == 0
@@ -278,8 +280,10 @@ def test_rankings_break_ties_at_the_bound_by_the_plain_sum():
 def test_lineup_ranks_candidates_and_resumes(case, tmp_path, capsys, monkeypatch):
     subject_dir, photo_dir = case
     out = tmp_path / "lineup"
+    # Each photo once (a photo given twice is refused): bea's are the stand-in at other sizes.
+    bea = [scaled_photo(photo_dir, tmp_path / f"bea{k}", f) for k, f in enumerate((0.5, 0.75))]
     argv = ["lineup", "--skull", str(subject_dir), "--candidate", "anna", str(photo_dir),
-            "--candidate", "bea", str(photo_dir), str(photo_dir), "--method", "posest-sfo",
+            "--candidate", "bea", *map(str, bea), "--method", "posest-sfo",
             "--no-progress", "--out", str(out)]
     assert main(argv) == 0
     stdout = capsys.readouterr().out

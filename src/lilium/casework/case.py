@@ -10,7 +10,7 @@ from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
-from .folders import labelled_skull
+from .folders import check_distinct_photos, labelled_skull
 from .identify import Calibrations, conclusion_line, identify, with_identification
 from .inputs import check_runnable, load_photos, load_skull
 from .prepared import check_photo_extra
@@ -120,6 +120,7 @@ def run_case(
         check_method(method, options.variant)
     if auto_landmarks:
         check_photo_extra()
+    check_distinct_photos(photos)
     if joint:
         from .joint_case import check_joint_case
 

@@ -1,9 +1,10 @@
 """One SFO on case folders (SPEC section 8): read, check, run, write ``result.json``."""
 
+import filecmp
 from dataclasses import replace
 from pathlib import Path
 
-from ..io.case import read_depth_table, read_photo, read_skull
+from ..io.case import IMAGE_NAMES, read_depth_table, read_photo, read_skull
 from ..io.jsonio import write_json
 from ..io.paths import safe_id
 from ..io.results import write_png, write_result
@@ -117,23 +118,58 @@ def write_joint_result(out_dir, result, skull, photos, overlay=True):
     return written
 
 
+def _image_of(path):
+    """The image file of a photo folder or an image path; None when there is none (yet)."""
+    path = Path(path)
+    if path.is_dir():
+        return next((path / n for n in IMAGE_NAMES if (path / n).is_file()), None)
+    return path if path.is_file() else None
+
+
+def repeated_photo(paths):
+    """The first photo of ``paths`` that repeats an earlier one: the same path, or the same
+    image byte for byte (a copied photo folder, the image under another name).
+
+    Returns
+    -------
+    (int, int, str) or None
+        The later index, the earlier one and how they are the same (``"the same photo as"``
+        or ``"the same image (byte for byte) as"``); None when every photo differs.
+    """
+    seen, by_size = {}, {}
+    for k, path in enumerate(paths):
+        key = Path(path).resolve()
+        if key in seen:
+            return k, seen[key], "the same photo as"
+        seen[key] = k
+        image = _image_of(path)
+        if image is None:
+            continue
+        size = image.stat().st_size
+        for j in by_size.get(size, []):
+            if filecmp.cmp(image, _image_of(paths[j]), shallow=False):
+                return k, j, "the same image (byte for byte) as"
+        by_size.setdefault(size, []).append(k)
+    return None
+
+
 def check_distinct_photos(paths):
-    """Refuse a photo given twice to a joint SFO (it would count its landmarks twice).
+    """Refuse a photo given twice to a case or a joint SFO, by path or as a copy of its image
+    (a joint SFO would count its landmarks twice, and the identification of several photos
+    would count it as a second view and lift the single-photo cap).
 
     Raises
     ------
     ValueError
         Naming the repeated path.
     """
-    seen = {}
-    for path in paths:
-        key = Path(path).resolve()
-        if key in seen:
-            raise ValueError(
-                f"--photo {path}: the same photo as --photo {seen[key]}; a joint SFO takes each "
-                "photo of the person once"
-            )
-        seen[key] = path
+    repeat = repeated_photo(paths)
+    if repeat is not None:
+        k, j, how = repeat
+        raise ValueError(
+            f"--photo {paths[k]}: {how} --photo {paths[j]}; give each photo of the person once "
+            "(a repeated photo is no second view)"
+        )
 
 
 def joint_sfo_on_folders(

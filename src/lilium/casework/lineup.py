@@ -10,7 +10,9 @@ Outputs: ``OUT/<candidate>/<photo>/<method tag>/result.json`` and ``overlay.png`
 ``OUT/lineup.json`` (the ranking) and ``OUT/report.html`` (the ranking first, then every
 SFO with its overlay). **Resumable**: an SFO whose ``result.json`` is already there for the
 same method, variant, seed, skull and photo is read back, not run again, so a lineup killed
-half-way continues where it stopped; a progress bar counts the SFOs.
+half-way continues where it stopped; its identification is computed again, with this run's
+calibration (another ``--calibration`` changes the LRs, not the SFOs); a progress bar counts
+the SFOs.
 """
 
 from dataclasses import replace
@@ -23,7 +25,7 @@ from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
-from .folders import labelled_skull
+from .folders import labelled_skull, repeated_photo
 from .identify import Calibrations, conclusion_line, identify, with_identification
 from .inputs import load_photos, load_skull
 
@@ -48,8 +50,15 @@ def _stored(folder, method, variant, seed, skull_id, photo_id):
     return result if same else None
 
 
+#: The lineup's own files in its output folder: no candidate's folder may take their names.
+OWN_FILES = ("lineup.json", "report.html")
+
+
 def check_candidates(candidates):
-    """Refuse an empty lineup, a candidate without photos and a name given twice.
+    """Refuse an empty lineup, a candidate without a name or photos, a name given twice or
+    taken by the lineup's own files (:data:`OWN_FILES`), and a photo given twice, by path or
+    as a copy of its image, for one candidate (it would count as a second view) or for two (a
+    photo shows one person).
 
     Parameters
     ----------
@@ -60,11 +69,25 @@ def check_candidates(candidates):
     seen = set()
     for name, photos in candidates:
         key = safe_id(name)
+        if not name.strip():
+            raise ValueError("--candidate: a candidate's name is empty; give each one a name")
         if not photos:
             raise ValueError(f"--candidate {name}: give one or more photos after the name")
         if key in seen:
             raise ValueError(f"--candidate {name}: the name is given twice; names must differ")
+        if key in OWN_FILES:
+            raise ValueError(
+                f"--candidate {name}: the name of the lineup's own {key}; rename the candidate"
+            )
         seen.add(key)
+    owners = [(name, path) for name, photos in candidates for path in photos]
+    repeat = repeated_photo([path for _, path in owners])
+    if repeat is not None:
+        (name, path), (other, first) = owners[repeat[0]], owners[repeat[1]]
+        raise ValueError(
+            f"--candidate {name}: {path} is {repeat[2]} {first} (--candidate {other}); give "
+            "each photo once, with the one person it shows"
+        )
 
 
 def rank_key(entry, first_method):
@@ -161,6 +184,9 @@ def run_lineup(
                     result = run_sfo(method, skull, photo, options, seed)
                     result = with_identification(result, skull, [photo], calibrations)
                     write_result(folder, result, result_overlay(result, skull, photo))
+                else:  # identified again: this run's --calibration, not the stored record's
+                    result = with_identification(result, skull, [photo], calibrations)
+                    write_json(folder / "result.json", result.to_dict())
                 bar.update(1)
                 done[method].append((photo, result))
                 rel = folder.relative_to(out).as_posix()

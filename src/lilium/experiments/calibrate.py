@@ -137,13 +137,97 @@ class DatasetInputs:
 
 
 def stored_rows(db):
-    """Every row of a results database with its parsed ``result`` (``row["data"]``)."""
+    """Every row of a results database with its parsed ``result`` (``row["data"]``).
+
+    Raises
+    ------
+    ValueError
+        A row whose ``result`` is not a JSON object, or whose camera or stored terms cannot be
+        read, naming the database and the row.
+    """
     with ResultStore(db, read_only=True) as store:
         rows = [dict(r) for r in store.rows(list(COLUMNS))]
         config = store.get_meta("config")
-    for r in rows:
-        r["data"] = json.loads(r["result"]) if r.get("result") else None
+    for k, r in enumerate(rows):
+        r["data"] = _stored_result(db, k, r.get("result"))
     return rows, (config or {}).get("dataset")
+
+
+def _stored_result(db, k, text):
+    """Row ``k``'s ``result`` JSON parsed and checked (None when empty)."""
+
+    def damaged(what):
+        return ValueError(
+            f"{db}: row {k + 1} holds {what}; the database was edited or damaged: restore it, "
+            "or delete that row (lilium experiment then runs its SFO again)"
+        )
+
+    if text is None or text == "":
+        return None
+    try:
+        data = json.loads(text)
+    except (TypeError, ValueError, RecursionError):
+        raise damaged("a result that is not valid JSON") from None
+    if not isinstance(data, dict):
+        raise damaged("a result that is not a JSON object")
+    if data.get("camera") is not None:
+        try:
+            Camera.from_dict(data["camera"])
+        except ValueError as exc:
+            raise damaged(f"an unreadable camera ({exc})") from None
+    for key in (TERMS_KEY, TERMS_KEY + "_joint"):
+        terms = data.get(key)
+        if terms is not None and not (
+            isinstance(terms, dict)
+            and all(
+                v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
+                for v in terms.values()
+            )
+        ):
+            raise damaged(f"{key} that are not numbers by name")
+    return data
+
+
+#: What ``lilium calibrate`` writes in its output folder.
+OUTPUT_FILES = ("calibration.json", "calibration.csv", "tippett.png")
+
+
+def check_databases(dbs, out_dir, dataset=None):
+    """Refuse, before anything is read or written, a database given twice (its SFOs would
+    count twice, as other people's), one with no SFO, one ``out_dir`` would write over, and a
+    ``dataset`` folder without its ``dataset.json``.
+
+    Raises
+    ------
+    ValueError
+        Naming the database or the option, and the fix.
+    """
+    seen = {}
+    outputs = {(Path(out_dir) / name).resolve(): name for name in OUTPUT_FILES}
+    for db in dbs:
+        key = Path(db).resolve()
+        if key in seen:
+            raise ValueError(
+                f"{db}: the same database as {seen[key]}; give each database once (its SFOs "
+                "would count twice, as other people's)"
+            )
+        seen[key] = db
+        if key in outputs:
+            raise ValueError(
+                f"--out {out_dir}: lilium calibrate writes {outputs[key]} there, over the "
+                f"database {db}; give another --out"
+            )
+        with ResultStore(db, read_only=True) as store:
+            if store.count() == 0:
+                raise ValueError(
+                    f"{db}: no SFO in this results database (its experiment stored none); "
+                    "give a database lilium experiment has filled"
+                )
+    if dataset is not None and not (Path(dataset) / "dataset.json").is_file():
+        raise ValueError(
+            f"--dataset {dataset}: no dataset.json there; give the dataset folder the "
+            "experiment ran on (the one holding dataset.json)"
+        )
 
 
 def _camera(row):

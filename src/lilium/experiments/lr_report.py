@@ -17,7 +17,13 @@ import numpy as np
 
 from .. import __version__
 from ..io.calibration import write_calibration
-from .calibrate import database_decisions, fit_models, performance_table, validate
+from .calibrate import (
+    check_databases,
+    database_decisions,
+    fit_models,
+    performance_table,
+    validate,
+)
 from .config import method_label
 from .identification import identification_table
 
@@ -229,6 +235,7 @@ def calibrate_databases(dbs, out_dir, dataset=None, log=print):
     table, decision_pairs, validated
         As :func:`lr_identification`.
     """
+    check_databases(dbs, out_dir, dataset)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths, table, decision_pairs, validated = lr_identification(dbs, out_dir, dataset, log)

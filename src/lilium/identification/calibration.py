@@ -173,22 +173,47 @@ class Calibration:
 
     @classmethod
     def from_dict(cls, data):
+        """Inverse of :meth:`to_dict`; a ``ValueError`` (or ``KeyError``/``TypeError``) names
+        what is wrong: every coefficient must be a finite JSON number (not text, not a
+        boolean, not NaN), every ``scale`` above 0 and ``n_same``/``n_diff`` whole numbers of
+        at least 1, or the model's LRs would be NaN or unbounded."""
         names = tuple(data["names"])
         unknown = [n for n in names if n not in FEATURES]
         if unknown:
             raise ValueError(f"unknown identification terms {unknown}; known: {list(FEATURES)}")
+        coefficients = {
+            key: {n: _finite(data[key][n], f"{key}.{n}") for n in names}
+            for key in ("centre", "scale", "fill", "weights")
+        }
+        bad_scale = [n for n, v in coefficients["scale"].items() if v <= 0]
+        if bad_scale:
+            raise ValueError(f"scale.{bad_scale[0]} must be above 0")
         return cls(
             names,
-            {n: float(data["centre"][n]) for n in names},
-            {n: float(data["scale"][n]) for n in names},
-            {n: float(data["fill"][n]) for n in names},
-            {n: float(data["weights"][n]) for n in names},
-            float(data["intercept"]),
-            int(data["n_same"]),
-            int(data["n_diff"]),
+            coefficients["centre"],
+            coefficients["scale"],
+            coefficients["fill"],
+            coefficients["weights"],
+            _finite(data["intercept"], "intercept"),
+            _count(data["n_same"], "n_same"),
+            _count(data["n_diff"], "n_diff"),
             dict(data.get("provenance", {})),
             _read_warp(data.get("warp")),
         )
+
+
+def _finite(value, name):
+    """A stored coefficient: a finite number (a JSON text or boolean is not one)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+        raise ValueError(f"{name} must be a finite number, got {str(value)[:40]!r}")
+    return float(value)
+
+
+def _count(value, name):
+    """A stored number of training pairs: a whole number of at least 1."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ValueError(f"{name} must be a whole number of at least 1, got {str(value)[:40]!r}")
+    return value
 
 
 def _read_warp(warp):
@@ -199,6 +224,8 @@ def _read_warp(warp):
     ln_lr = np.asarray(warp["ln_lr"], float)
     if knots.ndim != 1 or knots.shape != ln_lr.shape or len(knots) < 2:
         raise ValueError("a calibration warp needs equal lists 'knots' and 'ln_lr' (2+ values)")
+    if not (np.all(np.isfinite(knots)) and np.all(np.isfinite(ln_lr))):
+        raise ValueError("a calibration warp's 'knots' and 'ln_lr' must be finite numbers")
     if np.any(np.diff(knots) <= 0) or np.any(np.diff(ln_lr) < 0):
         raise ValueError("a calibration warp must be increasing")
     return {"knots": knots.tolist(), "ln_lr": ln_lr.tolist()}

@@ -100,8 +100,14 @@ def read_calibration(path=None):
             f"{path}: not a Lilium calibration file (no \"format\": \"{FORMAT}\"); give a file "
             "written by lilium calibrate"
         )
+    entries = data.get("models") or {}
+    if not isinstance(entries, dict):
+        raise ValueError(
+            f'{path}: "models" must be an object of "<method>/<variant>/<decision>": '
+            "model; give a file written by lilium calibrate"
+        )
     models = {}
-    for key, entry in (data.get("models") or {}).items():
+    for key, entry in entries.items():
         try:
             models[key] = Calibration.from_dict(entry)
         except (KeyError, TypeError, ValueError) as exc:
