@@ -13,7 +13,8 @@ own folder traced, and gets one verdict:
 - ``stray output``: a library's warning reached stderr.
 
 Probes of ``lilium photo`` and ``lilium import-ct`` (whose fixes belong to the photo/CT work of
-issue 28) are counted apart. ::
+issue 28) are counted apart. Those of ``lilium lineup``, ``lilium calibrate``, ``--calibration``
+and the joint SFO are in ``probe_hostile_casework.py``. ::
 
     python benchmarks/probe_hostile.py --work /tmp/probes [--only SUBSTRING] [--limit-s 60]
 
@@ -61,7 +62,8 @@ class ProbeTimeout(BaseException):
 class Probe:
     """One hostile input: ``argv(ws)`` the command line, ``expect`` ``"error"``, ``"ok"`` or
     ``"warn"``, ``needles`` what the error line (or warning) must contain, ``setup(ws)`` what
-    to break in the probe's copy of the case, ``owner`` ``"rel"``, ``"photo"`` or ``"ct"``."""
+    to break in the probe's copy of the case, ``owner`` ``"rel"``, ``"photo"`` or ``"ct"``,
+    ``check(ws)`` (an expected success) what is wrong with its outputs, or None."""
 
     name: str
     argv: object
@@ -69,6 +71,7 @@ class Probe:
     needles: tuple = ()
     setup: object = None
     owner: str = "rel"
+    check: object = None
 
 
 class Workspace:
@@ -76,6 +79,7 @@ class Workspace:
 
     def __init__(self, root, base):
         self.root = Path(root)
+        self.base = Path(base)
         shutil.copytree(base, self.root / "in")
         self.skull = self.root / "in" / "subjects" / "standin"
         self.photo = self.root / "in" / "photos" / "standin_frontal"
@@ -169,6 +173,9 @@ def run_probe(probe, ws, limit_s):
         return "wrongly refused", seconds, last
     if probe.expect == "warn" and not all(n in text for n in probe.needles):
         return "silently wrong", seconds, "no warning naming " + repr(probe.needles)
+    problem = probe.check(ws) if probe.check is not None else None
+    if problem:
+        return "silently wrong", seconds, problem
     return "pass", seconds, last
 
 
@@ -521,12 +528,16 @@ def photo_and_ct_probes():
 
 
 def all_probes():
+    # The newer entry points' probes live in their own module (each reads in one sitting).
+    from probe_hostile_casework import casework_probes
+
     return (
         photo_json_probes()
         + skull_probes()
         + image_probes()
         + option_probes()
         + experiment_probes()
+        + casework_probes()
         + photo_and_ct_probes()
     )
 
