@@ -99,47 +99,9 @@ def _terms_db(n_subjects=12, change=None, name="r.sqlite"):
     identification terms (same-person pairs fit better); ``change`` an SQL statement after."""
 
     def setup(ws):
-        import numpy as np
+        from standin_case import terms_database
 
-        from lilium.experiments.store import ResultStore
-        from lilium.identification.terms import TERM_NAMES
-
-        rng = np.random.default_rng(0)
-        camera = {
-            "focal_px": 2600.0,
-            "principal_point_px": [600.0, 450.0],
-            "skull2cam": [[1, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 900], [0, 0, 0, 1]],
-        }
-        subjects = [f"s{k:02d}" for k in range(n_subjects)]
-        path = _in(ws, name)
-        with ResultStore(path) as store:
-            for person in subjects:
-                for skull in subjects:
-                    same = skull == person
-                    terms = {t: float(rng.normal(0, 1)) for t in TERM_NAMES}
-                    terms["landmark_chi2"] = float(rng.gamma(2.0, 0.3 if same else 1.0))
-                    store.insert(
-                        dict(
-                            experiment="A",
-                            method="posest-sfo",
-                            variant="",
-                            axes_set=0,
-                            repetition=0,
-                            seed=0,
-                            photo=f"{person}_f",
-                            subject=skull,
-                            view="frontal",
-                            true_subject=person,
-                            positive=int(same),
-                            success=1,
-                            score=terms["landmark_chi2"],
-                            seconds=0.01,
-                            skull_px=100,
-                            outside_px=0,
-                            percent_outside=0.0,
-                            result=json.dumps({"camera": camera, "identification_terms": terms}),
-                        )
-                    )
+        path = terms_database(_in(ws, name), n_subjects)
         if change:
             conn = sqlite3.connect(path)
             with conn:

@@ -158,3 +158,37 @@ def scaled_photo(photo_dir, folder, factor):
     data.pop("ground_truth", None)
     write_json(folder / "photo.json", data)
     return folder
+
+
+def terms_database(path, n_subjects=3, result=None, seed=0):
+    """A results database (``lilium experiment``'s) of frontal POSEST-SFO SFOs of
+    ``n_subjects`` people, every photo against every skull, each with a camera and stored
+    identification terms, the same person's landmark term lower (so ``lilium calibrate`` can
+    fit a model on 10+ subjects); ``result(k, data)`` returns row ``k``'s ``result`` text
+    instead of ``data`` as JSON. Returns ``path``.
+    """
+    from lilium.experiments.store import ResultStore
+    from lilium.identification.terms import TERM_NAMES
+
+    rng = np.random.default_rng(seed)
+    camera = {
+        "focal_px": 2600.0,
+        "principal_point_px": [600.0, 450.0],
+        "skull2cam": [[1, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 900], [0, 0, 0, 1]],
+    }
+    subjects = [f"s{k:02d}" for k in range(n_subjects)]
+    with ResultStore(path) as store:
+        for k, (person, skull) in enumerate((p, s) for p in subjects for s in subjects):
+            same = skull == person
+            terms = {t: float(rng.normal(0, 1)) for t in TERM_NAMES}
+            terms["landmark_chi2"] = float(rng.gamma(2.0, 0.3 if same else 1.0))
+            data = {"camera": camera, "identification_terms": terms}
+            store.insert(
+                dict(experiment="A", method="posest-sfo", variant="", axes_set=0, repetition=0,
+                     seed=0, photo=f"{person}_f", subject=skull, view="frontal",
+                     true_subject=person, positive=int(same), success=1,
+                     score=terms["landmark_chi2"], seconds=0.01, skull_px=100, outside_px=0,
+                     percent_outside=0.0,
+                     result=json.dumps(data) if result is None else result(k, data))
+            )  # fmt: skip
+    return path

@@ -7,7 +7,6 @@ file or option (exit 2), or the right answer."""
 import json
 import shutil
 
-import numpy as np
 import pytest
 
 from cli_helpers import _one_line_error, _run
@@ -15,8 +14,8 @@ from lilium.casework.folders import check_distinct_photos
 from lilium.casework.lineup import check_candidates
 from lilium.experiments.store import ResultStore
 from lilium.identification.calibration import Calibration
-from lilium.identification.terms import TERM_NAMES
 from lilium.io.calibration import read_calibration, shipped_path
+from standin_case import terms_database
 
 # -- calibration files -------------------------------------------------------------------------
 
@@ -68,31 +67,9 @@ def test_a_calibration_file_names_itself_and_the_model(tmp_path):
 # -- lilium calibrate ----------------------------------------------------------------------------
 
 
-def _results_db(path, n_subjects=3, result=None):
-    """A results database of frontal POSEST-SFO SFOs, every photo against every skull, each
-    with its camera and stored identification terms (``result(k, data)`` edits row k's)."""
-    rng = np.random.default_rng(0)
-    camera = {
-        "focal_px": 2600.0,
-        "principal_point_px": [600.0, 450.0],
-        "skull2cam": [[1, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 900], [0, 0, 0, 1]],
-    }
-    subjects = [f"s{k}" for k in range(n_subjects)]
-    with ResultStore(path) as store:
-        for k, (person, skull) in enumerate((p, s) for p in subjects for s in subjects):
-            data = {"camera": camera, "identification_terms": {t: rng.random() for t in TERM_NAMES}}
-            text = json.dumps(data) if result is None else result(k, data)
-            store.insert(
-                dict(experiment="A", method="posest-sfo", variant="", axes_set=0, repetition=0,
-                     seed=0, photo=f"{person}_f", subject=skull, view="frontal",
-                     true_subject=person, positive=int(person == skull), success=1, score=1.0,
-                     result=text)
-            )  # fmt: skip
-    return path
-
 
 def test_calibrate_refuses_a_database_twice_empty_or_under_its_outputs(tmp_path, capsys):
-    db = _results_db(tmp_path / "r.sqlite")
+    db = terms_database(tmp_path / "r.sqlite")
     out = tmp_path / "out"
     _one_line_error(capsys, ["calibrate", db, tmp_path / "." / "r.sqlite", "--out", out], "twice")
     with ResultStore(tmp_path / "empty.sqlite"):
@@ -122,7 +99,7 @@ def test_calibrate_refuses_a_database_twice_empty_or_under_its_outputs(tmp_path,
     ],
 )
 def test_calibrate_names_the_database_and_row_of_a_damaged_result(tmp_path, capsys, result, needle):
-    db = _results_db(tmp_path / "r.sqlite", result=result)
+    db = terms_database(tmp_path / "r.sqlite", result=result)
     _one_line_error(capsys, ["calibrate", db, "--out", tmp_path / "out"], "r.sqlite", needle)
 
 
