@@ -1,5 +1,7 @@
 """``lilium import-ct``: a CT volume to a subject folder (skull.ply, face.ply, landmarks)."""
 
+from .argtypes import int_in
+
 
 def _numbers(text, n, kind, name):
     try:
@@ -58,7 +60,9 @@ def register(subparsers):
     p.add_argument("--raw-shape", help="raw data: slices,rows,columns (or rows,columns per file)")
     p.add_argument("--raw-dtype", help="raw data: voxel type, e.g. int16")
     p.add_argument("--byte-order", default="little", choices=["little", "big"])
-    p.add_argument("--header-bytes", type=int, default=0, help="raw data: bytes to skip per file")
+    p.add_argument(
+        "--header-bytes", type=int_in(0), default=0, help="raw data: bytes to skip per file"
+    )
     p.add_argument("--spacing", help="voxel size x,y,z in mm (raw data; overrides a header)")
     p.add_argument(
         "--allow-outside-data",

@@ -26,6 +26,33 @@ def fraction(closed):
     return parse
 
 
+def experiment_list(text):
+    """``--experiments`` argument type: comma-separated noise profiles, each once."""
+    from ..synthetic.noise import NOISE_PROFILES
+
+    letters = [e.strip().upper() for e in text.split(",") if e.strip()]
+    if not letters:
+        raise argparse.ArgumentTypeError(f"give at least one of {', '.join(NOISE_PROFILES)}")
+    for letter in letters:
+        if letter not in NOISE_PROFILES:
+            raise argparse.ArgumentTypeError(
+                f"{letter!r} is not an experiment; give some of {', '.join(NOISE_PROFILES)}"
+            )
+        if letters.count(letter) > 1:
+            raise argparse.ArgumentTypeError(f"{letter} is given twice; give each once")
+    return tuple(letters)
+
+
+def check_contact_sheet(path):
+    """Refuse a ``--contact-sheet`` path that cannot take a PNG, before generating anything."""
+    if path is None:
+        return
+    if path.is_dir():
+        raise ValueError(f"--contact-sheet {path}: is a folder; give a file name ending in .png")
+    if path.suffix.lower() not in (".png", ".jpg", ".jpeg"):
+        raise ValueError(f"--contact-sheet {path}: give a file name ending in .png (or .jpg)")
+
+
 def register(subparsers):
     p = subparsers.add_parser(
         "synth",
@@ -43,7 +70,10 @@ def register(subparsers):
     )
     p.add_argument("--seed", type=seed, default=0)
     p.add_argument(
-        "--experiments", default="A,B,C", help="comma-separated noise profiles (default A,B,C)"
+        "--experiments",
+        type=experiment_list,
+        default="A,B,C",
+        help="comma-separated noise profiles (default A,B,C)",
     )
     p.add_argument(
         "--workers", type=int_in(1, 256), default=2, help="processes over subjects (default 2)"
@@ -76,7 +106,8 @@ def register(subparsers):
 def run(args):
     from ..synthetic.dataset import generate_dataset
 
-    experiments = tuple(e.strip().upper() for e in args.experiments.split(",") if e.strip())
+    experiments = args.experiments
+    check_contact_sheet(args.contact_sheet)
     bar = None
     if not args.no_progress:
         from tqdm import tqdm

@@ -122,6 +122,23 @@ def _one_line(exc):
     return " ".join(f"{type(exc).__name__}: {exc}".split())
 
 
+def _check_same_grid(slices, iop, pixel_spacing):
+    """Refuse a series whose slices differ in ``ImageOrientationPatient`` or ``PixelSpacing``:
+    the volume takes both from the first slice, so another slice's would be silently wrong."""
+    for f, ds in slices[1:]:
+        for tag, first in (("ImageOrientationPatient", iop), ("PixelSpacing", pixel_spacing)):
+            try:
+                value = np.array(getattr(ds, tag), float).reshape(np.shape(first))
+            except (TypeError, ValueError):
+                value = None
+            if value is None or not np.allclose(value, first, atol=1e-4, rtol=1e-3):
+                raise ValueError(
+                    f"{f}: {tag} differs from the series' first slice {slices[0][0].name} "
+                    f"({list(np.round(first, 4))}); the slices are not one volume: remove the "
+                    "odd slice or export the series again (resampled to one grid)"
+                )
+
+
 def read_dicom(path):
     """A DICOM series: every image file of a folder with the same series (needs ``pydicom``).
 
@@ -188,6 +205,7 @@ def read_dicom(path):
             f"{slices[0][0]}: ImageOrientationPatient (6 numbers), ImagePositionPatient (3) or "
             f"PixelSpacing (2) is malformed ({exc})"
         ) from exc
+    _check_same_grid(slices, iop, (row_spacing, col_spacing))
     row_dir, col_dir = iop[:3], iop[3:]
     normal = np.cross(row_dir, col_dir)
     if np.linalg.norm(normal) < 1e-6 or positions.shape[1:] != (3,):

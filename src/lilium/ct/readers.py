@@ -148,7 +148,8 @@ def _dtype(name, byte_order, source):
         cause = None
     if dt is None or dt.kind not in "iuf" or dt.itemsize > 8:
         raise ValueError(
-            f"{source}: unknown voxel type {name!r}; use int16, uint16, int32, float32, ..."
+            f"{source}: unknown voxel type {name!r}; give --raw-dtype int16, uint16, int32, "
+            "float32, ..."
         ) from cause
     if byte_order not in ("little", "big"):
         raise ValueError(f"{source}: byte order must be 'little' or 'big', got {byte_order!r}")
@@ -190,7 +191,7 @@ def read_raw(paths, shape, dtype, spacing, byte_order="little", header_bytes=0):
         )
     check_voxel_count(shape, source)
     if int(header_bytes) < 0:
-        raise ValueError(f"{source}: header_bytes must be >= 0, got {header_bytes}")
+        raise ValueError(f"{source}: --header-bytes must be 0 or more, got {header_bytes}")
     chunks = []
     for p in paths:
         raw = read_bytes(p)[int(header_bytes) :]

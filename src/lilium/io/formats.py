@@ -408,6 +408,8 @@ def read_landmarks(path, kind, coordinate_system="LPS"):
     """
     _known(kind)
     path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{path}: is a folder, not a landmark file; give the file's path")
     if not path.is_file():
         raise ValueError(f"{path}: file not found; check the landmark file's path")
     fmt = landmark_format(path)
