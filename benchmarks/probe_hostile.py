@@ -14,7 +14,9 @@ own folder traced, and gets one verdict:
 
 Probes of ``lilium photo`` and ``lilium import-ct`` (whose fixes belong to the photo/CT work of
 issue 28) are counted apart. Those of ``lilium lineup``, ``lilium calibrate``, ``--calibration``
-and the joint SFO are in ``probe_hostile_casework.py``. ::
+and the joint SFO are in ``probe_hostile_casework.py``; more of ``lilium photo``, ``lilium
+import-ct`` and ``lilium synth`` (EXIF, image modes, DICOM series, NIfTI affines, counts) are in
+``probe_hostile_inputs.py``. ::
 
     python benchmarks/probe_hostile.py --work /tmp/probes [--only SUBSTRING] [--limit-s 60]
 
@@ -63,7 +65,8 @@ class Probe:
     """One hostile input: ``argv(ws)`` the command line, ``expect`` ``"error"``, ``"ok"`` or
     ``"warn"``, ``needles`` what the error line (or warning) must contain, ``setup(ws)`` what
     to break in the probe's copy of the case, ``owner`` ``"rel"``, ``"photo"`` or ``"ct"``,
-    ``check(ws)`` (an expected success) what is wrong with its outputs, or None."""
+    ``check(ws)`` (an expected success) what is wrong with its outputs, or None, ``code`` the
+    exit status of an expected success (``lilium photo`` exits 3 when it finds no face)."""
 
     name: str
     argv: object
@@ -72,6 +75,7 @@ class Probe:
     setup: object = None
     owner: str = "rel"
     check: object = None
+    code: int = 0
 
 
 class Workspace:
@@ -169,8 +173,8 @@ def run_probe(probe, ws, limit_s):
         if len(errors) != 1 or not all(n in errors[0] for n in probe.needles):
             return "unclear message", seconds, last
         return "pass", seconds, last
-    if code != 0:
-        return "wrongly refused", seconds, last
+    if code != probe.code:
+        return "wrongly refused", seconds, f"exit {code}: {last}"
     if probe.expect == "warn" and not all(n in text for n in probe.needles):
         return "silently wrong", seconds, "no warning naming " + repr(probe.needles)
     problem = probe.check(ws) if probe.check is not None else None
@@ -530,6 +534,7 @@ def photo_and_ct_probes():
 def all_probes():
     # The newer entry points' probes live in their own module (each reads in one sitting).
     from probe_hostile_casework import casework_probes
+    from probe_hostile_inputs import input_probes
 
     return (
         photo_json_probes()
@@ -539,6 +544,7 @@ def all_probes():
         + experiment_probes()
         + casework_probes()
         + photo_and_ct_probes()
+        + input_probes()
     )
 
 
