@@ -165,3 +165,34 @@ def test_cli_synth(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "sheet.png").is_file()
     assert read_json(tmp_path / "dataset.json")["experiments"] == ["A", "B"]
     assert "wrote 1 subjects and 2 photos" in capsys.readouterr().out
+
+
+_PHOTO_THEN_DATASET = """
+from pathlib import Path
+from PIL import Image
+from skimage import data
+from lilium.cli.main import main
+from lilium.synthetic.dataset import generate_dataset
+
+if __name__ == "__main__":
+    root = Path(__file__).parent
+    Image.fromarray(data.astronaut()).save(root / "astronaut.jpg", quality=95)
+    assert main(["photo", str(root / "astronaut.jpg"), "--out", str(root / "prepared")]) == 0
+    generate_dataset(root / "ds", 2, 1, seed=0, experiments=("A",), workers=2)
+    print("generated")
+"""
+
+
+def test_a_dataset_after_lilium_photo_in_one_process(tmp_path):
+    # Forked after LiteRT had started its threads, the workers deadlocked; spawned, they run.
+    import subprocess
+    import sys
+
+    pytest.importorskip("ai_edge_litert")
+    script = tmp_path / "go.py"
+    script.write_text(_PHOTO_THEN_DATASET)
+    done = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0 and "generated" in done.stdout, done.stderr[-2000:]
+    assert len(read_json(tmp_path / "ds" / "dataset.json")["subjects"]) == 2

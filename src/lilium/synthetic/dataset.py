@@ -29,6 +29,7 @@ import os
 import shutil
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from multiprocessing import get_context
 from pathlib import Path
 
 import cv2
@@ -274,7 +275,9 @@ def generate_dataset(
             if progress is not None:
                 progress(len(results), n_subjects)
     else:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        # Spawned, not forked, as the experiment runner's workers: a fork after a library
+        # started threads (LiteRT's, once `lilium photo` ran in this process) deadlocked.
+        with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
             futures = {pool.submit(_generate_subject, t): t[1] for t in tasks}
             for future in as_completed(futures):
                 results[futures[future]] = future.result()
