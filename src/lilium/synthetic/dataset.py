@@ -233,7 +233,8 @@ def generate_dataset(
     progress : callable, optional
         ``progress(done_subjects, n_subjects)`` after each subject.
     workers : int
-        Processes over subjects (1 = in this process).
+        Processes over subjects (1 = in this process). They are spawned, so a script that
+        calls this with ``workers > 1`` needs the ``if __name__ == "__main__":`` guard.
     ranges : photos.CameraRanges
     subject_factory, subject_writer : callable, optional
         ``factory(subject_id, rng) -> subject`` and ``writer(folder, subject)``; default
