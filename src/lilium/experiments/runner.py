@@ -110,6 +110,11 @@ def load_dataset(cfg, workers=1, log=print):
     from ..io.jsonio import read_json
 
     root = Path(cfg.dataset.path).resolve()
+    if root.exists() and not root.is_dir():
+        raise ValueError(
+            f"{root}: dataset.path is a file, not a folder; set dataset.path in the config to "
+            "the dataset folder (or to a new folder to generate it)"
+        )
     index_path = root / "dataset.json"
     if not index_path.is_file():
         if not cfg.dataset.generate:
