@@ -535,6 +535,7 @@ def all_probes():
     # The newer entry points' probes live in their own module (each reads in one sitting).
     from probe_hostile_casework import casework_probes
     from probe_hostile_inputs import input_probes
+    from probe_hostile_runs import run_probes
 
     return (
         photo_json_probes()
@@ -545,6 +546,7 @@ def all_probes():
         + casework_probes()
         + photo_and_ct_probes()
         + input_probes()
+        + run_probes()
     )
 
 
