@@ -13,7 +13,7 @@ from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import check_joint_method, check_method, run_joint_sfo, run_sfo
 from .identify import Calibrations, with_identification
-from .inputs import load_photos, load_skull
+from .inputs import first_file, load_photos, load_skull
 
 
 def labelled_skull(skull, inputs):
@@ -122,7 +122,7 @@ def _image_of(path):
     """The image file of a photo folder or an image path; None when there is none (yet)."""
     path = Path(path)
     if path.is_dir():
-        return next((path / n for n in IMAGE_NAMES if (path / n).is_file()), None)
+        return first_file(path, IMAGE_NAMES)
     return path if path.is_file() else None
 
 

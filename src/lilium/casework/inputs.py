@@ -46,7 +46,8 @@ class PhotoRecord(NamedTuple):
     origin: object = None
 
 
-def _first_file(folder, names):
+def first_file(folder, names):
+    """The first of ``names`` that is a file in ``folder``; None when none is."""
     return next((folder / n for n in names if (folder / n).is_file()), None)
 
 
@@ -209,7 +210,7 @@ def load_photos(
                     f"{view_for_all!r}; --view sets the view of image files, a photo folder's is "
                     "its photo.json's: edit it there (or leave --view out)"
                 )
-            image = _first_file(path, IMAGE_NAMES)
+            image = first_file(path, IMAGE_NAMES)
             inputs["photo"] = image
             inputs["photo.json"] = path / "photo.json"
             facts = read_prepared(path)

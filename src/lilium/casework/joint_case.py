@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..methods.registry import METHODS, method_tag, run_joint_sfo
 from .case import log_warnings, status_text
-from .folders import check_distinct_photos, joint_overlay_name, write_joint_result
+from .folders import joint_overlay_name, write_joint_result
 from .identify import Calibrations, conclusion_line, with_identification
 
 #: Folder of the joint SFOs in a case's output folder.
@@ -18,20 +18,19 @@ JOINT_FOLDER = "joint"
 
 
 def check_joint_case(photos, methods):
-    """Refuse a ``--joint`` case that cannot run, before any file is read.
+    """Refuse a ``--joint`` case that cannot run, before any file is read (a photo given
+    twice is refused for every case, :func:`~lilium.casework.folders.check_distinct_photos`).
 
     Raises
     ------
     ValueError
-        Fewer than two photos, a photo given twice, no method with a joint form among
-        ``methods``.
+        Fewer than two photos, no method with a joint form among ``methods``.
     """
     if len(photos) < 2:
         raise ValueError(
             f"--joint needs two or more --photo of the same person, got {len(photos)}; drop "
             "--joint for one photo"
         )
-    check_distinct_photos(photos)
     if not any(METHODS[m].run_joint is not None for m in methods):
         joint = [name for name, m in METHODS.items() if m.run_joint is not None]
         raise ValueError(
