@@ -16,6 +16,10 @@ MIN_DEPTH_MM = 1e-6
 #: Photo views (SPEC section 8): lateral_left = the face points towards the image's left edge.
 VIEWS = ("frontal", "lateral_left", "lateral_right")
 
+#: The experiments of SPEC section 7, each named by its noise profile (ideal, landmark noise,
+#: realistic): :mod:`lilium.synthetic.noise` and :mod:`lilium.experiments.config`.
+EXPERIMENTS = ("A", "B", "C")
+
 #: Fewest 2D-3D correspondences POSEST accepts (a P4Pf sample).
 MIN_CORRESPONDENCES = 4
 

@@ -47,12 +47,9 @@ import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..constants import MAX_DE_POPULATION
+from ..constants import EXPERIMENTS, MAX_DE_POPULATION
 from ..methods.registry import METHODS
 from ..optimisation.de import DEOptions
-
-#: The experiments of SPEC section 7.
-EXPERIMENTS = ("A", "B", "C")
 
 #: Lilium fitness variants (from the method registry).
 LILIUM_VARIANTS = METHODS["lilium"].variants

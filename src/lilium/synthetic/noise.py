@@ -13,7 +13,7 @@
 
 import numpy as np
 
-NOISE_PROFILES = ("A", "B", "C")
+from ..constants import EXPERIMENTS as NOISE_PROFILES
 
 #: Largest landmark offset (pixels, per coordinate) of profiles B and C.
 LANDMARK_NOISE_PX = 5.0
