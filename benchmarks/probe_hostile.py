@@ -535,6 +535,8 @@ def all_probes():
     # The newer entry points' probes live in their own module (each reads in one sitting).
     from probe_hostile_casework import casework_probes
     from probe_hostile_inputs import input_probes
+    from probe_hostile_outputs import output_probes
+    from probe_hostile_resume import resume_probes
     from probe_hostile_runs import run_probes
 
     return (
@@ -547,6 +549,8 @@ def all_probes():
         + photo_and_ct_probes()
         + input_probes()
         + run_probes()
+        + output_probes()
+        + resume_probes()
     )
 
 

@@ -364,7 +364,7 @@ def test_last_resort_handler(case, tmp_path, capsys, monkeypatch):
         raise PermissionError(13, "Permission denied", str(tmp_path / "result.json"))
 
     monkeypatch.setattr(sfo_cli, "sfo_on_folders", refused)
-    _one_line_error(capsys, _sfo(case, tmp_path), "result.json: Permission denied", "permissions")
+    _one_line_error(capsys, _sfo(case, tmp_path), "result.json: permission denied", "permissions")
 
     def out_of_memory(*args, **kwargs):
         raise MemoryError

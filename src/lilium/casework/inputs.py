@@ -252,7 +252,7 @@ def load_photos(
             view = views[k_file] or "frontal"
             if lm_file is None:  # --auto-landmarks: lilium photo into OUT/<photo>/prepared/
                 photo, inputs, facts = _prepared_image(
-                    path, records, out, views[k_file], mask, sensor_width_mm, log
+                    path, _taken(records), out, views[k_file], mask, sensor_width_mm, log
                 )
                 origin = landmark_origin(photo, facts)
                 view = photo.view
@@ -277,25 +277,40 @@ def load_photos(
         photo = replace(
             photo, landmarks_file=str(inputs.get("facial landmarks") or inputs["photo.json"])
         )
+        photo = replace(photo, id=unique_id(photo.id, _taken(records)))
         records.append(PhotoRecord(photo, inputs, notes, origin))
-    seen = {}
-    for i, record in enumerate(records):  # unique photo ids for the outputs
-        n = seen.get(record.photo.id, 0)
-        seen[record.photo.id] = n + 1
-        if n:
-            records[i] = record._replace(
-                photo=replace(record.photo, id=_nth_id(record.photo.id, n))
-            )
     return records
 
 
-def _nth_id(photo_id, n_before):
-    """The output id of a photo whose id ``n_before`` earlier photos share (``front_2``, ...)."""
-    return f"{photo_id}_{n_before + 1}" if n_before else photo_id
+#: The joint SFOs' folder in a case's output folder (``<out>/joint/<method tag>/``).
+JOINT_FOLDER = "joint"
+
+#: Names at the top of a case's output folder that are not photo folders: a photo named so
+#: gets another id (``report.html_2``), as a repeated name does.
+CASE_OWN_NAMES = ("report.html", JOINT_FOLDER)
 
 
-def _prepared_image(path, records, out, view, mask, sensor_width_mm, log):
+def _taken(records):
+    return {*CASE_OWN_NAMES, *(r.photo.id for r in records)}
+
+
+def unique_id(photo_id, taken):
+    """The output id of a photo: ``photo_id``, or the first of ``photo_id_2``, ``photo_id_3``,
+    ... that no earlier photo has (``taken``, the ids given so far), so that photos ``front``,
+    ``front`` and ``front_2`` write to three folders (``front``, ``front_2``, ``front_2_2``).
+    """
+    if photo_id not in taken:
+        return photo_id
+    n = 2
+    while f"{photo_id}_{n}" in taken:
+        n += 1
+    return f"{photo_id}_{n}"
+
+
+def _prepared_image(path, taken, out, view, mask, sensor_width_mm, log):
     """``--auto-landmarks`` for one bare image: prepare, read back, keep the user's mask.
+
+    ``taken`` holds the output ids of the photos before it (:func:`unique_id`).
 
     Returns the photo (its id the image's stem, as for an image with a landmark file), its
     labelled inputs and the folder's :class:`~lilium.io.prepared.PreparedFacts`.
@@ -303,8 +318,7 @@ def _prepared_image(path, records, out, view, mask, sensor_width_mm, log):
     if out is None:
         raise ValueError("--auto-landmarks needs the output folder (--out) to prepare photos in")
     photo_id = safe_id(path.stem, "photo")
-    n_before = sum(r.photo.id == photo_id for r in records)
-    folder = Path(out) / _nth_id(photo_id, n_before) / "prepared"
+    folder = Path(out) / unique_id(photo_id, taken) / "prepared"  # the photo's output folder
     prepare_bare_photo(path, folder, view=view, sensor_width_mm=sensor_width_mm, log=log)
     photo = replace(read_photo(folder), id=photo_id)
     if mask is not None:  # the user's own mask wins over the automatic one

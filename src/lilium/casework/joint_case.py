@@ -12,9 +12,7 @@ from ..methods.registry import METHODS, method_tag, run_joint_sfo
 from .case import log_warnings, status_text
 from .folders import joint_overlay_name, write_joint_result
 from .identify import Calibrations, conclusion_line, with_identification
-
-#: Folder of the joint SFOs in a case's output folder.
-JOINT_FOLDER = "joint"
+from .inputs import JOINT_FOLDER
 
 
 def check_joint_case(photos, methods):
@@ -61,17 +59,10 @@ def run_joint_methods(skull, records, methods, options, seed, out, log=print, ca
     dict of str -> (JointSfoResult, Path)
         Per joint method, its result and its output folder.
 
-    Raises
-    ------
-    ValueError
-        A photo id ``joint`` (it would share the joint folder's name).
+    A photo's id is never :data:`~lilium.casework.inputs.JOINT_FOLDER`
+    (:func:`~lilium.casework.inputs.unique_id`).
     """
     photos = [record.photo for record in records]
-    if any(p.id == JOINT_FOLDER for p in photos):
-        raise ValueError(
-            f"--joint: a photo is named {JOINT_FOLDER!r}, the name of the joint results' folder; "
-            "rename the photo (folder or image)"
-        )
     done = {}
     for method in methods:
         if METHODS[method].run_joint is None:

@@ -6,9 +6,13 @@ Each factory returns a callable for ``add_argument(type=...)``; argparse turns i
 """
 
 import argparse
+import errno
+import functools
 import math
 import os
 from pathlib import Path
+
+from ..io.paths import check_no_links
 
 #: Largest seed: numpy takes any non-negative integer, SQLite and JSON readers an int64.
 MAX_SEED = 2**63 - 1
@@ -57,6 +61,41 @@ def positive_float(allow_inf=False, why=""):
 seed = int_in(0, MAX_SEED, " (numpy seeds are non-negative)")
 
 
+#: What to do about the errors the system gives for a path (the rest: the general advice).
+_OS_ADVICE = {
+    errno.ENAMETOOLONG: "the name is too long; give a shorter path",
+    errno.EISDIR: "a folder stands where a file is needed; give another path",
+    errno.ENOTDIR: "a file stands where a folder is needed; give another path",
+    errno.EACCES: "permission denied; fix its permissions or give another path",
+    errno.ENOSPC: "the disk is full; free space or give a path on another disk",
+}
+
+
+def describe_os_error(exc):
+    """One line for an ``OSError``: the file it names, and what to do."""
+    reason = exc.strerror or " ".join(str(exc).split()) or type(exc).__name__
+    advice = _OS_ADVICE.get(exc.errno)
+    if exc.filename is None:
+        advice = advice or "check the paths and the free disk space"
+        return f"{reason} ({type(exc).__name__}); {advice}"
+    advice = advice or f"{reason}; check the path, its permissions and the free disk space"
+    return f"{exc.filename}: {advice}"
+
+
+def _path_checked(parse):
+    """``parse`` with a path the system refuses to look at (too long, ...) as its message."""
+
+    @functools.wraps(parse)
+    def checked(text):
+        try:
+            return parse(text)
+        except OSError as exc:
+            exc.filename = text if exc.filename is None else exc.filename
+            raise argparse.ArgumentTypeError(describe_os_error(exc)) from None
+
+    return checked
+
+
 def existing_file(what):
     """A path to an existing file (``what`` names it in the message)."""
 
@@ -68,14 +107,17 @@ def existing_file(what):
         return path
 
     parse.__name__ = "file"
-    return parse
+    return _path_checked(parse)
 
 
+@_path_checked
 def output_folder(text):
     """An output folder that exists or can be made, and can be written to.
 
     Rejects a path that is a file, lies under a file, or whose nearest existing folder is not
-    writable, so a command never fails after a long run because it cannot write.
+    writable, so a command never fails after a long run because it cannot write; and a folder
+    holding a symbolic link (:func:`lilium.io.paths.check_no_links`), through which it would
+    write outside the folder.
     """
     path = Path(text)
     if path.exists() and not path.is_dir():
@@ -93,4 +135,8 @@ def output_folder(text):
         raise argparse.ArgumentTypeError(
             f"{parent} is not writable; give a folder you can write to (or fix its permissions)"
         )
+    try:
+        check_no_links(path)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
     return path

@@ -87,6 +87,7 @@ def register(subparsers):
 
 def run(args):
     from ..ct.importer import import_ct
+    from ..io.paths import check_no_links
 
     options = {"byte_order": args.byte_order, "header_bytes": args.header_bytes}
     if args.raw_shape:
@@ -106,6 +107,7 @@ def run(args):
         options = {k: v for k, v in options.items() if k == "spacing"}
     if args.allow_outside_data:
         options["allow_outside_data"] = True
+    check_no_links(args.out)
     result = import_ct(
         args.volume,
         args.out,

@@ -20,6 +20,7 @@ import sys
 import warnings
 
 from .. import __version__
+from .argtypes import describe_os_error
 
 #: Sub-command modules, in the order ``lilium --help`` lists them.
 COMMANDS = [
@@ -65,12 +66,7 @@ def _one_line(text):
 def _describe(exc):
     """The one-line message of an exception that is not an input error."""
     if isinstance(exc, OSError):
-        reason = exc.strerror or _one_line(exc) or type(exc).__name__
-        if exc.filename is not None:
-            return (
-                f"{exc.filename}: {reason}; check the path, its permissions and the free disk space"
-            )
-        return f"{reason} ({type(exc).__name__}); check the paths and the free disk space"
+        return describe_os_error(exc)
     if isinstance(exc, MemoryError):
         return "out of memory; downscale the photo (see docs/checks.md) or free memory"
     detail = _one_line(exc)
@@ -87,6 +83,9 @@ def main(argv=None):
         args = build_parser().parse_args(argv)
     except SystemExit as exc:  # --help, --version (0) or a bad argument (2, one line printed)
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+    except OSError as exc:  # an argument's type looked at a path the system refuses
+        print(f"lilium: error: {describe_os_error(exc)}", file=sys.stderr)
+        return 2
     debug = os.environ.get(DEBUG_ENV, "") not in ("", "0")
     try:
         with warnings.catch_warnings():

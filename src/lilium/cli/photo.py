@@ -50,8 +50,10 @@ def register(subparsers):
 
 
 def run(args):
+    from ..io.paths import check_no_links
     from ..photo.prepare import prepare_photo
 
+    check_no_links(args.out)
     start = time.perf_counter()
     result = prepare_photo(
         args.image,

@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+from .argtypes import output_folder
+
 
 def register(subparsers):
     p = subparsers.add_parser(
@@ -14,7 +16,7 @@ def register(subparsers):
         ),
     )
     p.add_argument("db", type=Path, help="results database written by lilium experiment")
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--out", type=output_folder, required=True, help="output folder")
     p.set_defaults(func=run)
 
 

@@ -493,8 +493,57 @@ def markdown_report(db, summary, tests, implausible, n_rows, terms_off=()):
     return "\n".join(parts)
 
 
+#: The write test :func:`write_report` makes (and removes) in its folder.
+WRITE_TEST = ".lilium-write-test"
+
+#: Every file :func:`write_report` writes in its folder (the LR files only when a calibration
+#: can be cross-validated).
+REPORT_FILES = (
+    "report.md",
+    "summary.csv",
+    "wilcoxon.csv",
+    "implausible.csv",
+    "terms_off.csv",
+    "ranks.csv",
+    "rank_distribution.png",
+    "bpe.png",
+    "identification.csv",
+    "cmc.csv",
+    "cmc.png",
+    "calibration.csv",
+    "tippett.png",
+    WRITE_TEST,
+)
+
+
+def _same_file(a, b):
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and a.samefile(b))
+    except OSError:
+        return False
+
+
+def check_database_not_output(db, out_dir):
+    """Refuse, before anything is written, a database that a report file in ``out_dir`` would
+    overwrite (``lilium report in/summary.csv --out in``).
+
+    Raises
+    ------
+    ValueError
+        Naming ``--out``, the file and the database, and the fix.
+    """
+    db, out_dir = Path(db), Path(out_dir)
+    for name in REPORT_FILES:
+        if _same_file(out_dir / name, db):
+            raise ValueError(
+                f"--out {out_dir}: lilium report writes {name} there, over the database {db}; "
+                "give another --out"
+            )
+
+
 def write_report(db, out_dir):
-    """Write ``report.md``, the CSV tables and the PNG plots to ``out_dir``.
+    """Write ``report.md``, the CSV tables and the PNG plots (:data:`REPORT_FILES`) to
+    ``out_dir``; a database one of them would overwrite is refused first.
 
     Returns
     -------
@@ -502,11 +551,12 @@ def write_report(db, out_dir):
     """
     rows = load_rows(db)
     out_dir = Path(out_dir)
+    check_database_not_output(db, out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out {out_dir}: is a file, not a folder; give a folder for the report")
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
-        probe = out_dir / ".lilium-write-test"
+        probe = out_dir / WRITE_TEST
         probe.write_bytes(b"")
         probe.unlink()
     except OSError as exc:

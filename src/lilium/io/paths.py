@@ -12,14 +12,18 @@ import re
 from pathlib import Path
 
 #: Characters replaced by ``_``: path separators, characters Windows forbids, and ``%``/``#``
-#: (which would change the meaning of a relative link); control characters too.
-_UNSAFE = re.compile(r'[\x00-\x1f\x7f/\\:*?"<>|%#]')
+#: (which would change the meaning of a relative link); control characters too, and the lone
+#: surrogates by which Python holds a file name's bytes that are not UTF-8 (they cannot be
+#: written into a UTF-8 report or JSON file).
+_UNSAFE = re.compile(r'[\x00-\x1f\x7f/\\:*?"<>|%#\ud800-\udfff]')
 
 #: Names Windows reserves whatever the extension.
 _RESERVED = {"con", "prn", "aux", "nul"} | {f"{p}{i}" for p in ("com", "lpt") for i in range(10)}
 
-#: Longest id (characters); longer names are cut (file systems allow 255 bytes).
+#: Longest id, in characters and in UTF-8 bytes; longer names are cut. File systems allow 255
+#: bytes per name, and an id is written with a prefix and suffixes (``overlay_<id>.png``).
 MAX_ID_CHARS = 100
+MAX_ID_BYTES = 200
 
 
 def safe_id(name, default="photo"):
@@ -46,9 +50,12 @@ def safe_id(name, default="photo"):
     'javascript_alert(1)'
     >>> safe_id("a/b\\\\c")
     'a_b_c'
+    >>> len(safe_id("\N{GRINNING FACE}" * 70).encode())
+    200
     """
     text = _UNSAFE.sub("_", str(name)).strip(" .")
-    text = text[:MAX_ID_CHARS].rstrip(" .")
+    text = text[:MAX_ID_CHARS].encode("utf-8")[:MAX_ID_BYTES].decode("utf-8", "ignore")
+    text = text.rstrip(" .")
     if not text:
         return default
     if text.split(".")[0].lower() in _RESERVED:
@@ -64,3 +71,29 @@ def path_id(path, default="photo"):
     """
     name = Path(os.path.normpath(os.path.abspath(path))).name
     return safe_id(name, default)
+
+
+def check_no_links(folder):
+    """Refuse an output folder that holds a symbolic link (anywhere below it).
+
+    A command writes only inside its output folder, and it writes files by name: a link left
+    there (``out/report.html -> ../notes.txt``, a dangling ``overlay.png``, a photo folder
+    pointing elsewhere) would make it write through the link, outside the folder. The folder
+    itself may be reached through links. Nothing to check when it does not exist yet.
+
+    Raises
+    ------
+    ValueError
+        Naming the first link found.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return
+    for parent, dirs, files in os.walk(folder):  # does not descend into linked folders
+        for name in sorted(dirs) + sorted(files):
+            path = Path(parent) / name
+            if path.is_symlink():
+                raise ValueError(
+                    f"{path} is a symbolic link inside the output folder, and Lilium writes "
+                    "only inside it; remove the link or give another output folder"
+                )

@@ -11,14 +11,23 @@ Rules (docs/photo.md):
 - A folder holding any of those names that ``lilium photo`` did not write (a hand-made photo
   folder) is refused: nothing of the user's is replaced.
 - The image may be the folder's own (``lilium photo D/image.jpg --out D``, the user's or an
-  earlier run's): it is read first and kept in place.
+  earlier run's): it is read first and kept in place. Any other file this command writes there
+  (``D/face_mask.png``, or ``D/image.png`` when the folder's image will be ``image.jpg`` or the
+  turned copy) is refused as the photo: writing the folder would replace it.
 """
 
 from pathlib import Path
 
 from ..io.prepared import PREPARED_BY, written_by_lilium_photo
 
-__all__ = ["IMAGE_FILES", "OWN_FILES", "PREPARED_BY", "check_image_path", "claim_folder"]
+__all__ = [
+    "IMAGE_FILES",
+    "OWN_FILES",
+    "PREPARED_BY",
+    "check_image_path",
+    "check_photo_not_output",
+    "claim_folder",
+]
 
 #: The files ``lilium photo`` writes in its folder.
 IMAGE_FILES = ("image.png", "image.jpg", "image.jpeg")
@@ -75,6 +84,34 @@ def claim_folder(out, image_path):
             "--out (lilium photo replaces only its own files)"
         )
     return present
+
+
+def check_photo_not_output(out, image_path, kept_name=None):
+    """Refuse a photograph that is one of the files ``lilium photo`` writes in ``out``.
+
+    Parameters
+    ----------
+    out : Path
+        ``--out``.
+    image_path : Path
+        The photograph.
+    kept_name : str, optional
+        The folder's image when it is the photo copied unchanged (``image.png``, ``image.jpg``
+        or ``image.jpeg``): the photo may be that file, kept in place. None when the folder's
+        image is a converted or turned copy.
+
+    Raises
+    ------
+    ValueError
+        The photo is (the same file as) one of :data:`OWN_FILES` in ``out`` other than
+        ``kept_name``: the message names the photo and the fix.
+    """
+    for name in OWN_FILES:
+        if name != kept_name and _same_file(out / name, image_path):
+            raise ValueError(
+                f"{image_path}: the photo is {out / name}, a file lilium photo writes in --out "
+                f"{out}, so preparing it would replace it; give another --out or rename the photo"
+            )
 
 
 def check_image_path(image_path):

@@ -24,7 +24,7 @@ from ..io.case import read_image
 from ..io.formats import read_landmarks
 from ..io.jsonio import write_json
 from .analysis import analyse_face, upright_turns
-from .folder import PREPARED_BY, check_image_path, claim_folder
+from .folder import PREPARED_BY, check_image_path, check_photo_not_output, claim_folder
 from .headpose import implausible_distance, iris_distance_mm
 from .landmarks import mesh_face_curves
 from .mask import mask_outline
@@ -59,10 +59,19 @@ class PreparedPhoto:
     warnings: tuple = ()
 
 
-def _copy_image(image_path, image, out, turned=False):
+def _copied_image_name(image_path, turned=False):
+    """The folder's image name when it is the photo copied unchanged (PNG or JPEG, not turned),
+    else None (the folder then holds a converted ``image.png``)."""
     suffix = image_path.suffix.lower()
     if suffix in (".png", ".jpg", ".jpeg") and not turned:
-        target = out / f"image{suffix}"
+        return f"image{suffix}"
+    return None
+
+
+def _copy_image(image_path, image, out, turned=False):
+    name = _copied_image_name(image_path, turned)
+    if name is not None:
+        target = out / name
         if not (target.exists() and target.samefile(image_path)):  # the folder's own image
             shutil.copyfile(image_path, target)
         return target
@@ -150,6 +159,7 @@ def prepare_photo(
     """
     image_path = check_image_path(image_path)
     out = Path(out_dir)
+    check_photo_not_output(out, image_path, _copied_image_name(image_path))
     previous = claim_folder(out, image_path)
     image = read_image(image_path)
     h, w = image.shape[:2]
@@ -168,6 +178,7 @@ def prepare_photo(
             )
         image = np.ascontiguousarray(np.rot90(image, turns))
         h, w = image.shape[:2]
+        check_photo_not_output(out, image_path)  # a link to the folder's image: turned over it
     reviewed = read_landmarks(landmarks_path, "facial") if landmarks_path else None
     analysis = analyse_face(image, face)
     view = view or (analysis.view if analysis else "frontal")

@@ -15,6 +15,7 @@ import base64
 import html
 import io
 import json
+import re
 
 import numpy as np
 
@@ -125,6 +126,38 @@ def _data_url(image):
     return "data:image/jpeg;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
 
 
+#: What :func:`script_json` writes for the characters that could end a ``<script>`` or open a
+#: comment or entity in it.
+_SCRIPT_ESCAPES = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026"}
+
+
+def script_json(value):
+    """``value`` as JSON to embed in a ``<script>``: no ``</script>`` or ``<!--`` can appear.
+
+    ``<``, ``>`` and ``&`` (found only inside JSON strings) become ``\\u003c``, ``\\u003e`` and
+    ``\\u0026``, which JSON and JavaScript read back as the same characters; non-ASCII text is
+    escaped too (``json.dumps``' default), so U+2028 and U+2029 cannot break the line.
+    """
+    text = json.dumps(value)
+    return re.sub("[<>&]", lambda match: _SCRIPT_ESCAPES[match.group(0)], text)
+
+
+def fill_template(template, values):
+    """``template`` with every placeholder (a key of ``values``) replaced, in one pass.
+
+    The values are never scanned again, so a placeholder's text inside one of them (a photo
+    named ``a__W__.png`` in the title) stays as it is. Escape the values for where they go.
+
+    Parameters
+    ----------
+    template : str
+    values : dict of str -> str
+        Placeholder (e.g. ``"__TITLE__"``) -> its text.
+    """
+    pattern = re.compile("|".join(re.escape(key) for key in sorted(values, key=len, reverse=True)))
+    return pattern.sub(lambda match: values[match.group(0)], template)
+
+
 def review_page(image, landmarks, sources, outline_uv, priors, title, message=""):
     """The review page as a string.
 
@@ -148,7 +181,7 @@ def review_page(image, landmarks, sources, outline_uv, priors, title, message=""
         "r": max(1.5, max(h, w) / 250),
     }
     outline = " ".join(f"{u:.1f},{v:.1f}" for u, v in np.asarray(outline_uv).reshape(-1, 2))
-    replace = {
+    values = {
         "__TITLE__": html.escape(title),
         "__MESSAGE__": html.escape(message),
         "__W__": str(w),
@@ -157,9 +190,6 @@ def review_page(image, landmarks, sources, outline_uv, priors, title, message=""
         "__STROKE__": f"{max(1, max(h, w) / 400):.1f}",
         "__OUTLINE__": outline,
         "__IMAGE__": _data_url(image),
-        "__DATA__": json.dumps(data).replace("</", "<\\/"),
+        "__DATA__": script_json(data),
     }
-    page = _PAGE
-    for key, value in replace.items():
-        page = page.replace(key, value)
-    return page
+    return fill_template(_PAGE, values)

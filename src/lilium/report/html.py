@@ -545,10 +545,15 @@ def build_report(entries, title=None, command=None, date=None, decisions=()):
 
 
 def write_report(path, entries, **kwargs):
-    """Write :func:`build_report` to ``path`` (UTF-8); returns the path."""
+    """Write :func:`build_report` to ``path`` (UTF-8); returns the path.
+
+    A file name that is not UTF-8 (held by Python as lone surrogates) is shown with U+FFFD in
+    place of its bad bytes; the report is written all the same.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(build_report(entries, **kwargs), encoding="utf-8")
+    text = build_report(entries, **kwargs)
+    path.write_bytes(text.encode("utf-8", "surrogateescape").decode("utf-8", "replace").encode())
     return path
 
 
