@@ -77,6 +77,24 @@ def _describe(exc):
     )
 
 
+def _prog(argv):
+    """``lilium <command>`` as far as ``argv`` names one (before it is parsed)."""
+    words = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    names = [module.rsplit(".", 1)[-1].replace("_", "-") for module in COMMANDS]
+    return next((f"lilium {w}" for w in words if w in names), "lilium")
+
+
+def _interrupted(exc):
+    """Whether ``exc`` arose from a ``KeyboardInterrupt`` (its cause or context)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
 def main(argv=None):
     """Run the command; returns the exit status (2 for any error, with one line on stderr)."""
     try:
@@ -86,6 +104,9 @@ def main(argv=None):
     except OSError as exc:  # an argument's type looked at a path the system refuses
         print(f"lilium: error: {describe_os_error(exc)}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # Ctrl-C while the commands' modules are imported
+        print(f"{_prog(argv)}: interrupted", file=sys.stderr)
+        return 130
     debug = os.environ.get(DEBUG_ENV, "") not in ("", "0")
     try:
         with warnings.catch_warnings():
@@ -99,6 +120,9 @@ def main(argv=None):
         print(f"lilium {args.command}: interrupted", file=sys.stderr)
         return 130
     except Exception as exc:  # the last resort: never a traceback for the user
+        if _interrupted(exc):  # a compiled kernel reports Ctrl-C as a SystemError
+            print(f"lilium {args.command}: interrupted", file=sys.stderr)
+            return 130
         if debug:
             raise
         print(f"lilium {args.command}: error: {_describe(exc)}", file=sys.stderr)

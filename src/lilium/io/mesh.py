@@ -1,5 +1,8 @@
 """Mesh files (PLY, OBJ, STL) through trimesh, with checks for degenerate meshes."""
 
+import signal
+import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -8,6 +11,34 @@ MESH_SUFFIXES = (".ply", ".obj", ".stl")
 
 #: A skull in millimetres spans roughly 100-300 mm; outside this the unit is probably wrong.
 PLAUSIBLE_EXTENT_MM = (20.0, 1000.0)
+
+
+def import_trimesh():
+    """The ``trimesh`` module, imported on first use with Ctrl-C held back until it is in.
+
+    trimesh imports its optional dependencies under ``except BaseException``, which swallows a
+    ``KeyboardInterrupt`` that arrives meanwhile: a Ctrl-C in that 0.15 s was lost and the
+    command ran on. During the import a Ctrl-C is only noted (the main thread's handler is
+    swapped); once the import is over, it is passed to the handler from before (Python's:
+    ``KeyboardInterrupt`` in Lilium's code).
+    """
+    if "trimesh" in sys.modules:
+        return sys.modules["trimesh"]
+    if threading.current_thread() is not threading.main_thread():
+        import trimesh  # handlers belong to the main thread
+
+        return trimesh
+    noted = []
+    before = signal.signal(signal.SIGINT, lambda signum, frame: noted.append(signum))
+    try:
+        import trimesh
+    finally:
+        signal.signal(signal.SIGINT, before)
+    if noted and callable(before):
+        before(signal.SIGINT, None)
+    elif noted and before == signal.SIG_DFL:
+        raise KeyboardInterrupt
+    return trimesh
 
 
 def read_mesh(path):
@@ -39,7 +70,7 @@ def read_mesh(path):
         if fast is not None:
             check_mesh(*fast, str(path))
             return fast
-    import trimesh  # 0.15 s to import: only for the layouts read_binary_ply does not read
+    trimesh = import_trimesh()  # 0.15 s: only for the layouts read_binary_ply does not read
     try:
         mesh = trimesh.load(path, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many kinds for a corrupt file
@@ -154,7 +185,7 @@ def check_mesh(vertices_mm, faces, source="mesh"):
 
 def write_mesh(path, vertices_mm, faces):
     """Write a triangle mesh (format from the suffix)."""
-    import trimesh
+    trimesh = import_trimesh()
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

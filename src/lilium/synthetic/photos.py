@@ -59,6 +59,7 @@ from ..fitness import curves as _curves
 from ..fitness.curves import check_view
 from ..geometry.camera import Camera, principal_point_of
 from ..geometry.rotations import rotvec_to_matrix
+from ..io.mesh import import_trimesh
 from ..softtissue.depths import BUILTIN_DEPTHS
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
 from . import render as _render
@@ -357,8 +358,9 @@ def prepare_head(subject):
     """A :class:`HeadModel` from a subject (``skin_vertices_mm``, ``skin_faces``,
     ``facial_landmarks``; the mask's neck cut clears ``head_skull_vertices_mm``, the complete
     skull of a subject whose skull lacks the mandible, or else ``skull_vertices_mm``)."""
-    import trimesh
     from scipy.spatial import ConvexHull
+
+    trimesh = import_trimesh()
 
     vertices = np.asarray(subject.skin_vertices_mm, dtype=float)
     faces = np.asarray(subject.skin_faces, dtype=np.int64)

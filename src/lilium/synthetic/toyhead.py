@@ -10,6 +10,7 @@ Skull frame: mm, x = the subject's left, y = up, z = anterior.
 
 import numpy as np
 
+from ..io.mesh import import_trimesh
 from ..softtissue.landmarks import CORRESPONDENCES, EXTRA_CRANIAL, EXTRA_FACIAL
 from .subjects import MANDIBLE_LANDMARKS, SyntheticSubject, axes_on_skull
 
@@ -83,7 +84,7 @@ def make_toy_subject(subject_id="toy", rng=None, subdivisions=4, mandible=True):
     SyntheticSubject
         With the fields the photo renderer needs (no ``shape``, depths or bone normals).
     """
-    import trimesh
+    trimesh = import_trimesh()
 
     rng = np.random.default_rng(rng)
     scale = 1.0 + rng.uniform(-0.05, 0.05, size=3)
@@ -157,9 +158,9 @@ def write_toy_subject(folder, subject):
     """Write a stand-in subject folder (SPEC section 8) with trimesh PLY meshes."""
     from pathlib import Path
 
-    import trimesh
-
     from ..io.jsonio import write_json
+
+    trimesh = import_trimesh()
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

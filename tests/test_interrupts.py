@@ -1,0 +1,60 @@
+"""Ctrl-C (benchmarks/probe_hostile_resume.py): one line and exit status 130 whenever it comes,
+never a traceback, and never lost inside a library's import."""
+
+import subprocess
+import sys
+import textwrap
+
+import lilium.cli.main as cli_main
+from cli_helpers import _sfo
+
+#: A child that sends itself SIGINT while Python looks for trimesh, then imports it.
+_CHILD = textwrap.dedent(
+    """
+    import os, signal, sys
+
+    class CtrlC:
+        def find_spec(self, name, path=None, target=None):
+            if name == "trimesh":
+                os.kill(os.getpid(), signal.SIGINT)
+            return None
+
+    sys.meta_path.insert(0, CtrlC())
+    from lilium.io.mesh import import_trimesh
+    try:
+        import_trimesh()
+    except KeyboardInterrupt:
+        print("interrupted; trimesh complete:", "trimesh.creation" in sys.modules)
+    """
+)
+
+
+def test_ctrl_c_during_the_trimesh_import_is_raised_after_it():
+    # trimesh imports its optional parts under ``except BaseException``: a KeyboardInterrupt
+    # raised inside the import could be swallowed there. Held back, it comes after the import.
+    done = subprocess.run([sys.executable, "-c", _CHILD], capture_output=True, text=True)
+    assert done.stdout.strip() == "interrupted; trimesh complete: True", done.stderr
+
+
+def test_ctrl_c_while_the_commands_load_is_one_line(monkeypatch, capsys):
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli_main, "build_parser", interrupted)
+    assert cli_main.main(["sfo", "--help"]) == 130
+    assert capsys.readouterr().err == "lilium sfo: interrupted\n"
+
+
+def test_ctrl_c_inside_a_compiled_kernel_is_one_line(case, tmp_path, monkeypatch, capsys):
+    # numba's dispatcher returns with the KeyboardInterrupt set: CPython raises a SystemError
+    # caused by it, which must not read as a bug.
+    import lilium.cli.sfo as sfo_cli
+
+    def kernel_interrupted(*args, **kwargs):
+        raise SystemError("CPUDispatcher(kernel) returned a result with an exception set") from (
+            KeyboardInterrupt()
+        )
+
+    monkeypatch.setattr(sfo_cli, "sfo_on_folders", kernel_interrupted)
+    assert cli_main.main([str(a) for a in _sfo(case, tmp_path / "out")]) == 130
+    assert capsys.readouterr().err == "lilium sfo: interrupted\n"
