@@ -499,20 +499,9 @@ WRITE_TEST = ".lilium-write-test"
 #: Every file :func:`write_report` writes in its folder (the LR files only when a calibration
 #: can be cross-validated).
 REPORT_FILES = (
-    "report.md",
-    "summary.csv",
-    "wilcoxon.csv",
-    "implausible.csv",
-    "terms_off.csv",
-    "ranks.csv",
-    "rank_distribution.png",
-    "bpe.png",
-    "identification.csv",
-    "cmc.csv",
-    "cmc.png",
-    "calibration.csv",
-    "tippett.png",
-    WRITE_TEST,
+    *("report.md", "summary.csv", "wilcoxon.csv", "implausible.csv", "terms_off.csv"),
+    *("ranks.csv", "rank_distribution.png", "bpe.png", "identification.csv", "cmc.csv"),
+    *("cmc.png", "calibration.csv", "tippett.png", WRITE_TEST),
 )
 
 
