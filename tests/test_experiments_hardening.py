@@ -18,7 +18,8 @@ from lilium.cli.main import main
 from lilium.experiments.config import MAX_SEED, config_from_dict, load_config
 from lilium.experiments.dataset import check_index
 from lilium.experiments.runner import Task, run_task
-from lilium.experiments.store import KEY_COLUMNS, ResultStore, RunLock
+from lilium.experiments.store import KEY_COLUMNS, ResultStore
+from lilium.io.locks import RunLock
 from lilium.optimisation.de import DEOptions
 from lilium.synthetic import dataset as ds
 from lilium.synthetic.photos import CameraRanges
@@ -321,7 +322,7 @@ def test_report_out_that_is_a_file(tmp_path, capsys):
     status, err = run_cli(capsys, ["report", str(db), "--out", str(target)])
     assert status == 2 and "--out" in err and "is a file" in err
     status, err = run_cli(capsys, ["report", str(db), "--out", str(target / "sub")])
-    assert status == 2 and "--out" in err and "cannot write there" in err
+    assert status == 2 and "--out" in err and "cannot hold folders" in err
     assert target.read_text() == "keep me"
     status, err = run_cli(capsys, ["report", str(tmp_path), "--out", str(tmp_path / "rep")])
     assert status == 2 and "is a folder; give the results database file" in err

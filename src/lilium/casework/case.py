@@ -5,13 +5,17 @@ from pathlib import Path
 
 from ..io.case import read_depth_table
 from ..io.paths import safe_id
-from ..io.results import write_result
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
-from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
-from .folders import check_distinct_photos, labelled_skull
-from .identify import Calibrations, conclusion_line, identify, with_identification
+from .folders import (
+    check_distinct_photos,
+    labelled_skull,
+    output_lock,
+    resumed_sfo,
+    sfo_fingerprint,
+)
+from .identify import Calibrations, conclusion_line, identify
 from .inputs import check_runnable, load_photos, load_skull
 from .prepared import check_photo_extra
 
@@ -107,13 +111,25 @@ def run_case(
     -------
     list of ReportEntry
 
+    Raises
+    ------
+    ValueError
+        An invalid input (naming the file), or another run holding ``out``
+        (:func:`~lilium.casework.folders.output_lock`).
+
     Notes
     -----
+    **Resumable**: an SFO whose ``result.json`` is already there, whole with its overlays, for
+    the same input files' bytes, method, options, seed and priors (its ``"inputs_sha256"``,
+    :func:`~lilium.casework.folders.sfo_fingerprint`) is read back, not run again (its log line
+    says ``(stored)``), so a case killed half-way continues where it stopped, with the same
+    report as a run that was not stopped; any other stored SFO runs again (the log says why).
+
     Before the first SFO, ``log`` gets one line per term Lilium will switch off for a photo
     (:func:`~lilium.casework.inputs.check_runnable`): ``<photo>: lilium <variant>: P_pll
     switched off: <why>``; each SFO's line ends with the terms it ran without.
     """
-    from ..report.html import ReportEntry, write_report
+    from ..report.html import write_report
 
     methods = list(dict.fromkeys(methods)) or ["lilium"]
     for method in methods:
@@ -128,80 +144,115 @@ def run_case(
     skull, skull_inputs = load_skull(skull_path, landmarks, axes, log=log)
     skull = labelled_skull(skull, skull_inputs)
     out = Path(out)
-    records = load_photos(
-        photos, log=log, skull=skull, auto_landmarks=auto_landmarks, out=out, **photo_options
-    )
-    if depth_table:
-        options = replace(options, depth_table=read_depth_table(depth_table))
-    calibrations = Calibrations(calibration)
-    planned = {}
-    for photo, inputs, _, _ in records:  # every problem before any long run
-        planned[photo.id] = check_runnable(
-            skull, photo, methods, options.variant, skull_inputs, inputs
+    with output_lock(out):
+        records = load_photos(
+            photos, log=log, skull=skull, auto_landmarks=auto_landmarks, out=out, **photo_options
         )
+        if depth_table:
+            options = replace(options, depth_table=read_depth_table(depth_table))
+        calibrations = Calibrations(calibration)
+        _check_records(skull, skull_inputs, records, methods, options.variant, log)
+        joints = {}  # method -> (JointSfoResult, folder), for the joint methods
+        if joint:
+            from .joint_case import run_joint_methods
+
+            joints = run_joint_methods(
+                skull, records, methods, options, seed, out, log, calibrations, skull_inputs
+            )
+        run = _CaseRun(skull, skull_inputs, out, options, seed, calibrations, log)
+        entries = run.entries(records, methods, joints)
+        decisions = run.decisions(methods)
+        report = write_report(
+            out / "report.html", entries, title=title, command=command, decisions=decisions
+        )
+    log(f"report: {report}")
+    return entries
+
+
+def _check_records(skull, skull_inputs, records, methods, variant, log):
+    """Every problem of the photos before any long run; log the terms switched off and the
+    photos with unreviewed automatic landmarks."""
+    planned = {}
+    for photo, inputs, _, _ in records:
+        planned[photo.id] = check_runnable(skull, photo, methods, variant, skull_inputs, inputs)
         check_inputs(skull, photo)  # left/right of skull and photo (names the file)
     for photo_id, off in planned.items():
         for term, why in off.items():
-            log(f"{photo_id}: lilium {options.variant}: {term_label(term)} switched off: {why}")
+            log(f"{photo_id}: lilium {variant}: {term_label(term)} switched off: {why}")
     for photo, _, _, origin in records:
         if origin is not None and origin.unreviewed:
             log(f"{photo.id}: {origin.line()}")
-    entries = []
-    joints = {}  # method -> (JointSfoResult, folder), for the joint methods
-    if joint:
-        from .joint_case import joint_entry, run_joint_methods
 
-        joints = run_joint_methods(
-            skull, records, methods, options, seed, out, log, calibrations
+
+class _CaseRun:
+    """The per-photo SFOs of one case, each run or reused
+    (:func:`~lilium.casework.folders.resumed_sfo`), with one file-digest cache."""
+
+    def __init__(self, skull, skull_inputs, out, options, seed, calibrations, log):
+        self.skull, self.skull_inputs, self.out = skull, skull_inputs, out
+        self.options, self.seed, self.calibrations, self.log = options, seed, calibrations, log
+        self.digests = {}
+        self.separate = {}  # method -> [(photo, result)], for the decision over several photos
+
+    def entries(self, records, methods, joints):
+        """The report entries of every photo and method (``joints``: the joint SFOs' runs)."""
+        from .joint_case import joint_entry
+
+        entries = []
+        for k, (photo, inputs, notes, origin) in enumerate(records):
+            landmark_info = _landmark_info(origin, self.out)
+            labelled = {**self.skull_inputs, **inputs}
+            for method in methods:
+                if method in joints:
+                    run = joints[method]
+                    entry = joint_entry(run, k, self.skull, photo, labelled, notes, self.out)
+                else:
+                    entry = self.single(method, photo, inputs, notes, landmark_info)
+                entries.append(entry)
+        return entries
+
+    def single(self, method, photo, inputs, notes, landmark_info):
+        """The report entry of ``method``'s SFO of ``photo``, run or reused, and logged."""
+        from ..report.html import ReportEntry
+
+        tag = method_tag(method, self.options.variant)
+        folder = self.out / safe_id(photo.id) / tag  # ids read from files are safe already
+        fingerprint = sfo_fingerprint(
+            method, self.options, self.seed, self.skull, self.skull_inputs, [photo], [inputs],
+            self.digests,
         )
-    separate = {}  # method -> [(photo, result)], for the decision over several photos
-    for k, (photo, inputs, notes, origin) in enumerate(records):
-        landmark_info = _landmark_info(origin, out)
+        sfo = (method, self.skull, photo, self.options, self.seed)
+        calibrations, log = self.calibrations, self.log
+        result, reused = resumed_sfo(folder, *sfo, fingerprint, calibrations, log, run_sfo)
+        self.separate.setdefault(method, []).append((photo, result))
+        rel = folder.relative_to(self.out)
+        outputs = {"result.json": f"{rel.as_posix()}/result.json"}
+        if (folder / "overlay.png").is_file():
+            outputs["overlay.png"] = f"{rel.as_posix()}/overlay.png"
+        name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
+        how = " (stored)" if reused else ""
+        self.log(
+            f"{photo.id}: {name}: {status_text(result)}, {result.seconds:.2f} s{how} -> {folder}"
+        )
+        log_warnings(result, self.log)
+        self.log(f"  {conclusion_line(result.extra['identification'])}")
+        labelled = {**self.skull_inputs, **inputs}
+        return ReportEntry(self.skull, photo, result, labelled, notes, outputs, **landmark_info)
+
+    def decisions(self, methods):
+        """Each method's decision over its separate SFOs of two or more photos, logged."""
+        decisions = []
         for method in methods:
-            if method in joints:
-                labelled = {**skull_inputs, **inputs}
-                entries.append(joint_entry(joints[method], k, skull, photo, labelled, notes, out))
+            done = self.separate.get(method, [])
+            if len(done) < 2:
                 continue
-            result = run_sfo(method, skull, photo, options, seed)
-            result = with_identification(result, skull, [photo], calibrations)
-            separate.setdefault(method, []).append((photo, result))
-            tag = method_tag(method, options.variant)
-            folder = out / safe_id(photo.id) / tag  # ids read from files are safe already
-            write_result(folder, result, result_overlay(result, skull, photo))
-            rel = folder.relative_to(out)
-            outputs = {"result.json": f"{rel.as_posix()}/result.json"}
-            if (folder / "overlay.png").is_file():
-                outputs["overlay.png"] = f"{rel.as_posix()}/overlay.png"
-            name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
-            log(f"{photo.id}: {name}: {status_text(result)}, {result.seconds:.2f} s -> {folder}")
-            log_warnings(result, log)
-            log(f"  {conclusion_line(result.extra['identification'])}")
-            entries.append(
-                ReportEntry(
-                    skull,
-                    photo,
-                    result,
-                    {**skull_inputs, **inputs},
-                    notes,
-                    outputs,
-                    **landmark_info,
-                )
-            )
-    decisions = []
-    for method, done in separate.items():
-        if len(done) < 2:
-            continue
-        photos_m, results_m = zip(*done, strict=True)
-        record = identify(skull, list(photos_m), list(results_m), calibrations)
-        tag = method_tag(method, options.variant)
-        label = f"photos {', '.join(p.id for p in photos_m)} together, {tag}"
-        log(f"{label}: {conclusion_line(record)}")
-        decisions.append((label, record))
-    report = write_report(
-        out / "report.html", entries, title=title, command=command, decisions=decisions
-    )
-    log(f"report: {report}")
-    return entries
+            photos_m, results_m = zip(*done, strict=True)
+            record = identify(self.skull, list(photos_m), list(results_m), self.calibrations)
+            tag = method_tag(method, self.options.variant)
+            label = f"photos {', '.join(p.id for p in photos_m)} together, {tag}"
+            self.log(f"{label}: {conclusion_line(record)}")
+            decisions.append((label, record))
+        return decisions
 
 
 def status_text(result):

@@ -8,9 +8,18 @@ Methods without a joint form (POSEST-SFO) run per photo as without ``--joint``.
 
 from pathlib import Path
 
+from ..inputs import correspondences
+from ..io.jsonio import write_json
+from ..io.results import read_joint_result
 from ..methods.registry import METHODS, method_tag, run_joint_sfo
 from .case import log_warnings, status_text
-from .folders import joint_overlay_name, write_joint_result
+from .folders import (
+    joint_overlay_name,
+    sfo_fingerprint,
+    stored_result,
+    with_fingerprint,
+    write_joint_result,
+)
 from .identify import Calibrations, conclusion_line, with_identification
 from .inputs import JOINT_FOLDER
 
@@ -37,13 +46,19 @@ def check_joint_case(photos, methods):
         )
 
 
-def run_joint_methods(skull, records, methods, options, seed, out, log=print, calibrations=None):
+def run_joint_methods(
+    skull, records, methods, options, seed, out, log=print, calibrations=None, skull_inputs=None
+):
     """Run every joint-capable method of ``methods`` once on all the photos; write each.
+
+    A joint SFO already stored in its folder for the same input files, options, seed and
+    priors (:func:`~lilium.casework.folders.stored_result`), with every overlay whole, is read
+    back instead (its log line says ``(stored)``) and identified with ``calibrations``.
 
     Parameters
     ----------
     skull : Skull
-    records : list of (Photo, dict, dict)
+    records : list of PhotoRecord
         From :func:`~lilium.casework.inputs.load_photos`.
     methods : sequence of str
     options : SfoOptions
@@ -53,6 +68,9 @@ def run_joint_methods(skull, records, methods, options, seed, out, log=print, ca
     log : callable
     calibrations : Calibrations, optional
         For the joint SFO's identification (default: the shipped calibration).
+    skull_inputs : dict of str -> path, optional
+        The skull's labelled files (:func:`~lilium.casework.inputs.load_skull`), for the
+        input fingerprint.
 
     Returns
     -------
@@ -63,18 +81,21 @@ def run_joint_methods(skull, records, methods, options, seed, out, log=print, ca
     (:func:`~lilium.casework.inputs.unique_id`).
     """
     photos = [record.photo for record in records]
+    calibrations = calibrations or Calibrations()
     done = {}
     for method in methods:
         if METHODS[method].run_joint is None:
             continue
-        result = run_joint_sfo(method, skull, photos, options, seed)
-        result = with_identification(result, skull, photos, calibrations or Calibrations())
         folder = Path(out) / JOINT_FOLDER / method_tag(method, options.variant)
-        write_joint_result(folder, result, skull, photos)
+        fingerprint = sfo_fingerprint(
+            method, options, seed, skull, skull_inputs or {}, photos, [r.inputs for r in records]
+        )
+        sfo = (method, skull, photos, options, seed)
+        result, reused = _resumed_joint(folder, sfo, fingerprint, calibrations, log)
         name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
         log(
             f"joint ({', '.join(p.id for p in photos)}): {name}: score {result.fitness:.4g}, "
-            f"{result.seconds:.2f} s -> {folder}"
+            f"{result.seconds:.2f} s{' (stored)' if reused else ''} -> {folder}"
         )
         for single in result.photos:
             log(f"  {single.photo_id}: {status_text(single)}")
@@ -82,6 +103,35 @@ def run_joint_methods(skull, records, methods, options, seed, out, log=print, ca
         log(f"  {conclusion_line(result.extra['identification'])}")
         done[method] = (result, folder)
     return done
+
+
+def _resumed_joint(folder, sfo, fingerprint, calibrations, log):
+    """The joint SFO ``sfo = (method, skull, photos, options, seed)`` stored in ``folder``
+    when it is this one, else run and written (``result.json`` with ``fingerprint``, the
+    overlays); either way identified with ``calibrations``.
+
+    Returns
+    -------
+    result : JointSfoResult
+    reused : bool
+    """
+    method, skull, photos, options, seed = sfo
+    names = [correspondences(skull, photo).facial_names for photo in photos]
+    overlays = [joint_overlay_name(photo.id) for photo in photos]
+    result, why = stored_result(
+        folder, fingerprint, overlays, lambda path: read_joint_result(path, names)
+    )
+    if result is not None:
+        result = with_identification(result, skull, photos, calibrations)
+        write_json(folder / "result.json", result.to_dict())  # this run's calibration
+        return result, True
+    if why:
+        log(f"joint: {method_tag(method, options.variant)}: running the SFO again: {why}")
+    result = run_joint_sfo(method, skull, photos, options, seed)
+    result = with_identification(result, skull, photos, calibrations)
+    result = with_fingerprint(result, fingerprint)
+    write_joint_result(folder, result, skull, photos)
+    return result, False
 
 
 def joint_entry(joint_run, k, skull, photo, inputs, notes, out):

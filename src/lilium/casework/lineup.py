@@ -8,11 +8,14 @@ tissue, :mod:`lilium.casework.identify`). Candidates are ranked by log10 LR (no 
 
 Outputs: ``OUT/<candidate>/<photo>/<method tag>/result.json`` and ``overlay.png`` per SFO,
 ``OUT/lineup.json`` (the ranking) and ``OUT/report.html`` (the ranking first, then every
-SFO with its overlay). **Resumable**: an SFO whose ``result.json`` is already there for the
-same method, variant, seed, skull and photo is read back, not run again, so a lineup killed
-half-way continues where it stopped; its identification is computed again, with this run's
-calibration (another ``--calibration`` changes the LRs, not the SFOs); a progress bar counts
-the SFOs.
+SFO with its overlay). **Resumable**: an SFO whose ``result.json`` is already there, whole
+with its ``overlay.png``, for the same input files' bytes, method, options, seed and priors
+(its ``"inputs_sha256"``, :func:`~lilium.casework.folders.sfo_fingerprint`) is read back, not
+run again, so a lineup killed half-way continues where it stopped; any other stored SFO runs
+again (the log says why). Its identification is computed again, with this run's calibration
+(another ``--calibration`` changes the LRs, not the SFOs); a progress bar counts the SFOs. A
+second run on the same ``--out`` is refused while one runs
+(:func:`~lilium.casework.folders.output_lock`).
 """
 
 from dataclasses import replace
@@ -20,35 +23,18 @@ from pathlib import Path
 
 from ..io.jsonio import write_json
 from ..io.paths import safe_id
-from ..io.results import read_result, write_result
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
-from ..methods.overlay import result_overlay
 from ..methods.registry import check_method, method_tag, run_sfo
-from .folders import labelled_skull, repeated_photo
-from .identify import Calibrations, conclusion_line, identify, with_identification
+from .folders import (
+    labelled_skull,
+    output_lock,
+    repeated_photo,
+    resumed_sfo,
+    sfo_fingerprint,
+)
+from .identify import Calibrations, conclusion_line, identify
 from .inputs import load_photos, load_skull
-
-
-def _stored(folder, method, variant, seed, skull_id, photo_id):
-    """The SFO stored in ``folder`` when it is this one, else None."""
-    path = Path(folder) / "result.json"
-    if not path.is_file():
-        return None
-    try:
-        result = read_result(path)
-    except ValueError:
-        return None
-    same = (
-        result.method == method
-        and (result.variant or None) == (variant or None)
-        and (result.seed == seed or method == "posest-sfo")
-        and result.skull_id == skull_id
-        and result.photo_id == photo_id
-        and "identification" in result.extra
-    )
-    return result if same else None
-
 
 #: The lineup's own files in its output folder: no candidate's folder may take their names.
 OWN_FILES = ("lineup.json", "report.html")
@@ -146,10 +132,14 @@ def run_lineup(
     -------
     list of dict
         The ranking: ``candidate``, ``photos``, ``method``, ``identification``, best first.
-    """
-    from tqdm import tqdm
 
-    from ..report.html import ReportEntry, write_report
+    Raises
+    ------
+    ValueError
+        An invalid input (naming the file or option), or another run holding ``out``
+        (:func:`~lilium.casework.folders.output_lock`).
+    """
+    from ..report.html import write_report
 
     check_candidates(candidates)
     methods = list(dict.fromkeys(methods)) or ["lilium"]
@@ -166,68 +156,92 @@ def run_lineup(
             check_inputs(skull, record.photo)
         loaded.append((name, records))
 
-    total = sum(len(records) for _, records in loaded) * len(methods)
-    bar = tqdm(total=total, desc="lineup SFOs", unit="SFO", disable=not progress)
-    entries, ranking = [], []
-    for name, records in loaded:
-        done = {m: [] for m in methods}
-        for photo, inputs, notes, _ in records:
-            folder_id = safe_id(photo.id)
-            # The report and the results name the candidate with the photo.
-            photo = replace(photo, id=f"{name}: {photo.id}")
-            for method in methods:
-                tag = method_tag(method, options.variant)
-                folder = out / safe_id(name) / folder_id / tag
-                variant = options.variant if method == "lilium" else None
-                result = _stored(folder, method, variant, seed, skull.id, photo.id)
-                if result is None:
-                    result = run_sfo(method, skull, photo, options, seed)
-                    result = with_identification(result, skull, [photo], calibrations)
-                    write_result(folder, result, result_overlay(result, skull, photo))
-                else:  # identified again: this run's --calibration, not the stored record's
-                    result = with_identification(result, skull, [photo], calibrations)
-                    write_json(folder / "result.json", result.to_dict())
-                bar.update(1)
-                done[method].append((photo, result))
-                rel = folder.relative_to(out).as_posix()
-                outputs = {"result.json": f"{rel}/result.json"}
-                if (folder / "overlay.png").is_file():
-                    outputs["overlay.png"] = f"{rel}/overlay.png"
-                entries.append(
-                    ReportEntry(skull, photo, result, {**skull_inputs, **inputs}, notes, outputs)
-                )
-        for method in methods:
-            photos_m = [p for p, _ in done[method]]
-            results_m = [r for _, r in done[method]]
-            if len(results_m) == 1:
-                record = results_m[0].extra["identification"]
-            else:
-                record = identify(skull, photos_m, results_m, calibrations)
-            ranking.append(
-                dict(
-                    candidate=name,
-                    photos=[p.id for p in photos_m],
-                    method=method_tag(method, options.variant),
-                    identification=record,
-                )
-            )
-    bar.close()
-    first = method_tag(methods[0], options.variant)
-
-    ranking.sort(key=lambda entry: rank_key(entry, first))
-    for k, entry in enumerate(ranking, start=1):
-        entry["rank"] = k
-        log(f"{k}. {entry['candidate']} ({entry['method']}): "
-            f"{conclusion_line(entry['identification'])}")
-    write_json(out / "lineup.json", {"skull": skull.id, "ranking": ranking})
-    decisions = [
-        (f"{e['rank']}. candidate {e['candidate']} ({len(e['photos'])} photo(s)), {e['method']}",
-         e["identification"])
-        for e in ranking
-    ]
-    title = title or f"Lineup: skull {skull.id} against {len(candidates)} candidates"
-    report = write_report(
-        out / "report.html", entries, title=title, command=command, decisions=decisions
-    )
+    with output_lock(out):
+        run = _LineupRun(skull, skull_inputs, out, methods, options, seed, calibrations, log)
+        entries, ranking = run.all(loaded, progress)
+        first = method_tag(methods[0], options.variant)
+        ranking.sort(key=lambda entry: rank_key(entry, first))
+        for k, entry in enumerate(ranking, start=1):
+            entry["rank"] = k
+            log(f"{k}. {entry['candidate']} ({entry['method']}): "
+                f"{conclusion_line(entry['identification'])}")
+        write_json(out / "lineup.json", {"skull": skull.id, "ranking": ranking})
+        decisions = [
+            (f"{e['rank']}. candidate {e['candidate']} ({len(e['photos'])} photo(s)), "
+             f"{e['method']}", e["identification"])
+            for e in ranking
+        ]
+        title = title or f"Lineup: skull {skull.id} against {len(candidates)} candidates"
+        report = write_report(
+            out / "report.html", entries, title=title, command=command, decisions=decisions
+        )
     log(f"report: {report}")
     return ranking
+
+
+class _LineupRun:
+    """Every candidate's SFOs of one lineup, each run or reused
+    (:func:`~lilium.casework.folders.resumed_sfo`), with one file-digest cache."""
+
+    def __init__(self, skull, skull_inputs, out, methods, options, seed, calibrations, log):
+        self.skull, self.skull_inputs, self.out = skull, skull_inputs, out
+        self.methods, self.options, self.seed = methods, options, seed
+        self.calibrations, self.log = calibrations, log
+        self.digests = {}
+
+    def all(self, loaded, progress):
+        """The report entries and the (unsorted) ranking of ``loaded``: (name, records)."""
+        from tqdm import tqdm
+
+        total = sum(len(records) for _, records in loaded) * len(self.methods)
+        bar = tqdm(total=total, desc="lineup SFOs", unit="SFO", disable=not progress)
+        entries, ranking = [], []
+        for name, records in loaded:
+            done = {m: [] for m in self.methods}
+            for record in records:
+                for method, entry in self.photo(name, record):
+                    bar.update(1)
+                    done[method].append((entry.photo, entry.result))
+                    entries.append(entry)
+            ranking += [self.decision(name, method, done[method]) for method in self.methods]
+        bar.close()
+        return entries, ranking
+
+    def photo(self, name, record):
+        """Yield (method, ReportEntry) of each method's SFO of candidate ``name``'s photo."""
+        from ..report.html import ReportEntry
+
+        photo, inputs, notes, _ = record
+        folder_id = safe_id(photo.id)
+        # The report and the results name the candidate with the photo.
+        photo = replace(photo, id=f"{name}: {photo.id}")
+        for method in self.methods:
+            folder = self.out / safe_id(name) / folder_id / method_tag(method, self.options.variant)
+            fingerprint = sfo_fingerprint(
+                method, self.options, self.seed, self.skull, self.skull_inputs, [photo],
+                [inputs], self.digests,
+            )
+            sfo = (method, self.skull, photo, self.options, self.seed)
+            result, _ = resumed_sfo(folder, *sfo, fingerprint, self.calibrations, self.log, run_sfo)
+            rel = folder.relative_to(self.out).as_posix()
+            outputs = {"result.json": f"{rel}/result.json"}
+            if (folder / "overlay.png").is_file():
+                outputs["overlay.png"] = f"{rel}/overlay.png"
+            labelled = {**self.skull_inputs, **inputs}
+            yield method, ReportEntry(self.skull, photo, result, labelled, notes, outputs)
+
+    def decision(self, name, method, done):
+        """The ranking entry of candidate ``name`` for ``method``: its photos' ``done``
+        (photo, result) pairs, taken together when several."""
+        photos = [p for p, _ in done]
+        results = [r for _, r in done]
+        if len(results) == 1:
+            record = results[0].extra["identification"]
+        else:
+            record = identify(self.skull, photos, results, self.calibrations)
+        return dict(
+            candidate=name,
+            photos=[p.id for p in photos],
+            method=method_tag(method, self.options.variant),
+            identification=record,
+        )

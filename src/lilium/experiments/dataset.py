@@ -14,12 +14,17 @@ not start at all:
   ``photo.json``.
 - :func:`dataset_fingerprint`: a SHA-256 of ``dataset.json`` (without its ``seconds`` timing
   fields, so that regenerating the same dataset gives the same fingerprint) and of the content
-  of every regular file in the subject and photo folders the tasks read (hard links hashed
-  once). The results database keeps it; resuming against a dataset with another fingerprint (the
-  same ids from another seed, a file edited by hand) is refused. Cost, measured on the layout
-  of the paper's dataset (17 subjects x 60 photos x 3 experiments: 12,428 files, 205 MB on
-  disk, images hard-linked across A/B/C as the generator makes them): 0.56 to 0.62 s with a
-  warm file cache, against 23 s to enumerate its 2,548,980 tasks (docs/experiments.md).
+  of every regular file in every subject and photo folder ``dataset.json`` lists (hard links
+  hashed once), whatever the config selects: the experiments, methods or axis sets of a config
+  may change between runs on one database, the dataset may not. The results database keeps it;
+  resuming against a dataset with another fingerprint (the same ids from another seed, a file
+  edited by hand) is refused. Databases written before whole-dataset fingerprints keep the
+  fingerprint of the folders their tasks read (``tasks=``): the runner accepts that one too,
+  once, and then records the whole-dataset one
+  (:func:`lilium.experiments.runner.check_dataset_fingerprint`). Cost, measured on the layout of
+  the paper's dataset (17 subjects x 60 photos x 3 experiments: 12,428 files, 205 MB on disk,
+  images hard-linked across A/B/C as the generator makes them): 0.56 to 0.62 s with a warm file
+  cache, against 23 s to enumerate its 2,548,980 tasks (docs/experiments.md).
 """
 
 import hashlib
@@ -208,8 +213,28 @@ def _file_digest(path):
     return h.hexdigest()
 
 
-def dataset_fingerprint(root, index, tasks):
-    """SHA-256 (hex, 16 digits) of a dataset as the tasks read it (see the module docstring).
+def dataset_folders(root, index):
+    """Every subject and photo folder ``dataset.json`` lists, as absolute paths (sorted).
+
+    Parameters
+    ----------
+    root : Path
+        The dataset folder.
+    index : dict
+        Its checked ``dataset.json`` (:func:`check_index`).
+
+    Returns
+    -------
+    list of str
+    """
+    root = Path(root)
+    folders = {str(root / s["path"]) for s in index["subjects"]}
+    folders |= {str(root / path) for p in index["photos"] for path in p["paths"].values()}
+    return sorted(folders)
+
+
+def dataset_fingerprint(root, index, tasks=None):
+    """SHA-256 (hex, 16 digits) of a dataset (see the module docstring).
 
     Parameters
     ----------
@@ -217,7 +242,11 @@ def dataset_fingerprint(root, index, tasks):
         The dataset folder.
     index : dict
         Its ``dataset.json``.
-    tasks : list of Task
+    tasks : list of Task, optional
+        Hash only the folders these tasks read: the fingerprint that databases written before
+        whole-dataset fingerprints keep (it changed with the config's experiments). Default:
+        every folder of :func:`dataset_folders`; a listed folder that does not exist (one a
+        config does not use, deleted to save space) is hashed as missing.
 
     Returns
     -------
@@ -225,10 +254,16 @@ def dataset_fingerprint(root, index, tasks):
         Independent of where the dataset folder lies (paths are hashed relative to it).
     """
     root = Path(root)
-    folders = sorted({t.subject_dir for t in tasks} | {t.photo_dir for t in tasks})
+    if tasks is None:
+        folders = dataset_folders(root, index)
+    else:
+        folders = sorted({t.subject_dir for t in tasks} | {t.photo_dir for t in tasks})
     h = hashlib.sha256(_canonical_index(index))
     by_inode = {}
     for folder in folders:
+        if tasks is None and not os.path.isdir(folder):
+            h.update(f"\n{Path(folder).relative_to(root).as_posix()}\0missing".encode())
+            continue
         with os.scandir(folder) as entries:
             files = sorted(
                 (e for e in entries if not e.name.startswith(".") and e.is_file()),

@@ -18,7 +18,7 @@ SFOs in flight; a rerun skips the stored keys.
 
 Before the first SFO the run checks the dataset (:mod:`lilium.experiments.dataset`: the
 index, every file the tasks read, the fingerprint the database keeps) and takes the database's
-lock (:class:`~lilium.experiments.store.RunLock`): a second run on the same database refuses at
+lock (:class:`~lilium.io.locks.RunLock`): a second run on the same database refuses at
 once.
 
 Executors: a local process pool (default, all cores) or a Dask distributed cluster
@@ -39,11 +39,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.locks import RunLock
 from ..optimisation.de import DEOptions
 from .dataset import check_index, check_task_files, dataset_fingerprint
 from .executors import connect_scheduler, dask_results, local_results
 from .joint_tasks import JOINT_METHODS, partner_tasks, photo_pairs, run_joint_task
-from .store import KEY_COLUMNS, ResultStore, RunLock, database_error
+from .store import KEY_COLUMNS, ResultStore, database_error
 
 #: Cached cases per worker process (skulls are a few MB each).
 SKULL_CACHE = 48
@@ -118,9 +119,12 @@ def load_dataset(cfg, workers=1, log=print):
     index_path = root / "dataset.json"
     if not index_path.is_file():
         if not cfg.dataset.generate:
+            why = "not found"
+            if any((root / name).exists() for name in ("subjects", "photos")):
+                why = "not found: an unfinished dataset (lilium synth writes dataset.json last)"
             raise ValueError(
-                f"{index_path}: dataset index not found; generate the dataset (lilium synth) or "
-                "set dataset.generate = true in the config"
+                f"{index_path}: dataset index {why}; generate the dataset (lilium synth) or set "
+                "dataset.generate = true in the config"
             )
         from ..synthetic.dataset import generate_dataset
 
@@ -467,35 +471,84 @@ def run_experiment(cfg, scheduler=None, workers=None, db=None, progress=True, lo
         root, index = load_dataset(cfg, workers=workers, log=log)
         tasks = enumerate_tasks(cfg, root, index)
         check_task_files(tasks + partner_tasks(tasks))
-        fingerprint = dataset_fingerprint(root, index, tasks + partner_tasks(tasks))
+        fingerprint = dataset_fingerprint(root, index)
         try:
             with ResultStore(db) as store:
-                return _run(
-                    cfg, store, tasks, root, fingerprint, scheduler, workers, progress, log, start
-                )
+                store.check_fingerprint(cfg.fingerprint(), what="other DE settings or seeds")
+                check_dataset_fingerprint(store, root, index, tasks, fingerprint, log)
+                config = {"name": cfg.name, "dataset": str(root), "de": vars(cfg.de)}
+                store.set_meta("config", config)
+                return _run(cfg, store, tasks, scheduler, workers, progress, log, start)
         except sqlite3.DatabaseError as exc:
             raise database_error(db, exc) from None
 
 
-def _run(cfg, store, tasks, root, fingerprint, scheduler, workers, progress, log, start):
-    """The run itself, once every check has passed (see :func:`run_experiment`)."""
+#: ``meta`` keys of the dataset fingerprint and of what it covers (absent: the folders the
+#: database's runs read, as databases written before whole-dataset fingerprints keep it).
+DATASET_FINGERPRINT_KEY = "dataset_fingerprint"
+DATASET_SCOPE_KEY = "dataset_fingerprint_scope"
+WHOLE_DATASET = "every folder of dataset.json"
+
+
+def check_dataset_fingerprint(store, root, index, tasks, fingerprint, log=print):
+    """Record the dataset's fingerprint in the database, or check it against the stored one.
+
+    The fingerprint covers the whole dataset (:func:`.dataset.dataset_fingerprint`), so that
+    the experiments of a config may be added or dropped between runs on one database.
+    Decision for the databases written before (their fingerprint covers only the folders the
+    tasks of their config read, and they do not mark its scope): such a fingerprint is accepted
+    when it equals the one of the folders the current tasks read, and is then replaced by the
+    whole-dataset one (marked), so that the next run may change the experiments. A database of
+    that kind resumed with other experiments than it was made with is refused, saying to resume
+    it once with its own config first. Any other mismatch is another dataset: refused.
+
+    Parameters
+    ----------
+    store : ResultStore
+    root : Path
+        The dataset folder.
+    index : dict
+        Its ``dataset.json``.
+    tasks : list of Task
+        The run's tasks.
+    fingerprint : str
+        ``dataset_fingerprint(root, index)``.
+    log : callable
+
+    Raises
+    ------
+    ValueError
+        Naming the database and the dataset folder it was made from.
+    """
     db = store.path
-    store.check_fingerprint(cfg.fingerprint(), what="other DE settings or seeds")
+    stored = store.get_meta(DATASET_FINGERPRINT_KEY)
+    whole = store.get_meta(DATASET_SCOPE_KEY) == WHOLE_DATASET
+    if stored is None and store.count():
+        log(f"{db}: made before dataset fingerprints; recording the fingerprint of {root}")
+    elif stored not in (None, fingerprint) and not whole:
+        if stored == dataset_fingerprint(root, index, tasks + partner_tasks(tasks)):
+            log(f"{db}: recording the fingerprint of the whole dataset {root}")
+            store.set_meta(DATASET_FINGERPRINT_KEY, fingerprint)
     previous = store.get_meta("config")
     made_from = previous.get("dataset", "?") if isinstance(previous, dict) else "?"
-    if store.get_meta("dataset_fingerprint") is None and store.count():
-        log(f"{db}: made before dataset fingerprints; recording the fingerprint of {root}")
-    store.check_fingerprint(
-        fingerprint,
-        what="another dataset",
-        key="dataset_fingerprint",
-        fix=(
-            f"{root} is not the dataset the database was made from ({made_from}; other seed, "
-            "ids or files): give a new --db for this dataset, or point dataset.path to the "
-            "database's dataset"
-        ),
+    fix = (
+        f"{root} is not the dataset the database was made from ({made_from}; other seed, ids or "
+        "files): give a new --db for this dataset, or point dataset.path to the database's "
+        "dataset"
     )
-    store.set_meta("config", {"name": cfg.name, "dataset": str(root), "de": vars(cfg.de)})
+    if not whole and stored is not None:
+        fix += (
+            " (a database made before whole-dataset fingerprints: if the dataset is the same, "
+            "resume it once with the experiments it was made with, then change them)"
+        )
+    store.check_fingerprint(fingerprint, "another dataset", DATASET_FINGERPRINT_KEY, fix)
+    if not whole:
+        store.set_meta(DATASET_SCOPE_KEY, WHOLE_DATASET)
+
+
+def _run(cfg, store, tasks, scheduler, workers, progress, log, start):
+    """The run itself, once every check has passed (see :func:`run_experiment`)."""
+    db = store.path
     done = store.done_keys()
     todo = [t for t in tasks if t.key not in done]
     already = len(tasks) - len(todo)

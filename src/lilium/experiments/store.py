@@ -14,9 +14,7 @@ database that one is using.
 """
 
 import json
-import os
 import sqlite3
-import time
 from pathlib import Path
 
 #: Columns of the unique key, in order.
@@ -85,8 +83,38 @@ CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 FORMAT = "lilium-experiment-results"
 
 
+#: SQLite result codes (extended names) of a write the system refused: the disk is full, or a
+#: file-size limit (``ulimit -f``) was reached. The database stays intact (SQLite rolls the
+#: transaction back), so these are not a damaged database.
+WRITE_REFUSED = frozenset(
+    {
+        "SQLITE_FULL",
+        "SQLITE_IOERR",
+        "SQLITE_IOERR_WRITE",
+        "SQLITE_IOERR_FSYNC",
+        "SQLITE_IOERR_DIR_FSYNC",
+        "SQLITE_IOERR_TRUNCATE",
+        "SQLITE_IOERR_SHMSIZE",
+    }
+)
+
+
+def write_refused(exc):
+    """Whether a ``sqlite3.Error`` is a write the system refused (see :data:`WRITE_REFUSED`)."""
+    return getattr(exc, "sqlite_errorname", None) in WRITE_REFUSED
+
+
 def database_error(path, exc, fix="give another --db (or restore the file from a copy)"):
-    """The ``ValueError`` for a ``sqlite3.DatabaseError`` on the results database ``path``."""
+    """The ``ValueError`` for a ``sqlite3.DatabaseError`` on the results database ``path``.
+
+    A write the system refused (:func:`write_refused`) says so and that the run resumes; any
+    other error says the file cannot be used, with ``fix``.
+    """
+    if write_refused(exc):
+        return ValueError(
+            f"{path}: could not write (disk full or a file-size limit; {exc}); the stored SFOs "
+            "are kept: free space and run the same command again to resume"
+        )
     return ValueError(
         f"{path}: cannot use this results database ({exc}): it is corrupt, truncated, not "
         f"writable or not a Lilium results database; {fix}"
@@ -276,80 +304,3 @@ class ResultStore:
 def task_key(row):
     """The key tuple of a row or task dict."""
     return tuple(row[c] for c in KEY_COLUMNS)
-
-
-class RunLock:
-    """An exclusive lock on a results database: one ``lilium experiment`` at a time.
-
-    ``fcntl.flock`` on ``<db>.lock`` (next to the database), taken without waiting. The kernel
-    drops the lock when its process ends, however it ends, so a crashed or killed run leaves no
-    stale lock; the file, which names the owner's PID and start time, is removed on release.
-    Where ``fcntl`` does not exist (Windows) no lock is taken.
-
-    Parameters
-    ----------
-    db : str or Path
-        The results database (its folder must exist).
-
-    Raises
-    ------
-    ValueError
-        Another process holds the lock (its PID is in the message).
-    """
-
-    def __init__(self, db):
-        self.db = Path(db)
-        self.path = self.db.with_name(self.db.name + ".lock")
-        self.fd = None
-
-    def acquire(self):
-        try:
-            import fcntl
-        except ImportError:  # pragma: no cover - Windows
-            return self
-        while True:
-            try:
-                fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
-            except OSError as exc:
-                raise ValueError(
-                    f"{self.path}: cannot create the lock file ({exc.strerror}); give a --db in "
-                    "a writable folder"
-                ) from None
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError:
-                owner = os.pread(fd, 200, 0).decode(errors="replace").strip() or "another process"
-                os.close(fd)
-                raise ValueError(
-                    f"{self.db}: in use by another lilium experiment ({owner}); wait for it to "
-                    "finish, stop it, or give another --db"
-                ) from None
-            # The holder before us may have removed the file after we opened it: retry then.
-            try:
-                same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
-            except FileNotFoundError:
-                same = False
-            if same:
-                break
-            os.close(fd)
-        os.ftruncate(fd, 0)
-        stamp = time.strftime("%Y-%m-%d %H:%M:%S")
-        os.pwrite(fd, f"pid {os.getpid()} on {os.uname().nodename}, since {stamp}".encode(), 0)
-        self.fd = fd
-        return self
-
-    def release(self):
-        if self.fd is None:
-            return
-        try:
-            os.unlink(self.path)  # while still holding the lock, see acquire()
-        except FileNotFoundError:
-            pass
-        os.close(self.fd)
-        self.fd = None
-
-    def __enter__(self):
-        return self.acquire()
-
-    def __exit__(self, *exc):
-        self.release()

@@ -1,5 +1,6 @@
 """SFO outputs: ``result.json`` (SPEC section 8) and PNG pictures."""
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -8,19 +9,50 @@ from .jsonio import read_json, write_json
 
 
 def write_png(path, rgb):
-    """Write an ``(H, W, 3)`` uint8 array as PNG."""
+    """Write an ``(H, W, 3)`` uint8 array as PNG, atomically: to a temporary file in the same
+    folder, then renamed over ``path``, so ``path`` is never a cut PNG.
+
+    Raises
+    ------
+    OSError
+        Naming ``path`` (a full disk, a file-size limit, ...).
+    """
     from PIL import Image
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(np.asarray(rgb, dtype=np.uint8)).save(path)
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:
+        Image.fromarray(np.asarray(rgb, dtype=np.uint8)).save(tmp, format="PNG")
+        os.replace(tmp, path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        if exc.filename is None:  # Pillow's write() errors name no file
+            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
+        raise
+
+
+def png_readable(path):
+    """Whether ``path`` is a whole, readable image file (Pillow's ``verify``): False when it is
+    missing, empty or cut."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as image:
+            image.verify()
+    except (OSError, SyntaxError, ValueError):
+        return False
+    return True
 
 
 def write_result(out_dir, result, overlay_rgb=None):
-    """Write ``out_dir/result.json`` and, when given, ``out_dir/overlay.png``.
+    """Write ``out_dir/overlay.png``, when given, then ``out_dir/result.json``.
 
-    Without an overlay, an ``overlay.png`` left in ``out_dir`` by an earlier run is removed: it
-    would show another camera than the ``result.json`` beside it.
+    Both are written atomically and ``result.json`` last (an earlier one is removed first), so
+    a ``result.json`` is only ever there with its whole overlay: a run killed in between
+    leaves no result that a resumed run would take as finished. Without an overlay, an
+    ``overlay.png`` left in ``out_dir`` by an earlier run is removed: it would show another
+    camera than the ``result.json`` beside it.
 
     Returns
     -------
@@ -30,11 +62,12 @@ def write_result(out_dir, result, overlay_rgb=None):
     out_dir = Path(out_dir)
     path = out_dir / "result.json"
     overlay = out_dir / "overlay.png"
+    path.unlink(missing_ok=True)
     if overlay_rgb is None and (overlay.is_file() or overlay.is_symlink()):
         overlay.unlink()
-    write_json(path, result.to_dict())
     if overlay_rgb is not None:
         write_png(overlay, overlay_rgb)
+    write_json(path, result.to_dict())
     return path
 
 
@@ -56,6 +89,57 @@ def read_result_camera(path):
     return Camera.from_dict(data["camera"], name=f"{path}: camera")
 
 
+#: ``result.json`` keys of one SFO that are :class:`~lilium.methods.result.SfoResult` fields
+#: (the others go to its ``extra``).
+_SFO_KEYS = {"method", "variant", "seed", "subject", "photo", "camera", "fitness", "terms",
+             "terms_off", "facial_landmarks_3d", "seconds", "landmark_error", "warnings",
+             "priors", "error"}
+
+#: Keys of a joint SFO's ``result.json`` that are not its ``extra``.
+_JOINT_KEYS = {"method", "variant", "seed", "subject", "joint", "photos", "fitness",
+               "facial_landmarks_3d", "seconds", "error"}
+
+#: Joint run facts each photo's result carries in its ``extra`` (with ``joint_photos``).
+_JOINT_RUN_KEYS = ("history", "generations", "evaluations", "stop")
+
+
+def _camera(value, name):
+    from ..geometry.camera import Camera
+
+    return None if value is None else Camera.from_dict(value, name=name)
+
+
+def _sfo_result(data, camera, extra):
+    """An :class:`~lilium.methods.result.SfoResult` from one SFO's ``result.json`` dict."""
+    from ..inputs import CaseWarning
+    from ..methods.result import SfoResult
+
+    return SfoResult(
+        method=str(data["method"]),
+        variant=data.get("variant"),
+        seed=data.get("seed"),
+        skull_id=str(data["subject"]),
+        photo_id=str(data["photo"]),
+        camera=camera,
+        fitness=float("inf") if data.get("fitness") is None else float(data["fitness"]),
+        terms=dict(data.get("terms") or {}),
+        facial_landmarks_mm={
+            k: np.asarray(v, float) for k, v in (data.get("facial_landmarks_3d") or {}).items()
+        },
+        seconds=float(data.get("seconds") or 0.0),
+        error=str(data.get("error") or ""),
+        extra=extra,
+        warnings=tuple(CaseWarning(w["code"], w["message"]) for w in data.get("warnings", [])),
+        priors=data.get("priors"),
+        landmark_error=data.get("landmark_error"),
+        terms_off=dict(data.get("terms_off") or {}),
+    )
+
+
+def _incomplete(path, exc):
+    return ValueError(f"{path}: not a complete result.json ({exc}); delete it to rerun")
+
+
 def read_result(path):
     """An :class:`~lilium.methods.result.SfoResult` back from the ``result.json`` of one SFO
     (what a resumed run keeps instead of running the SFO again).
@@ -65,38 +149,64 @@ def read_result(path):
     ValueError
         A missing or malformed file, naming it.
     """
-    import numpy as np
-
-    from ..inputs import CaseWarning
-    from ..methods.result import SfoResult
-
     data = read_json(path)
-    known = {"method", "variant", "seed", "subject", "photo", "camera", "fitness", "terms",
-             "terms_off", "facial_landmarks_3d", "seconds", "landmark_error", "warnings",
-             "priors", "error"}
     try:
         camera = read_result_camera(path)
-        return SfoResult(
+        extra = {k: v for k, v in data.items() if k not in _SFO_KEYS}
+        return _sfo_result(data, camera, extra)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise _incomplete(path, exc) from None
+
+
+def read_joint_result(path, facial_names=None):
+    """A :class:`~lilium.methods.joint.JointSfoResult` back from a joint SFO's ``result.json``
+    (SPEC section 9; what a resumed ``lilium case --joint`` keeps).
+
+    Parameters
+    ----------
+    path : path
+    facial_names : sequence of sequence of str, optional
+        Each photo's facial landmark names, in the file's photo order: its share of the shared
+        soft tissue (its result's ``facial_landmarks_mm``, as the joint run gave it). Default:
+        every photo gets all the shared landmarks.
+
+    Raises
+    ------
+    ValueError
+        A missing or malformed file, or one of a single SFO, naming it.
+    """
+    from ..methods.joint import JointSfoResult
+
+    data = read_json(path)
+    try:
+        if not isinstance(data, dict) or data.get("joint") is not True:
+            raise ValueError("not a joint SFO's result")
+        shared = {k: np.asarray(v, float) for k, v in data["facial_landmarks_3d"].items()}
+        entries = list(data["photos"])
+        extra = {k: v for k, v in data.items() if k not in _JOINT_KEYS}
+        fitness = float("inf") if data["fitness"] is None else float(data["fitness"])
+        history = extra.get("history") or [fitness]
+        run = {"joint_photos": [str(e["photo"]) for e in entries], "joint_fitness": history[-1]}
+        run |= {k: extra[k] for k in _JOINT_RUN_KEYS if k in extra}
+        names = facial_names if facial_names is not None else [list(shared)] * len(entries)
+        singles = []
+        for entry, own in zip(entries, names, strict=True):
+            single = {k: data[k] for k in ("method", "variant", "seed", "subject", "seconds")}
+            single |= {**entry, "fitness": entry.get("fitness_unweighted")}
+            single["facial_landmarks_3d"] = {n: shared[n] for n in own if n in shared}
+            camera = _camera(entry["camera"], f"{path}: photo {entry['photo']}: camera")
+            singles.append(_sfo_result(single, camera, dict(run)))
+        return JointSfoResult(
             method=str(data["method"]),
-            variant=data.get("variant"),
-            seed=data.get("seed"),
+            variant=data["variant"],
+            seed=data["seed"],
             skull_id=str(data["subject"]),
-            photo_id=str(data["photo"]),
-            camera=camera,
-            fitness=float("inf") if data.get("fitness") is None else float(data["fitness"]),
-            terms=dict(data.get("terms") or {}),
-            facial_landmarks_mm={
-                k: np.asarray(v, float) for k, v in (data.get("facial_landmarks_3d") or {}).items()
-            },
-            seconds=float(data.get("seconds") or 0.0),
-            error=str(data.get("error") or ""),
-            extra={k: v for k, v in data.items() if k not in known},
-            warnings=tuple(CaseWarning(w["code"], w["message"]) for w in data.get("warnings", [])),
-            priors=data.get("priors"),
-            landmark_error=data.get("landmark_error"),
-            terms_off=dict(data.get("terms_off") or {}),
+            photos=tuple(singles),
+            fitness=fitness,
+            facial_landmarks_mm=shared,
+            seconds=float(data["seconds"]),
+            weights=tuple(float(e["weight"]) for e in entries),
+            extra=extra,
         )
     except (KeyError, TypeError, ValueError) as exc:
-        raise ValueError(
-            f"{path}: not a complete result.json ({exc}); delete it to rerun"
-        ) from None
+        raise _incomplete(path, exc) from None

@@ -12,6 +12,11 @@ Layout under ``out_dir``::
                                       (copies where links are not possible)
         photo.json, face_curve.json
 
+``dataset.json`` is removed first and written last: a folder without it is an unfinished
+dataset (a run killed mid-way), which ``lilium experiment`` refuses (or generates again, with
+``dataset.generate = true``), also when an older complete dataset lay there before. A write the
+system refuses is an ``OSError`` naming the file (or the subject folder) it was writing.
+
 Every subject ``k`` draws from its own child of ``np.random.SeedSequence(seed)``, so the output
 does not depend on the number of worker processes or their scheduling. The photos of experiments
 A, B and C share their camera and render; B and C share their noisy landmarks too (C differs from
@@ -29,13 +34,14 @@ import os
 import shutil
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
 from multiprocessing import get_context
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from ..io.jsonio import write_json
+from ..io import jsonio
 from ..softtissue.landmarks import CORRESPONDENCES
 from . import incomplete as _incomplete
 from . import noise as _noise
@@ -56,11 +62,37 @@ def photo_id(subject_id, view, k):
     return f"{subject_id}_{'f' if view == 'frontal' else 'l'}{k:02d}"
 
 
+@contextmanager
+def _naming(path):
+    """Give an ``OSError`` raised inside without a file name (a full disk or a file-size limit
+    met inside OpenCV, trimesh or Pillow: "File too large") the name ``path``."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is not None:
+            raise
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from exc
+
+
+def _write_json(path, data):
+    """:func:`lilium.io.jsonio.write_json`, an ``OSError`` naming ``path`` (:func:`_naming`)."""
+    with _naming(path):
+        jsonio.write_json(path, data)
+
+
 def write_png(path, image, bilevel=False):
     """Write an RGB ``(H, W, 3)`` or grey ``(H, W)`` uint8 image as PNG.
 
     ``bilevel=True`` writes a 1-bit PNG (non-zero -> 255 when read back), about ten times faster
     than 8-bit for masks.
+
+    Raises
+    ------
+    OSError
+        Naming ``path`` (:func:`_naming`).
+    ValueError
+        OpenCV could not write it (it says no more: a full disk, a file-size limit or no write
+        permission).
     """
     image = np.asarray(image)
     if image.ndim == 3:
@@ -68,8 +100,13 @@ def write_png(path, image, bilevel=False):
     params = [cv2.IMWRITE_PNG_COMPRESSION, PNG_COMPRESSION]
     if bilevel:
         params += [cv2.IMWRITE_PNG_BILEVEL, 1]
-    if not cv2.imwrite(str(path), image, params):
-        raise ValueError(f"{path}: could not write the PNG")
+    with _naming(path):
+        written = cv2.imwrite(str(path), image, params)
+    if not written:
+        raise ValueError(
+            f"{path}: could not write the PNG (a full disk, a file-size limit or no write "
+            "permission); free space or give another output folder"
+        )
 
 
 def _link_or_copy(src, dst):
@@ -79,7 +116,8 @@ def _link_or_copy(src, dst):
     try:
         os.link(src, dst)
     except OSError:
-        shutil.copyfile(src, dst)
+        with _naming(dst):
+            shutil.copyfile(src, dst)
 
 
 def write_photo_folders(
@@ -117,9 +155,11 @@ def write_photo_folders(
             extra=extra,
             unmarked=unmarked,
         )
-        write_json(folder / "photo.json", record)
+        _write_json(folder / "photo.json", record)
         if curve:
-            write_json(folder / "face_curve.json", curve)
+            _write_json(folder / "face_curve.json", curve)
+        else:  # one left by an older dataset in this folder would be read as this photo's
+            (folder / "face_curve.json").unlink(missing_ok=True)
         paths[exp] = f"photos/{exp}/{pid}"
     return paths
 
@@ -150,7 +190,8 @@ def _generate_subject(task):
         subject = factory(subject_id, subject_rng, mandible=False)
     on_skull = getattr(subject, "cranial_landmarks", None)
     subject_dir = out_dir / "subjects" / subject_id
-    writer(subject_dir, subject)
+    with _naming(subject_dir):
+        writer(subject_dir, subject)
 
     axes_files = []
     if "C" in experiments:
@@ -160,7 +201,7 @@ def _generate_subject(task):
             name = f"axes_C{k}.json"
             if on_skull is not None:  # drawn for every axis, written for the skull's landmarks
                 axes_set = {c: v for c, v in axes_set.items() if c in on_skull}
-            write_json(subject_dir / name, {"axes": axes_set})
+            _write_json(subject_dir / name, {"axes": axes_set})
             axes_files.append(name)
 
     head = _photos.prepare_head(subject)
@@ -204,6 +245,17 @@ def _generate_subject(task):
     if not mandible:
         subject_entry["mandible"] = False
     return subject_entry, entries
+
+
+def _unindex(out_dir):
+    """Remove ``out_dir/dataset.json`` before anything else is written.
+
+    ``dataset.json`` is written last, so a folder without it is an unfinished dataset, which
+    ``lilium experiment`` refuses (or generates again with ``dataset.generate = true``). Left in
+    place while a new dataset is written over an older one, a run killed mid-way would leave
+    the old index beside new files: a mixed dataset that looks complete.
+    """
+    (out_dir / "dataset.json").unlink(missing_ok=True)
 
 
 def generate_dataset(
@@ -259,6 +311,7 @@ def generate_dataset(
     if n_subjects < 1 or n_photos < 1:
         raise ValueError(f"need n_subjects >= 1 and n_photos >= 1, got {n_subjects}, {n_photos}")
     out_dir = Path(out_dir)
+    _unindex(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     ids = subject_ids(n_subjects)
@@ -320,5 +373,5 @@ def generate_dataset(
             "subjects_without_mandible": sorted(no_mandible),
             "drop_landmark_rate": drop_rate,
         }
-    write_json(out_dir / "dataset.json", index)
+    _write_json(out_dir / "dataset.json", index)
     return index
