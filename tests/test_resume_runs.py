@@ -222,3 +222,15 @@ def test_synth_write_refused_is_one_line_naming_the_file(tmp_path, monkeypatch, 
     assert main([*argv, "--no-progress", "--experiments", "A"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and str(out / "subjects" / "s01") in err, err
+
+
+def test_a_second_generation_in_one_folder_is_refused(tmp_path):
+    from lilium.io.locks import RunLock
+    from lilium.synthetic.dataset import generate_dataset
+
+    out = tmp_path / "data"
+    out.mkdir()
+    with RunLock(out, "lilium run", "--out"):  # another synth holds the folder
+        with pytest.raises(ValueError, match="in use by another lilium run"):
+            generate_dataset(out, 1, 1, seed=0, experiments=("A",), workers=1)
+    assert not (out / "dataset.json").exists()

@@ -42,6 +42,7 @@ import cv2
 import numpy as np
 
 from ..io import jsonio
+from ..io.locks import RunLock
 from ..softtissue.landmarks import CORRESPONDENCES
 from . import incomplete as _incomplete
 from . import noise as _noise
@@ -303,6 +304,12 @@ def generate_dataset(
     -------
     dict
         The index written to ``out_dir/dataset.json``.
+
+    Raises
+    ------
+    ValueError
+        A bad count or option, or another generation running in ``out_dir``
+        (:class:`~lilium.io.locks.RunLock`).
     """
     experiments = tuple(_noise.check_profile(e) for e in experiments)
     drop_rate = _incomplete.check_fraction(drop_landmark_rate, "drop_landmark_rate", closed=False)
@@ -311,67 +318,68 @@ def generate_dataset(
     if n_subjects < 1 or n_photos < 1:
         raise ValueError(f"need n_subjects >= 1 and n_photos >= 1, got {n_subjects}, {n_photos}")
     out_dir = Path(out_dir)
-    _unindex(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    start = time.perf_counter()
-    ids = subject_ids(n_subjects)
-    seqs = np.random.SeedSequence(seed).spawn(n_subjects)
-    no_mandible = _incomplete.mandible_less(ids, no_mandible_share, seed)
-    tasks = [
-        (str(out_dir), sid, seq, n_photos, experiments, ranges, subject_factory, subject_writer)
-        + (sid not in no_mandible, drop_rate)
-        for sid, seq in zip(ids, seqs, strict=True)
-    ]
-    results = {}
-    if workers <= 1:
-        for task in tasks:
-            results[task[1]] = _generate_subject(task)
-            if progress is not None:
-                progress(len(results), n_subjects)
-    else:
-        # Spawned, not forked, as the experiment runner's workers: a fork after a library
-        # started threads (LiteRT's, once `lilium photo` ran in this process) deadlocked.
-        with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
-            futures = {pool.submit(_generate_subject, t): t[1] for t in tasks}
-            for future in as_completed(futures):
-                results[futures[future]] = future.result()
+    with RunLock(out_dir, "lilium run", "--out"):  # two generations would mix their files
+        _unindex(out_dir)
+        start = time.perf_counter()
+        ids = subject_ids(n_subjects)
+        seqs = np.random.SeedSequence(seed).spawn(n_subjects)
+        no_mandible = _incomplete.mandible_less(ids, no_mandible_share, seed)
+        tasks = [
+            (str(out_dir), sid, seq, n_photos, experiments, ranges, subject_factory, subject_writer)
+            + (sid not in no_mandible, drop_rate)
+            for sid, seq in zip(ids, seqs, strict=True)
+        ]
+        results = {}
+        if workers <= 1:
+            for task in tasks:
+                results[task[1]] = _generate_subject(task)
                 if progress is not None:
                     progress(len(results), n_subjects)
+        else:
+            # Spawned, not forked, as the experiment runner's workers: a fork after a library
+            # started threads (LiteRT's, once `lilium photo` ran in this process) deadlocked.
+            with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
+                futures = {pool.submit(_generate_subject, t): t[1] for t in tasks}
+                for future in as_completed(futures):
+                    results[futures[future]] = future.result()
+                    if progress is not None:
+                        progress(len(results), n_subjects)
 
-    subjects, photos = [], []
-    for sid in ids:
-        subject_entry, entries = results[sid]
-        subjects.append(subject_entry)
-        photos.extend(entries)
-    index = {
-        "format": "lilium-synthetic-dataset",
-        "version": 1,
-        "seed": seed,
-        "n_subjects": n_subjects,
-        "n_photos_per_view": n_photos,
-        "experiments": list(experiments),
-        "camera_ranges": ranges.as_dict(),
-        "min_visible_landmarks": _photos.MIN_VISIBLE_LANDMARKS,
-        "priors": {
-            "focal_fraction": _photos.PRIOR_FOCAL_FRACTION,
-            "scd_fraction": _photos.PRIOR_SCD_FRACTION,
-            "head_rotation": "true rotation",
-            "head_tolerance_deg": _photos.PRIOR_HEAD_TOLERANCE_DEG,
-        },
-        "noise": {
-            "landmark_px": _noise.LANDMARK_NOISE_PX,
-            "axis_deg": _noise.AXIS_NOISE_DEG,
-            "n_axes_sets": _noise.N_AXES_SETS,
-        },
-        "subjects": subjects,
-        "photos": photos,
-        "seconds": time.perf_counter() - start,
-    }
-    if no_mandible or drop_rate:  # only then: complete datasets stay as they were
-        index["incomplete"] = {
-            "no_mandible_share": float(no_mandible_share),
-            "subjects_without_mandible": sorted(no_mandible),
-            "drop_landmark_rate": drop_rate,
+        subjects, photos = [], []
+        for sid in ids:
+            subject_entry, entries = results[sid]
+            subjects.append(subject_entry)
+            photos.extend(entries)
+        index = {
+            "format": "lilium-synthetic-dataset",
+            "version": 1,
+            "seed": seed,
+            "n_subjects": n_subjects,
+            "n_photos_per_view": n_photos,
+            "experiments": list(experiments),
+            "camera_ranges": ranges.as_dict(),
+            "min_visible_landmarks": _photos.MIN_VISIBLE_LANDMARKS,
+            "priors": {
+                "focal_fraction": _photos.PRIOR_FOCAL_FRACTION,
+                "scd_fraction": _photos.PRIOR_SCD_FRACTION,
+                "head_rotation": "true rotation",
+                "head_tolerance_deg": _photos.PRIOR_HEAD_TOLERANCE_DEG,
+            },
+            "noise": {
+                "landmark_px": _noise.LANDMARK_NOISE_PX,
+                "axis_deg": _noise.AXIS_NOISE_DEG,
+                "n_axes_sets": _noise.N_AXES_SETS,
+            },
+            "subjects": subjects,
+            "photos": photos,
+            "seconds": time.perf_counter() - start,
         }
-    _write_json(out_dir / "dataset.json", index)
-    return index
+        if no_mandible or drop_rate:  # only then: complete datasets stay as they were
+            index["incomplete"] = {
+                "no_mandible_share": float(no_mandible_share),
+                "subjects_without_mandible": sorted(no_mandible),
+                "drop_landmark_rate": drop_rate,
+            }
+        _write_json(out_dir / "dataset.json", index)
+        return index
