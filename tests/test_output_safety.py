@@ -107,3 +107,18 @@ def test_a_photo_folder_name_that_is_not_utf8_gets_a_report(case, tmp_path, caps
     assert code == 0, err
     assert (out / "caf_" / "posest-sfo" / "result.json").is_file()
     assert "caf\N{REPLACEMENT CHARACTER}" in (out / "report.html").read_text(encoding="utf-8")
+
+
+def test_a_write_error_without_a_file_name_gets_the_written_path(tmp_path, monkeypatch):
+    from pathlib import Path
+
+    from lilium.io.jsonio import write_json
+
+    def too_large(self, text, *args, **kwargs):
+        raise OSError(errno.EFBIG, "File too large")  # what write() says: no file name
+
+    monkeypatch.setattr(Path, "write_text", too_large)
+    with pytest.raises(OSError) as caught:
+        write_json(tmp_path / "result.json", {"a": 1})
+    assert caught.value.filename == str(tmp_path / "result.json")
+    assert list(tmp_path.iterdir()) == []  # no temporary file left

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .paths import naming_errors
+
 
 def _to_builtin(value):
     if isinstance(value, dict):
@@ -25,12 +27,24 @@ def _to_builtin(value):
 
 
 def write_json(path, data, indent=2):
-    """Write ``data`` (numpy arrays allowed; NaN/inf become null) atomically to ``path``."""
+    """Write ``data`` (numpy arrays allowed; NaN/inf become null) atomically to ``path``.
+
+    Raises
+    ------
+    OSError
+        Naming ``path`` (a full disk, a file-size limit, ...); no temporary file is left.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(_to_builtin(data), indent=indent) + "\n")
-    os.replace(tmp, path)
+    text = json.dumps(_to_builtin(data), indent=indent) + "\n"
+    try:
+        with naming_errors(path):
+            tmp.write_text(text)
+            os.replace(tmp, path)
+    except OSError:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 class _DuplicateKey(ValueError):

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .paths import naming_errors
+
 MESH_SUFFIXES = (".ply", ".obj", ".stl")
 
 #: A skull in millimetres spans roughly 100-300 mm; outside this the unit is probably wrong.
@@ -189,4 +191,5 @@ def write_mesh(path, vertices_mm, faces):
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    trimesh.Trimesh(vertices_mm, faces, process=False).export(path)
+    with naming_errors(path):
+        trimesh.Trimesh(vertices_mm, faces, process=False).export(path)

@@ -9,6 +9,7 @@ stays inside its parent on every common file system and reads as a relative link
 
 import os
 import re
+from contextlib import contextmanager
 from pathlib import Path
 
 #: Characters replaced by ``_``: path separators, characters Windows forbids, and ``%``/``#``
@@ -97,3 +98,18 @@ def check_no_links(folder):
                     f"{path} is a symbolic link inside the output folder, and Lilium writes "
                     "only inside it; remove the link or give another output folder"
                 )
+
+
+@contextmanager
+def naming_errors(path):
+    """Give an ``OSError`` raised inside without a file name the name ``path``.
+
+    A full disk or a file-size limit met inside a write (Python's, OpenCV's, trimesh's or
+    Pillow's: "File too large") names no file; the command's one-line error must.
+    """
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is not None:
+            raise
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from exc

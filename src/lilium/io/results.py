@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from .jsonio import read_json, write_json
+from .paths import naming_errors
 
 
 def write_png(path, rgb):
@@ -23,12 +24,11 @@ def write_png(path, rgb):
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp")
     try:
-        Image.fromarray(np.asarray(rgb, dtype=np.uint8)).save(tmp, format="PNG")
-        os.replace(tmp, path)
-    except OSError as exc:
+        with naming_errors(path):  # Pillow's write() errors name no file
+            Image.fromarray(np.asarray(rgb, dtype=np.uint8)).save(tmp, format="PNG")
+            os.replace(tmp, path)
+    except OSError:
         tmp.unlink(missing_ok=True)
-        if exc.filename is None:  # Pillow's write() errors name no file
-            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
         raise
 
 

@@ -34,7 +34,6 @@ import os
 import shutil
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from contextlib import contextmanager
 from multiprocessing import get_context
 from pathlib import Path
 
@@ -43,6 +42,7 @@ import numpy as np
 
 from ..io import jsonio
 from ..io.locks import RunLock
+from ..io.paths import naming_errors
 from ..softtissue.landmarks import CORRESPONDENCES
 from . import incomplete as _incomplete
 from . import noise as _noise
@@ -63,24 +63,6 @@ def photo_id(subject_id, view, k):
     return f"{subject_id}_{'f' if view == 'frontal' else 'l'}{k:02d}"
 
 
-@contextmanager
-def _naming(path):
-    """Give an ``OSError`` raised inside without a file name (a full disk or a file-size limit
-    met inside OpenCV, trimesh or Pillow: "File too large") the name ``path``."""
-    try:
-        yield
-    except OSError as exc:
-        if exc.filename is not None:
-            raise
-        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from exc
-
-
-def _write_json(path, data):
-    """:func:`lilium.io.jsonio.write_json`, an ``OSError`` naming ``path`` (:func:`_naming`)."""
-    with _naming(path):
-        jsonio.write_json(path, data)
-
-
 def write_png(path, image, bilevel=False):
     """Write an RGB ``(H, W, 3)`` or grey ``(H, W)`` uint8 image as PNG.
 
@@ -90,7 +72,7 @@ def write_png(path, image, bilevel=False):
     Raises
     ------
     OSError
-        Naming ``path`` (:func:`_naming`).
+        Naming ``path`` (:func:`~lilium.io.paths.naming_errors`).
     ValueError
         OpenCV could not write it (it says no more: a full disk, a file-size limit or no write
         permission).
@@ -101,7 +83,7 @@ def write_png(path, image, bilevel=False):
     params = [cv2.IMWRITE_PNG_COMPRESSION, PNG_COMPRESSION]
     if bilevel:
         params += [cv2.IMWRITE_PNG_BILEVEL, 1]
-    with _naming(path):
+    with naming_errors(path):
         written = cv2.imwrite(str(path), image, params)
     if not written:
         raise ValueError(
@@ -117,7 +99,7 @@ def _link_or_copy(src, dst):
     try:
         os.link(src, dst)
     except OSError:
-        with _naming(dst):
+        with naming_errors(dst):
             shutil.copyfile(src, dst)
 
 
@@ -156,9 +138,9 @@ def write_photo_folders(
             extra=extra,
             unmarked=unmarked,
         )
-        _write_json(folder / "photo.json", record)
+        jsonio.write_json(folder / "photo.json", record)
         if curve:
-            _write_json(folder / "face_curve.json", curve)
+            jsonio.write_json(folder / "face_curve.json", curve)
         else:  # one left by an older dataset in this folder would be read as this photo's
             (folder / "face_curve.json").unlink(missing_ok=True)
         paths[exp] = f"photos/{exp}/{pid}"
@@ -191,7 +173,7 @@ def _generate_subject(task):
         subject = factory(subject_id, subject_rng, mandible=False)
     on_skull = getattr(subject, "cranial_landmarks", None)
     subject_dir = out_dir / "subjects" / subject_id
-    with _naming(subject_dir):
+    with naming_errors(subject_dir):
         writer(subject_dir, subject)
 
     axes_files = []
@@ -202,7 +184,7 @@ def _generate_subject(task):
             name = f"axes_C{k}.json"
             if on_skull is not None:  # drawn for every axis, written for the skull's landmarks
                 axes_set = {c: v for c, v in axes_set.items() if c in on_skull}
-            _write_json(subject_dir / name, {"axes": axes_set})
+            jsonio.write_json(subject_dir / name, {"axes": axes_set})
             axes_files.append(name)
 
     head = _photos.prepare_head(subject)
@@ -381,5 +363,5 @@ def generate_dataset(
                 "subjects_without_mandible": sorted(no_mandible),
                 "drop_landmark_rate": drop_rate,
             }
-        _write_json(out_dir / "dataset.json", index)
+        jsonio.write_json(out_dir / "dataset.json", index)
         return index
