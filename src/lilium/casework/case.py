@@ -14,6 +14,7 @@ from .folders import (
     output_lock,
     resumed_sfo,
     sfo_fingerprint,
+    sfo_outputs,
 )
 from .identify import Calibrations, conclusion_line, identify
 from .inputs import check_runnable, load_photos, load_skull
@@ -225,10 +226,7 @@ class _CaseRun:
         calibrations, log = self.calibrations, self.log
         result, reused = resumed_sfo(folder, *sfo, fingerprint, calibrations, log, run_sfo)
         self.separate.setdefault(method, []).append((photo, result))
-        rel = folder.relative_to(self.out)
-        outputs = {"result.json": f"{rel.as_posix()}/result.json"}
-        if (folder / "overlay.png").is_file():
-            outputs["overlay.png"] = f"{rel.as_posix()}/overlay.png"
+        outputs = sfo_outputs(folder, self.out)
         name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
         how = " (stored)" if reused else ""
         self.log(

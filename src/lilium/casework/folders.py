@@ -386,6 +386,16 @@ def resumed_sfo(
     return result, False
 
 
+def sfo_outputs(folder, out):
+    """The report's links to one SFO's files in ``folder``: ``result.json`` and, when it was
+    written, ``overlay.png``, as POSIX paths relative to the output folder ``out``."""
+    rel = Path(folder).relative_to(out).as_posix()
+    outputs = {"result.json": f"{rel}/result.json"}
+    if (Path(folder) / "overlay.png").is_file():
+        outputs["overlay.png"] = f"{rel}/overlay.png"
+    return outputs
+
+
 @contextmanager
 def output_lock(out):
     """Hold the output folder ``out`` for one run (``lilium case`` or ``lilium lineup``).

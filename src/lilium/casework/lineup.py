@@ -32,6 +32,7 @@ from .folders import (
     repeated_photo,
     resumed_sfo,
     sfo_fingerprint,
+    sfo_outputs,
 )
 from .identify import Calibrations, conclusion_line, identify
 from .inputs import load_photos, load_skull
@@ -223,10 +224,7 @@ class _LineupRun:
             )
             sfo = (method, self.skull, photo, self.options, self.seed)
             result, _ = resumed_sfo(folder, *sfo, fingerprint, self.calibrations, self.log, run_sfo)
-            rel = folder.relative_to(self.out).as_posix()
-            outputs = {"result.json": f"{rel}/result.json"}
-            if (folder / "overlay.png").is_file():
-                outputs["overlay.png"] = f"{rel}/overlay.png"
+            outputs = sfo_outputs(folder, self.out)
             labelled = {**self.skull_inputs, **inputs}
             yield method, ReportEntry(self.skull, photo, result, labelled, notes, outputs)
 
