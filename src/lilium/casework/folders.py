@@ -360,8 +360,8 @@ def resumed_sfo(
     (:func:`stored_result`), else run and written (``result.json`` with ``fingerprint``,
     ``overlay.png``); either way identified with this run's ``calibrations``.
 
-    ``log`` gets one line when the stored result is reused, and one saying why when a stored
-    result is not (other inputs or options, an overlay missing or cut) and the SFO runs again.
+    ``log`` gets one line saying why when a stored result is not reused (other inputs or
+    options, an overlay missing or cut) and the SFO runs again; the caller says what it reused.
     ``run`` is the SFO runner (default :func:`~lilium.methods.registry.run_sfo`; the caller's
     own name of it, so a test can replace it there).
 
@@ -373,7 +373,6 @@ def resumed_sfo(
     tag = method_tag(method, options.variant)
     result, why = stored_result(folder, fingerprint)
     if result is not None:
-        log(f"{photo.id}: {tag}: reusing the stored result (same inputs and options) in {folder}")
         result = with_identification(result, skull, [photo], calibrations)
         write_json(Path(folder) / "result.json", result.to_dict())  # this run's calibration
         return result, True

@@ -223,7 +223,11 @@ class _LineupRun:
                 [inputs], self.digests,
             )
             sfo = (method, self.skull, photo, self.options, self.seed)
-            result, _ = resumed_sfo(folder, *sfo, fingerprint, self.calibrations, self.log, run_sfo)
+            result, reused = resumed_sfo(
+                folder, *sfo, fingerprint, self.calibrations, self.log, run_sfo
+            )
+            if reused:
+                self.log(f"{photo.id}: {method}: reusing the stored result in {folder}")
             outputs = sfo_outputs(folder, self.out)
             labelled = {**self.skull_inputs, **inputs}
             yield method, ReportEntry(self.skull, photo, result, labelled, notes, outputs)
