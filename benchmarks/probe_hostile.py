@@ -538,6 +538,7 @@ def all_probes():
     from probe_hostile_outputs import output_probes
     from probe_hostile_resume import resume_probes
     from probe_hostile_runs import run_probes
+    from probe_hostile_semantic import semantic_probes
 
     return (
         photo_json_probes()
@@ -551,6 +552,7 @@ def all_probes():
         + run_probes()
         + output_probes()
         + resume_probes()
+        + semantic_probes()
     )
 
 

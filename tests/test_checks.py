@@ -91,6 +91,26 @@ def test_photo_and_its_mirror_image(standin):
     check_photo_labels(replace(selfie, view="lateral_left"))
 
 
+def test_a_photo_with_some_pairs_swapped_or_upside_down(standin):
+    skull, photo = standin
+    lm = dict(photo.landmarks_uv)
+    # One slip: zygion's _l and _r exchanged (the others right): a camera 68 px off and a
+    # confident exclusion of the true person, before this check.
+    slip = {**lm, "zygion_l": lm["zygion_r"], "zygion_r": lm["zygion_l"]}
+    with pytest.raises(ValueError, match=r"zygion_l lie left of their _r twins.*swap _l and _r"):
+        check_inputs(skull, replace(photo, landmarks_uv=slip))
+    # Turned 180 degrees with its landmarks: every pair reversed, and the forehead below the
+    # chin: upside down, not mirrored.
+    w, h = photo.image_size_wh
+    turned = {k: np.array([w - 1 - uv[0], h - 1 - uv[1]]) for k, uv in lm.items()}
+    with pytest.raises(ValueError, match="upside down"):
+        check_inputs(skull, replace(photo, landmarks_uv=turned))
+    flipped = {k: np.array([uv[0], h - 1 - uv[1]]) for k, uv in lm.items()}  # top to bottom
+    for view in ("frontal", "lateral_left"):
+        with pytest.raises(ValueError, match="upside down or flipped top to bottom"):
+            check_photo_labels(replace(photo, landmarks_uv=flipped, view=view))
+
+
 def test_skull_faces_camera_rule(standin):
     skull, photo = standin
     truth = read_ground_truth_camera(photo)

@@ -1,5 +1,7 @@
 """The focal prior from EXIF: FocalLength with the sensor size, or FocalLengthIn35mmFilm."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -116,3 +118,20 @@ def test_a_focal_length_that_cannot_be_converted_says_so(tmp_path):
     plain = tmp_path / "plain.png"
     Image.new("RGB", (50, 40)).save(plain)
     assert exif_focal(plain) == (None, None)
+
+
+def test_a_prior_that_contradicts_the_photos_exif_is_named(tmp_path):
+    from lilium.casework.inputs import with_priors
+    from lilium.inputs import Photo, Priors
+
+    path = _jpeg(tmp_path / "a.jpg", size_wh=(400, 300), model="Phone X", focal_mm=4.2, f35=26)
+    exif_px = focal_prior_from_exif(path).focal_px  # about 289-379 px
+    photo = Photo("a", (400, 300), "frontal", {}, priors=Priors(focal_px=(600.0, 700.0)))
+    checked, _ = with_priors(photo, path)
+    (warning,) = [w for w in checked.warnings if w.code == "prior_conflict"]
+    assert "a.jpg" in warning.message and "600-700 px (photo.json)" in warning.message
+    assert checked.priors.focal_px == (600.0, 700.0)  # photo.json still wins
+    overlapping = replace(photo, priors=Priors(focal_px=(exif_px[1] - 10, 700.0)))
+    assert not [w for w in with_priors(overlapping, path)[0].warnings if w.code == "prior_conflict"]
+    ignored, _ = with_priors(photo, path, use_exif=False)  # --no-exif: EXIF is not read at all
+    assert not ignored.warnings

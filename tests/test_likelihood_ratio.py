@@ -195,6 +195,11 @@ def test_conclusion_scale_caps_and_consistency():
     assert conclude(-2.5, four).label == "strong support for exclusion"  # exclusion uncapped
     inconsistent = conclude(2.5, {}, {"view_mismatch": "the camera looks at the side"})
     assert inconsistent.label == "undetermined"
+    # A camera that contradicts the view reads no LR either way; a skull outside the head
+    # stops support only.
+    assert conclude(-2.5, {}, {"view_mismatch": "sideways"}).label == "undetermined"
+    outside = {"skull_outside_head": "40 % of the skull's pixels lie outside the head mask"}
+    assert conclude(-2.5, {}, outside).label == "strong support for exclusion"
     assert conclude(None).label == conclude(float("nan")).label == "undetermined"
 
 

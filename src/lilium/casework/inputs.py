@@ -347,7 +347,9 @@ def with_priors(photo, image, focal_px=None, scd_mm=None, use_exif=True, sensor_
     -------
     photo : Photo
         With ``priors``, ``prior_sources`` (values among :data:`lilium.inputs.PRIOR_SOURCES`)
-        and, when the EXIF focal length cannot be converted, warning ``exif_focal_unusable``.
+        and, when the EXIF focal length cannot be converted, warning ``exif_focal_unusable``;
+        when a focal prior given on the command line or in ``photo.json`` does not overlap the
+        photo's own EXIF focal length, warning ``prior_conflict`` (one of them is wrong).
     notes : dict of str -> str
         The same as text for the report (``"focal prior": "1900-2100 px (photo.json)"``).
     """
@@ -366,6 +368,8 @@ def with_priors(photo, image, focal_px=None, scd_mm=None, use_exif=True, sensor_
             details["focal_px"] = exif.source
         elif unusable:
             warnings.append(CaseWarning("exif_focal_unusable", unusable))
+    if sources.get("focal_px") in ("command line", "photo.json") and use_exif and image:
+        warnings += _exif_conflict(image, priors.focal_px, sources["focal_px"], sensor_width_mm)
     if scd_mm is not None:
         priors, sources["scd_mm"] = replace(priors, scd_mm=scd_mm), "command line"
         details["scd_mm"] = "command line --scd-mm"
@@ -383,6 +387,25 @@ def with_priors(photo, image, focal_px=None, scd_mm=None, use_exif=True, sensor_
             notes[label] = f"{fmt_range(*value, unit)} ({where})"
     photo = replace(photo, priors=priors, prior_sources=sources, warnings=tuple(warnings))
     return photo, notes
+
+
+def _exif_conflict(image, focal_px, source, sensor_width_mm):
+    """``[CaseWarning("prior_conflict", ...)]`` when the photo's EXIF focal interval does not
+    overlap the focal prior it was overruled by, else ``[]`` (no usable EXIF: nothing to say)."""
+    from ..io.exif import exif_focal
+
+    exif, _ = exif_focal(image, sensor_width_mm=sensor_width_mm)
+    if exif is None or (exif.focal_px[0] <= focal_px[1] and focal_px[0] <= exif.focal_px[1]):
+        return []
+    return [
+        CaseWarning(
+            "prior_conflict",
+            f"{image}: its EXIF focal length ({fmt_range(*exif.focal_px, 'px')}, {exif.source}) "
+            f"lies outside the focal prior {fmt_range(*focal_px, 'px')} ({source}) that "
+            "overrules it: one of them is wrong (another photo's prior, a cropped or resized "
+            "image); check both",
+        )
+    ]
 
 
 def _json_keys(path):

@@ -25,7 +25,10 @@ evidence against the same person whatever the material.
 
 **Consistency.** A consistency failure (skull pixels outside the head mask: an implausible
 SFO; the camera disagreeing with the declared view) is never support: the conclusion is at
-most "undetermined" and says why. A failed SFO (no camera) is "undetermined".
+most "undetermined" and says why. A camera that disagrees with the declared view is no
+exclusion either (an upside-down or mislabelled photo gave a camera 120 degrees off and
+"moderate support for exclusion"): the conclusion is "undetermined". A failed SFO (no camera)
+is "undetermined".
 """
 
 from dataclasses import dataclass
@@ -45,6 +48,11 @@ SCALE = (
 
 #: Index of "undetermined" in :data:`SCALE`.
 UNDETERMINED = 3
+
+#: Consistency failures that leave no camera to read any LR from: the conclusion is
+#: undetermined in both directions (the others only stop support: a skull that leaves the
+#: head is itself evidence against the person).
+CAMERA_FAILURES = ("view_mismatch",)
 
 #: Fewest landmark pairs that do not cap the support.
 MIN_PAIRS_UNCAPPED = 8
@@ -108,7 +116,8 @@ class Conclusion:
     caps : dict of str -> str
         The material caps that apply (whether or not they lowered this LR's level).
     inconsistent : dict of str -> str
-        Consistency failures that keep the conclusion from support.
+        Consistency failures that keep the conclusion from support (and, for
+        :data:`CAMERA_FAILURES`, from exclusion).
     """
 
     label: str
@@ -127,7 +136,8 @@ def conclude(log10_lr, caps=None, inconsistent=None):
     caps : dict of str -> str, optional
         :func:`material_caps`.
     inconsistent : dict of str -> str, optional
-        ``{warning code: sentence}`` of consistency failures.
+        ``{warning code: sentence}`` of consistency failures: none is support; one of
+        :data:`CAMERA_FAILURES` is no exclusion either.
 
     Returns
     -------
@@ -142,4 +152,6 @@ def conclude(log10_lr, caps=None, inconsistent=None):
     if inconsistent:
         top = UNDETERMINED
     capped = min(raw, max(top, UNDETERMINED))
+    if any(code in inconsistent for code in CAMERA_FAILURES):
+        capped = UNDETERMINED
     return Conclusion(SCALE[capped][0], SCALE[raw][0], caps, inconsistent)
