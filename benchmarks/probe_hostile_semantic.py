@@ -610,13 +610,13 @@ def semantic_probes():
     syn = lambda *setups: _then(_syn, *setups)  # noqa: E731
     return [
         # photos and their landmark files, masks and curves
-        Probe("semantic sfo landmark file of the half-size photo, priors kept", _sfo(S, P), "warn", ("outside_prior",), _then(_half_photo, _landmarks_of(P, _half))),  # noqa: E501
-        Probe("semantic sfo landmark file of the half-size photo, no priors", _sfo(S, P), "ok", (), _then(_half_photo, _landmarks_of(P, _half), _no_priors(P)), check=_right_camera(_base)),  # noqa: E501
-        Probe("semantic case landmark files swapped between a photo and its half-size copy", _case(S, [P, _half]), "error", ("half", "photo.json"), _then(_half_photo, _swap_files(P, _half))),  # noqa: E501
-        Probe("semantic sfo image and mask downscaled to 0.8, landmarks not", _sfo(S, P), "ok", (), _rescale_image(P, 0.8), check=_warned("mask")),  # noqa: E501
+        Probe("semantic sfo landmark file of the half-size photo, priors kept", _sfo(S, P), "error", ("photo.json", "of another photo"), _then(_half_photo, _landmarks_of(P, _half))),  # noqa: E501
+        Probe("semantic sfo landmark file of the half-size photo, no priors", _sfo(S, P), "error", ("photo.json", "of another photo"), _then(_half_photo, _landmarks_of(P, _half), _no_priors(P))),  # noqa: E501
+        Probe("semantic case landmark files swapped between a photo and its half-size copy", _case(S, [P, _half]), "error", ("photo.json", "of another photo"), _then(_half_photo, _swap_files(P, _half))),  # noqa: E501
+        Probe("semantic sfo image and mask downscaled to 0.8, landmarks not", _sfo(S, P), "error", ("mask", "rescaled"), _rescale_image(P, 0.8)),  # noqa: E501
         Probe("semantic sfo inverted face mask", _sfo(S, P), "ok", (), _invert_mask(P), check=_warned("mask")),  # noqa: E501
         Probe("semantic sfo lilium inverted face mask", _sfo(S, P, "--generations", "30", method="lilium"), "ok", (), _invert_mask(P), check=_warned("mask")),  # noqa: E501
-        Probe("semantic sfo lilium mask of another photo (head 400 px aside)", _sfo(S, P, "--generations", "30", method="lilium"), "ok", (), _shift_mask(P, 400), check=_warned("mask")),  # noqa: E501
+        Probe("semantic sfo lilium mask of another photo (head 400 px aside)", _sfo(S, P, "--generations", "30", method="lilium"), "error", ("mask", "of another photo"), _shift_mask(P, 400)),  # noqa: E501
         Probe("semantic case csv landmark twice at two places", _case(S, [_plain]), "error", ("front.csv", "zygion_l"), _csv_photo("zygion_l")),  # noqa: E501
         Probe("semantic case csv photo (control)", _case(S, [_plain]), "ok", (), _csv_photo(), check=_right_camera(_base)),  # noqa: E501
         # views
@@ -645,7 +645,7 @@ def semantic_probes():
         Probe("semantic sfo EXIF focal twice photo.json's focal prior", _sfo(S, P), "ok", (), _exif_jpg(156), check=_warned("EXIF")),  # noqa: E501
         Probe("semantic sfo EXIF focal alone (control)", _sfo(S, P), "ok", (), _exif_jpg(78, keep_prior=False), check=_right_camera(_base)),  # noqa: E501
         Probe("semantic sfo --depth-table nasion 80 mm", depth(), "ok", (), _depth_csv(80, ("nasion",)), check=_right_camera(_base)),  # noqa: E501
-        Probe("semantic sfo --depth-table 80 mm at every landmark", depth(), "ok", (), _depth_csv(80), check=_warned("d.csv")),  # noqa: E501
+        Probe("semantic sfo --depth-table 80 mm at every landmark", depth(), "error", ("d.csv",), _depth_csv(80)),  # noqa: E501
     ]
 
 

@@ -3,7 +3,6 @@
 from dataclasses import replace
 from pathlib import Path
 
-from ..io.case import read_depth_table
 from ..io.paths import safe_id
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
@@ -15,6 +14,7 @@ from .folders import (
     resumed_sfo,
     sfo_fingerprint,
     sfo_outputs,
+    with_depth_table,
 )
 from .identify import Calibrations, conclusion_line, identify
 from .inputs import check_runnable, load_photos, load_skull
@@ -150,7 +150,8 @@ def run_case(
             photos, log=log, skull=skull, auto_landmarks=auto_landmarks, out=out, **photo_options
         )
         if depth_table:
-            options = replace(options, depth_table=read_depth_table(depth_table))
+            options, photos_in = with_depth_table(options, depth_table, [r.photo for r in records])
+            records = [r._replace(photo=p) for r, p in zip(records, photos_in, strict=True)]
         calibrations = Calibrations(calibration)
         _check_records(skull, skull_inputs, records, methods, options.variant, log)
         joints = {}  # method -> (JointSfoResult, folder), for the joint methods

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..inputs import CaseWarning
 from ..io.case import IMAGE_NAMES, read_depth_table, read_photo, read_skull
 from ..io.jsonio import write_json
 from ..io.locks import RunLock
@@ -30,8 +31,28 @@ from ..methods.registry import (
     run_joint_sfo,
     run_sfo,
 )
+from ..softtissue.depths import depth_table_warning
 from .identify import Calibrations, with_identification
 from .inputs import first_file, load_photos, load_skull
+
+
+def with_depth_table(options, path, photos):
+    """``options`` with the depth table read from ``path``, and ``photos`` with its warning
+    ``implausible_depth`` when some of its mean depths are implausible
+    (:func:`~lilium.softtissue.depths.depth_table_warning`): the table's warning goes into the
+    result of every SFO that uses it (a photo's warnings are its results').
+
+    Returns
+    -------
+    options : SfoOptions
+    photos : list of Photo
+    """
+    table = read_depth_table(path)
+    message = depth_table_warning(table, str(path))
+    if message:
+        warning = CaseWarning("implausible_depth", message)
+        photos = [replace(p, warnings=(*p.warnings, warning)) for p in photos]
+    return replace(options, depth_table=table), list(photos)
 
 
 def labelled_skull(skull, inputs):
@@ -98,7 +119,7 @@ def sfo_on_folders(
     photo = record.photo
     check_inputs(skull, photo)
     if depth_table is not None:
-        options = replace(options, depth_table=read_depth_table(depth_table))
+        options, (photo,) = with_depth_table(options, depth_table, [photo])
     calibrations = Calibrations(calibration)
     result = run_sfo(method, skull, photo, options, seed)
     result = with_identification(result, skull, [photo], calibrations)
@@ -235,7 +256,7 @@ def joint_sfo_on_folders(
     for photo in photos:
         check_inputs(skull, photo)
     if depth_table is not None:
-        options = replace(options, depth_table=read_depth_table(depth_table))
+        options, photos = with_depth_table(options, depth_table, photos)
     calibrations = Calibrations(calibration)
     result = run_joint_sfo(method, skull, photos, options, seed)
     result = with_identification(result, skull, photos, calibrations)

@@ -31,6 +31,7 @@ from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
 from ..io.paths import safe_id
 from ..io.prepared import read_prepared
+from ..methods.photo_checks import check_landmarks_in_mask
 from ..validation import check_prior, fmt_range
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 
@@ -277,7 +278,10 @@ def load_photos(
         photo = replace(
             photo, landmarks_file=str(inputs.get("facial landmarks") or inputs["photo.json"])
         )
-        photo = replace(photo, id=unique_id(photo.id, _taken(records)))
+        off_mask = check_landmarks_in_mask(photo)  # an error, or warnings the result keeps
+        photo = replace(
+            photo, id=unique_id(photo.id, _taken(records)), warnings=(*photo.warnings, *off_mask)
+        )
         records.append(PhotoRecord(photo, inputs, notes, origin))
     return records
 

@@ -4,7 +4,9 @@
 lateral one (pixels, ``u`` = column, ``v`` = row). P_pll compares the skull's chin-jaw or
 forehead contour with it; without it, the curve is derived from the face mask (SPEC section 5).
 A file that holds no curve for the photo's view is an error, not silently ignored: the SFO
-would otherwise run on the mask's curve while the user believes it ran on theirs.
+would otherwise run on the mask's curve while the user believes it ran on theirs. A file that
+holds the other view's curve (``forehead`` for a photo declared frontal) names the view to
+check: the photo's declared view is the likelier mistake.
 """
 
 from pathlib import Path
@@ -54,6 +56,7 @@ def read_face_curve(path, view, image_size_wh=None):
             f"{type(data).__name__}; fix the file or remove it (the mask gives the curve then)"
         )
     if key not in data:
+        _check_other_view(path, data, view)
         other = ", ".join(repr(k) for k in data) or "nothing"
         raise ValueError(
             f"{path}: no {key!r} curve for this {view} photo (the file holds {other}); give "
@@ -84,6 +87,21 @@ def read_face_curve(path, view, image_size_wh=None):
             )
         curve = _pixel_curve(path, key, curve, image_size_wh)
     return curve
+
+
+def _check_other_view(path, data, view):
+    """Raise when the file holds the curve of the other view: the photo's view is wrong."""
+    key = CURVE_KEYS[view]
+    other = next((k for k in set(CURVE_KEYS.values()) - {key} if k in data), None)
+    if other is None:
+        return
+    kind = "frontal" if other == "chin_jaw" else "lateral"
+    raise ValueError(
+        f"{path}: no {key!r} curve for this {view} photo: the file holds {other!r}, the curve "
+        f'of a {kind} photo; check the photo\'s view ("view" in photo.json, or --view), or, '
+        f'if the photo is {view}, give {{"{key}": [[u, v], ...]}} in pixels instead or remove '
+        "the file (the mask gives the curve then)"
+    )
 
 
 def _pixel_curve(path, key, curve, image_size_wh):

@@ -20,10 +20,12 @@ Rules (each one skipped, never guessed, when the landmarks it needs are absent):
 - **left and right of the skull** (:func:`check_skull_labels`): ``dot(right x anterior,
   superior) > 0`` (the right-handed RAS frame); mirrored labels or a mirrored mesh make it
   negative: an error naming the landmark file;
-- **left and right of a frontal photo** (:func:`check_photo_labels`): facing the camera, the
-  subject's left is on the image's right, so each ``_l`` landmark has the larger ``u``; when
-  every pair is reversed the photo or its labels are mirrored: an error naming the file.
-  Lateral photos show one side only and are not checked;
+- **left, right, up and down of a photo**
+  (:func:`~lilium.methods.photo_checks.check_photo_labels`): facing the camera, the subject's
+  left is on the image's right, so each ``_l`` landmark of a frontal photo has the larger
+  ``u``; every pair reversed is a mirrored photo (or labels), some pairs reversed are swapped
+  labels; the forehead's midline landmarks below the chin's is an upside-down photo (any
+  view): an error naming the file;
 - **declared view** (:func:`view_warning`): after the SFO, frontal = at most
   :data:`~lilium.constants.VIEW_SPLIT_DEG` from the anterior direction, lateral = at least
   that, on the declared side (``lateral_left``: the face points to the image's left, so the
@@ -48,6 +50,7 @@ from ..fitness.camera_penalty import head_deviation_deg
 from ..inputs import CaseWarning
 from ..softtissue.landmarks import side, twin
 from ..validation import fmt_number, fmt_range
+from .photo_checks import check_landmarks_in_mask, check_photo_labels
 
 #: Anterior landmarks the anterior direction aims at when nasion is missing, in order.
 ANTERIOR_TARGETS = ("glabella", "subspinale", "prosthion", "metopion", "pogonion", "gnathion")
@@ -265,96 +268,10 @@ def check_skull_labels(skull):
     )
 
 
-def photo_pair_order(landmarks_uv):
-    """Bilateral pairs of a photo's landmarks and how many are reversed for a frontal view.
-
-    Returns
-    -------
-    pairs : list of str
-        Base names of the pairs present (``"exocanthion"``, ...).
-    reversed_pairs : list of str
-        Those whose ``_l`` landmark lies at a smaller ``u`` than its ``_r`` twin.
-    """
-    pairs, reversed_pairs = [], []
-    for name, uv in landmarks_uv.items():
-        if side(name) == "l" and twin(name) in landmarks_uv:
-            base = name[:-2]
-            pairs.append(base)
-            if float(uv[0]) < float(landmarks_uv[twin(name)][0]):
-                reversed_pairs.append(base)
-    return pairs, reversed_pairs
-
-
-#: A photo's facial landmarks above the eyes and below the nose (its midline): every upper one
-#: lies above every lower one in an upright photo, whatever the view.
-PHOTO_UPPER_MIDLINE = ("nasion", "glabella", "metopion", "bregma")
-PHOTO_LOWER_MIDLINE = ("subnasale", "labiale_superius", "pogonion", "gnathion")
-
-#: A frontal photo's pair is reversed when its ``_l`` twin lies left of its ``_r`` twin by more
-#: than this share of the landmarks' extent (on 322 generated frontal photos, Exp. A-C, every
-#: pair lay the right way round by at least 0.13 of the extent).
-PAIR_REVERSED_FRACTION = 0.02
-
-
-def _upside_down(landmarks_uv):
-    """Whether every upper midline landmark lies below (larger ``v``) every lower one."""
-    upper = [float(landmarks_uv[n][1]) for n in PHOTO_UPPER_MIDLINE if n in landmarks_uv]
-    lower = [float(landmarks_uv[n][1]) for n in PHOTO_LOWER_MIDLINE if n in landmarks_uv]
-    return bool(upper and lower) and min(upper) > max(lower)
-
-
-def check_photo_labels(photo):
-    """Raise when a photo's landmarks cannot be the right way up and round: the forehead's
-    midline landmarks below the chin's (an upside-down photo, any view); in a frontal photo,
-    every left/right pair reversed (a mirrored photo, or all labels swapped), or some pairs
-    clearly reversed while the others are not (those pairs' labels swapped).
-
-    A swapped pair is not noise a fit absorbs: it pulls the camera tens of pixels off, and the
-    identification would read a labelling slip as a different person.
-
-    Raises
-    ------
-    ValueError
-        Naming ``photo.landmarks_file`` and what to turn, flip or swap.
-    """
-    where = photo.landmarks_file or f"photo {photo.id!r}: facial landmarks"
-    lm = photo.landmarks_uv
-    if _upside_down(lm):
-        upper = ", ".join(n for n in PHOTO_UPPER_MIDLINE if n in lm)
-        lower = ", ".join(n for n in PHOTO_LOWER_MIDLINE if n in lm)
-        raise ValueError(
-            f"{where}: {upper} lie below {lower}: the photo is upside down or flipped top to "
-            "bottom (turn the image and its landmarks upright), or those labels are mixed up"
-        )
-    if photo.view != "frontal":
-        return
-    pairs, reversed_pairs = photo_pair_order(lm)
-    if not pairs:
-        return
-    if len(reversed_pairs) == len(pairs):
-        raise ValueError(
-            f"{where}: in this frontal photo every _l landmark lies left of its _r twin "
-            f"({', '.join(pairs)}), but facing the camera the subject's left is on the image's "
-            "right: the photo is mirrored (a selfie or a flipped scan: flip the image and its "
-            "landmarks horizontally) or _l and _r are swapped in the labels (swap them)"
-        )
-    extent = float(np.ptp(np.asarray(list(lm.values()), float), axis=0).max())
-    swapped = [
-        b for b in reversed_pairs
-        if lm[f"{b}_r"][0] - lm[f"{b}_l"][0] > PAIR_REVERSED_FRACTION * extent
-    ]
-    if swapped:
-        right = [b for b in pairs if b not in reversed_pairs]
-        raise ValueError(
-            f"{where}: in this frontal photo {', '.join(b + '_l' for b in swapped)} lie left of "
-            f"their _r twins while {', '.join(right)} lie the right way round (the subject's "
-            "left on the image's right): swap _l and _r of "
-            f"{', '.join(swapped)}, or give the photo's view if it is not frontal"
-        )
-
-
 def check_inputs(skull, photo):
-    """The checks before any SFO: left and right of the skull and of the photo.
+    """The checks before any SFO: left and right of the skull and of the photo, and the
+    photo's landmarks against its mask (the warnings of that check are the photo's own,
+    :func:`~lilium.casework.inputs.load_photos`).
 
     Raises
     ------
@@ -363,6 +280,7 @@ def check_inputs(skull, photo):
     """
     check_skull_labels(skull)
     check_photo_labels(photo)
+    check_landmarks_in_mask(photo)
 
 
 def view_warning(skull, photo, camera):

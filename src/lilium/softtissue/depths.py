@@ -3,6 +3,14 @@
 The built-in table holds approximate adult values on the scale of published meta-analyses; a
 user's own table (CSV with columns ``landmark,mean,sd,min,max``, see
 :func:`lilium.io.read_depth_table`) replaces it.
+
+A user's mean depth above :data:`IMPLAUSIBLE_DEPTH_FACTOR` times the built-in mean of its
+landmark (:data:`IMPLAUSIBLE_DEPTH_MM` where the built-in table has none) is implausible: still
+inside the 0-100 mm range, but it moves the facial landmarks so far off the skull that the SFO
+fits a camera of about twice the true focal length and the identification excludes the true
+person. A few such landmarks make a warning, worded by :func:`depth_table_warning` for the
+caller to attach; most of a table's landmarks (at least :data:`NOT_DEPTHS_MIN_LANDMARKS`) make
+it an error in :func:`check_depth_table`: the file then holds no soft-tissue depths in mm.
 """
 
 from dataclasses import dataclass
@@ -43,6 +51,92 @@ BUILTIN_DEPTHS = {
 }
 
 
+#: A mean depth above this many times the built-in mean of its landmark is implausible.
+IMPLAUSIBLE_DEPTH_FACTOR = 3.0
+
+#: A mean depth above this (mm) is implausible for a landmark the built-in table lacks.
+IMPLAUSIBLE_DEPTH_MM = 40.0
+
+#: A table whose implausible landmarks are more than half of it and at least this many holds no
+#: soft-tissue depths at all (another unit, another measure, shifted columns): an error.
+NOT_DEPTHS_MIN_LANDMARKS = 3
+
+
+def implausible_depths(table):
+    """The landmarks of a depth table whose mean depth is implausible.
+
+    Parameters
+    ----------
+    table : dict of str -> DepthStats
+        Keyed by cranial base name (:func:`check_depth_table`'s result).
+
+    Returns
+    -------
+    dict of str -> (float, float)
+        ``name -> (mean_mm, limit_mm)`` for each mean above its limit:
+        :data:`IMPLAUSIBLE_DEPTH_FACTOR` times the built-in mean, or :data:`IMPLAUSIBLE_DEPTH_MM`.
+    """
+    out = {}
+    for name, stats in table.items():
+        builtin = BUILTIN_DEPTHS.get(base_name(name))
+        limit = IMPLAUSIBLE_DEPTH_MM
+        if builtin is not None:
+            limit = IMPLAUSIBLE_DEPTH_FACTOR * builtin.mean_mm
+        if stats.mean_mm > limit:
+            out[name] = (float(stats.mean_mm), float(limit))
+    return out
+
+
+def _implausible_text(found, limit=6):
+    """``nasion 80 > 19.5 mm, ...`` for :func:`implausible_depths`' result."""
+    items = [
+        f"{name} {fmt_number(mean)} > {fmt_number(most)} mm" for name, (mean, most) in found.items()
+    ]
+    more = f" and {len(items) - limit} more" if len(items) > limit else ""
+    return ", ".join(items[:limit]) + more
+
+
+def depth_table_warning(table, source="depth table"):
+    """The message of warning ``implausible_depth`` for a table with implausible depths.
+
+    Parameters
+    ----------
+    table : dict of str -> DepthStats
+        Keyed by cranial base name (:func:`check_depth_table`'s result).
+    source : str
+        The file, named in the message.
+
+    Returns
+    -------
+    str or None
+        What is implausible and what to check (the caller makes it a warning with code
+        ``implausible_depth``: this layer knows no warning type); None when every mean depth
+        is plausible.
+    """
+    found = implausible_depths(table)
+    if not found:
+        return None
+    return (
+        f"{source}: implausible soft-tissue depths, above {IMPLAUSIBLE_DEPTH_FACTOR:g} times the "
+        f"built-in mean: {_implausible_text(found)}; a landmark that deep moves the face off "
+        "the skull and the camera with it: check these values (millimetres, measured from the "
+        "bone to the skin surface)"
+    )
+
+
+def _check_depths_plausible(table, source):
+    """Raise when most of the table's mean depths are implausible (module docstring)."""
+    found = implausible_depths(table)
+    if len(found) < NOT_DEPTHS_MIN_LANDMARKS or 2 * len(found) <= len(table):
+        return
+    raise ValueError(
+        f"{source}: {len(found)} of {len(table)} landmarks have a mean depth above "
+        f"{IMPLAUSIBLE_DEPTH_FACTOR:g} times their built-in mean ({_implausible_text(found)}): "
+        "these are not facial soft-tissue depths in millimetres (another unit or another "
+        "measure?); check the file, or leave out --depth-table to use the built-in table"
+    )
+
+
 def check_depth_table(table, source="depth table"):
     """Validate a ``{name: DepthStats}`` table and return it keyed by cranial base name.
 
@@ -54,7 +148,10 @@ def check_depth_table(table, source="depth table"):
     ValueError
         Unknown landmark, non-finite value, ``not 0 <= min <= mean <= max``, a depth beyond
         :data:`~lilium.constants.MAX_DEPTH_MM` or an SD outside
-        ``[0, MAX_DEPTH_SD_MM]``.
+        ``[0, MAX_DEPTH_SD_MM]``; or most landmarks with an implausible mean depth (at
+        least :data:`NOT_DEPTHS_MIN_LANDMARKS` and more than half of them above their limit,
+        :func:`implausible_depths`): the file holds no soft-tissue depths. Fewer implausible
+        means pass here; :func:`depth_table_warning` words their warning.
     """
     facial_base = {base_name(f): base_name(c) for c, f in CRANIAL_TO_FACIAL.items()}
     out = {}
@@ -82,6 +179,7 @@ def check_depth_table(table, source="depth table"):
                 f"min={stats.min_mm}, mean={stats.mean_mm}, max={stats.max_mm}"
             )
         out[name] = stats
+    _check_depths_plausible(out, source)
     return out
 
 

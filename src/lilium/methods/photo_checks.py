@@ -1,0 +1,232 @@
+"""Checks of a photo's files against each other, before any SFO (SPEC section 10).
+
+- **left, right, up and down** (:func:`check_photo_labels`): an upside-down photo (any view),
+  and in a frontal photo every left/right pair reversed (mirrored) or some pairs reversed while
+  the others are not (their labels swapped).
+- **landmarks on the face mask** (:func:`check_landmarks_in_mask`): every facial landmark lies
+  on the face, so on (or next to) the face mask. Each landmark's distance to the mask (0 inside)
+  is divided by the mask's bounding-box diagonal; on clean photos (the stand-in and generated
+  experiments A, B and C, noisy landmarks included) this ratio is at most about 0.02, while an
+  inverted mask, the mask of another photo or an image rescaled without its landmarks puts
+  several landmarks beyond 0.1. A landmark beyond :data:`MASK_OFF_FRACTION` is *off the mask*;
+  more than half of them off is an error, some of them a warning ``landmark_outside_mask``.
+"""
+
+import numpy as np
+
+from ..inputs import CaseWarning
+from ..softtissue.landmarks import side, twin
+
+#: A landmark farther than this fraction of the mask's bounding-box diagonal outside the mask
+#: is off it (clean photos: at most about 0.02; broken pairs: 0.1 to 0.6).
+MASK_OFF_FRACTION = 0.05
+
+#: What makes a photo's landmarks and mask disagree, and what to check.
+MASK_FIX = (
+    "the mask may be inverted, of another photo, or the image rescaled without its landmarks; "
+    "check that the face is the mask's non-zero pixels and that the image, mask and landmarks "
+    "are of the same photo at the same size"
+)
+
+
+def landmark_mask_distances_px(landmarks_uv, mask):
+    """Distance of each landmark to the nearest mask pixel (0 on the mask).
+
+    Parameters
+    ----------
+    landmarks_uv : ndarray of shape (N, 2)
+        ``(u = column, v = row)`` pixels; rounded to the nearest pixel, clipped to the image.
+    mask : ndarray of shape (H, W), bool
+        The face mask, not empty.
+
+    Returns
+    -------
+    ndarray of shape (N,)
+        Pixels.
+    """
+    h, w = mask.shape
+    cols = np.clip(np.rint(landmarks_uv[:, 0]), 0, w - 1).astype(int)
+    rows = np.clip(np.rint(landmarks_uv[:, 1]), 0, h - 1).astype(int)
+    out = np.zeros(len(rows))
+    outside = ~mask[rows, cols]
+    if not outside.any():
+        return out  # the clean case: no distance transform
+    from scipy.ndimage import distance_transform_edt  # off the `lilium sfo` start-up path
+
+    # The crop holding the whole mask and every landmark gives the same distances, cheaper.
+    mr, mc = np.nonzero(mask)
+    r0, r1 = min(mr.min(), rows.min()), max(mr.max(), rows.max()) + 1
+    c0, c1 = min(mc.min(), cols.min()), max(mc.max(), cols.max()) + 1
+    dist = distance_transform_edt(~mask[r0:r1, c0:c1])
+    out[outside] = dist[rows[outside] - r0, cols[outside] - c0]
+    return out
+
+
+def mask_diagonal_px(mask):
+    """Diagonal of the mask's bounding box, pixels (``mask`` (H, W) bool, not empty)."""
+    rows = np.flatnonzero(mask.any(axis=1))
+    cols = np.flatnonzero(mask.any(axis=0))
+    return float(np.hypot(rows[-1] - rows[0] + 1, cols[-1] - cols[0] + 1))
+
+
+def landmark_mask_ratios(photo):
+    """Each landmark's distance to the face mask over the mask's bounding-box diagonal.
+
+    Parameters
+    ----------
+    photo : Photo
+
+    Returns
+    -------
+    dict of str -> float
+        By landmark name, 0 on the mask; empty without a mask (or an empty one).
+    """
+    mask = photo.face_mask
+    if mask is None or not photo.landmarks_uv:
+        return {}
+    mask = np.asarray(mask, bool)
+    if not mask.any():
+        return {}
+    names = list(photo.landmarks_uv)
+    uv = np.array([np.asarray(photo.landmarks_uv[n], float) for n in names])
+    ratios = landmark_mask_distances_px(uv, mask) / mask_diagonal_px(mask)
+    return dict(zip(names, ratios.tolist(), strict=True))
+
+
+def check_landmarks_in_mask(photo):
+    """The facial landmarks against the face mask: an error, a warning or nothing.
+
+    Parameters
+    ----------
+    photo : Photo
+        Its ``landmarks_uv`` (pixels) and ``face_mask`` ((H, W) bool or None: nothing checked).
+
+    Returns
+    -------
+    list of CaseWarning
+        One ``landmark_outside_mask`` naming the landmarks off the mask when some, but at most
+        half, are farther than :data:`MASK_OFF_FRACTION` of the mask's bounding-box diagonal
+        outside it; else empty.
+
+    Raises
+    ------
+    ValueError
+        More than half of the landmarks off the mask, naming the landmark file (or the photo),
+        their number and the fix (:data:`MASK_FIX`).
+    """
+    ratios = landmark_mask_ratios(photo)
+    off = sorted((n for n, r in ratios.items() if r > MASK_OFF_FRACTION), key=ratios.get)[::-1]
+    if not off:
+        return []
+    where, mask = _where(photo)
+    worst = f"up to {ratios[off[0]]:.2f} of the mask's bounding-box diagonal"
+    counted = f"{len(off)} of {len(ratios)} facial landmarks lie outside {mask}"
+    if 2 * len(off) > len(ratios):
+        raise ValueError(f"{where}: {counted} ({worst}; {_names(off)}): {MASK_FIX}")
+    return [
+        CaseWarning(
+            "landmark_outside_mask",
+            f"{where}: {counted} ({worst}): {_names(off)}; check these landmarks and the mask: "
+            f"{MASK_FIX}",
+        )
+    ]
+
+
+def _where(photo):
+    """The landmark file (else the photo) and the mask, as the message names them."""
+    if photo.landmarks_file:
+        return str(photo.landmarks_file), f"the face mask of photo {photo.id!r}"
+    return f"photo {photo.id!r}", "its face mask"
+
+
+def _names(names, limit=8):
+    shown = ", ".join(names[:limit])
+    return shown if len(names) <= limit else f"{shown} and {len(names) - limit} more"
+
+
+def photo_pair_order(landmarks_uv):
+    """Bilateral pairs of a photo's landmarks and how many are reversed for a frontal view.
+
+    Returns
+    -------
+    pairs : list of str
+        Base names of the pairs present (``"exocanthion"``, ...).
+    reversed_pairs : list of str
+        Those whose ``_l`` landmark lies at a smaller ``u`` than its ``_r`` twin.
+    """
+    pairs, reversed_pairs = [], []
+    for name, uv in landmarks_uv.items():
+        if side(name) == "l" and twin(name) in landmarks_uv:
+            base = name[:-2]
+            pairs.append(base)
+            if float(uv[0]) < float(landmarks_uv[twin(name)][0]):
+                reversed_pairs.append(base)
+    return pairs, reversed_pairs
+
+
+#: A photo's facial landmarks above the eyes and below the nose (its midline): every upper one
+#: lies above every lower one in an upright photo, whatever the view.
+PHOTO_UPPER_MIDLINE = ("nasion", "glabella", "metopion", "bregma")
+PHOTO_LOWER_MIDLINE = ("subnasale", "labiale_superius", "pogonion", "gnathion")
+
+#: A frontal photo's pair is reversed when its ``_l`` twin lies left of its ``_r`` twin by more
+#: than this share of the landmarks' extent (on 322 generated frontal photos, Exp. A-C, every
+#: pair lay the right way round by at least 0.13 of the extent).
+PAIR_REVERSED_FRACTION = 0.02
+
+
+def _upside_down(landmarks_uv):
+    """Whether every upper midline landmark lies below (larger ``v``) every lower one."""
+    upper = [float(landmarks_uv[n][1]) for n in PHOTO_UPPER_MIDLINE if n in landmarks_uv]
+    lower = [float(landmarks_uv[n][1]) for n in PHOTO_LOWER_MIDLINE if n in landmarks_uv]
+    return bool(upper and lower) and min(upper) > max(lower)
+
+
+def check_photo_labels(photo):
+    """Raise when a photo's landmarks cannot be the right way up and round: the forehead's
+    midline landmarks below the chin's (an upside-down photo, any view); in a frontal photo,
+    every left/right pair reversed (a mirrored photo, or all labels swapped), or some pairs
+    clearly reversed while the others are not (those pairs' labels swapped).
+
+    A swapped pair is not noise a fit absorbs: it pulls the camera tens of pixels off, and the
+    identification would read a labelling slip as a different person.
+
+    Raises
+    ------
+    ValueError
+        Naming ``photo.landmarks_file`` and what to turn, flip or swap.
+    """
+    where = photo.landmarks_file or f"photo {photo.id!r}: facial landmarks"
+    lm = photo.landmarks_uv
+    if _upside_down(lm):
+        upper = ", ".join(n for n in PHOTO_UPPER_MIDLINE if n in lm)
+        lower = ", ".join(n for n in PHOTO_LOWER_MIDLINE if n in lm)
+        raise ValueError(
+            f"{where}: {upper} lie below {lower}: the photo is upside down or flipped top to "
+            "bottom (turn the image and its landmarks upright), or those labels are mixed up"
+        )
+    if photo.view != "frontal":
+        return
+    pairs, reversed_pairs = photo_pair_order(lm)
+    if not pairs:
+        return
+    if len(reversed_pairs) == len(pairs):
+        raise ValueError(
+            f"{where}: in this frontal photo every _l landmark lies left of its _r twin "
+            f"({', '.join(pairs)}), but facing the camera the subject's left is on the image's "
+            "right: the photo is mirrored (a selfie or a flipped scan: flip the image and its "
+            "landmarks horizontally) or _l and _r are swapped in the labels (swap them)"
+        )
+    extent = float(np.ptp(np.asarray(list(lm.values()), float), axis=0).max())
+    swapped = [
+        b for b in reversed_pairs
+        if lm[f"{b}_r"][0] - lm[f"{b}_l"][0] > PAIR_REVERSED_FRACTION * extent
+    ]
+    if swapped:
+        right = [b for b in pairs if b not in reversed_pairs]
+        raise ValueError(
+            f"{where}: in this frontal photo {', '.join(b + '_l' for b in swapped)} lie left of "
+            f"their _r twins while {', '.join(right)} lie the right way round (the subject's "
+            "left on the image's right): swap _l and _r of "
+            f"{', '.join(swapped)}, or give the photo's view if it is not frontal"
+        )
