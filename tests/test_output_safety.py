@@ -122,3 +122,30 @@ def test_a_write_error_without_a_file_name_gets_the_written_path(tmp_path, monke
         write_json(tmp_path / "result.json", {"a": 1})
     assert caught.value.filename == str(tmp_path / "result.json")
     assert list(tmp_path.iterdir()) == []  # no temporary file left
+
+
+def test_an_sfo_leaves_no_overlay_of_an_earlier_one(case, tmp_path, capsys):
+    subject_dir, photo_dir = case
+    other = scaled_photo(photo_dir, tmp_path / "b" / "other", 0.8)
+    out = tmp_path / "out"
+    joint = ["sfo", "--skull", subject_dir, "--photo", photo_dir, "--photo", other]
+    tiny = ["--method", "lilium", "--generations", "2", "--population", "5", "--out", out]
+    code, _, err = _run(joint + tiny, capsys)
+    assert code == 0, err
+    assert len(list(out.glob("overlay_*.png"))) == 2
+    code, _, err = _run(_sfo(case, out, "--method", "posest-sfo"), capsys)  # one photo, after
+    assert code == 0, err
+    assert not list(out.glob("overlay_*.png")) and (out / "overlay.png").is_file()
+    code, _, err = _run(joint + tiny, capsys)  # the joint SFO again, after the single one
+    assert code == 0, err
+    assert not (out / "overlay.png").exists() and len(list(out.glob("overlay_*.png"))) == 2
+
+
+def test_a_candidate_name_cannot_rewrite_the_terminal_line(case, tmp_path, capsys):
+    _, photo_dir = case
+    name = "A\u202eB\nC"  # a right-to-left override and a newline
+    argv = ["lineup", "--no-progress", "--skull", case[0], "--candidate", name, photo_dir]
+    code, stdout, err = _run(argv + ["--method", "posest-sfo", "--out", tmp_path / "out"], capsys)
+    assert code == 0, err
+    (line,) = [ln for ln in stdout.splitlines() if ln.startswith("1. ")]
+    assert line.startswith("1. A\\u202eB\\u000aC (posest-sfo): ")

@@ -145,6 +145,13 @@ def test_write_result_writes_result_json_only_after_its_overlay(tmp_path, monkey
         write_result(folder, Result(), np.zeros((4, 5, 3), np.uint8))
     assert caught.value.filename == str(folder / "overlay.png")
     assert not (folder / "result.json").exists()  # the earlier one too: it is not this overlay's
+    # Neither the earlier overlay (another camera's) nor a temporary file is left.
+    assert list(folder.iterdir()) == []
+    monkeypatch.undo()
+    write_png(folder / "overlay.png", np.zeros((4, 5, 3), np.uint8))
+    monkeypatch.setattr(Image.Image, "save", full)
+    with pytest.raises(OSError):
+        write_png(folder / "overlay.png", np.ones((4, 5, 3), np.uint8))
     assert [p.name for p in folder.iterdir()] == ["overlay.png"]  # no temporary file left
     assert png_readable(folder / "overlay.png")  # the earlier one, whole (atomic replace)
 

@@ -18,9 +18,9 @@ from ..inputs import CaseWarning
 from ..io.case import IMAGE_NAMES, read_depth_table, read_photo, read_skull
 from ..io.jsonio import write_json
 from ..io.locks import RunLock
-from ..io.paths import safe_id
+from ..io.paths import printable, safe_id
 from ..io.provenance import input_files
-from ..io.results import png_readable, read_result, write_png, write_result
+from ..io.results import png_readable, read_result, remove_overlays, write_png, write_result
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
@@ -136,10 +136,10 @@ def write_joint_result(out_dir, result, skull, photos, overlay=True):
     """Write a joint SFO's ``overlay_<photo id>.png`` per photo (the photo's plain image when
     its camera failed), then its ``result.json`` (SPEC section 9).
 
-    As :func:`~lilium.io.results.write_result`: an earlier ``result.json`` is removed first and
-    the new one written last, so it is only ever there with its whole overlays. Without
-    overlays, an ``overlay_<photo id>.png`` of these photos left in ``out_dir`` by an earlier
-    run is removed (it would show another camera than the ``result.json`` beside it).
+    As :func:`~lilium.io.results.write_result`: an earlier ``result.json`` and the overlays of
+    an earlier SFO (:func:`~lilium.io.results.remove_overlays`, a single one's too) are removed
+    first and the new ``result.json`` written last, so it is only ever there with its whole
+    overlays.
 
     Returns
     -------
@@ -149,13 +149,12 @@ def write_joint_result(out_dir, result, skull, photos, overlay=True):
     out_dir = Path(out_dir)
     written = {"result.json": out_dir / "result.json"}
     written["result.json"].unlink(missing_ok=True)
+    remove_overlays(out_dir)
     for single, photo in zip(result.photos, photos, strict=True):
-        path = out_dir / joint_overlay_name(photo.id)
         if overlay:
+            path = out_dir / joint_overlay_name(photo.id)
             write_png(path, result_overlay(single, skull, photo))
             written[photo.id] = path
-        elif path.is_file() or path.is_symlink():
-            path.unlink()
     write_json(written["result.json"], result.to_dict())
     return written
 
@@ -398,7 +397,7 @@ def resumed_sfo(
         write_json(Path(folder) / "result.json", result.to_dict())  # this run's calibration
         return result, True
     if why:
-        log(f"{photo.id}: {tag}: running the SFO again: {why}")
+        log(f"{printable(photo.id)}: {tag}: running the SFO again: {why}")
     result = (run or run_sfo)(method, skull, photo, options, seed)
     result = with_identification(result, skull, [photo], calibrations)
     result = with_fingerprint(result, fingerprint)

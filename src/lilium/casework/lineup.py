@@ -22,7 +22,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..io.jsonio import write_json
-from ..io.paths import safe_id
+from ..io.paths import printable, safe_id
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.registry import check_method, method_tag, run_sfo
@@ -164,7 +164,7 @@ def run_lineup(
         ranking.sort(key=lambda entry: rank_key(entry, first))
         for k, entry in enumerate(ranking, start=1):
             entry["rank"] = k
-            log(f"{k}. {entry['candidate']} ({entry['method']}): "
+            log(f"{k}. {printable(entry['candidate'])} ({entry['method']}): "
                 f"{conclusion_line(entry['identification'])}")
         write_json(out / "lineup.json", {"skull": skull.id, "ranking": ranking})
         decisions = [
@@ -227,7 +227,7 @@ class _LineupRun:
                 folder, *sfo, fingerprint, self.calibrations, self.log, run_sfo
             )
             if reused:
-                self.log(f"{photo.id}: {method}: reusing the stored result in {folder}")
+                self.log(f"{printable(photo.id)}: {method}: reusing the stored result in {folder}")
             outputs = sfo_outputs(folder, self.out)
             labelled = {**self.skull_inputs, **inputs}
             yield method, ReportEntry(self.skull, photo, result, labelled, notes, outputs)

@@ -64,6 +64,17 @@ def safe_id(name, default="photo"):
     return text
 
 
+def printable(text):
+    """``text`` for a terminal line: every character that is not printable (control
+    characters, a newline, the bidirectional overrides that would reverse the rest of the
+    line) written as its escape (``\\u202e``).
+
+    >>> printable("A\\u202eB\\nC")
+    'A\\\\u202eB\\\\u000aC'
+    """
+    return "".join(c if c.isprintable() else f"\\u{ord(c):04x}" for c in str(text))
+
+
 def path_id(path, default="photo"):
     """The id of a folder or file given on the command line: its name as written, made safe.
 

@@ -32,6 +32,17 @@ def write_png(path, rgb):
         raise
 
 
+def remove_overlays(out_dir):
+    """Remove the overlays an earlier SFO left in ``out_dir``: ``overlay.png`` (one photo) and
+    ``overlay_<photo id>.png`` (a joint SFO), which would show another camera than the
+    ``result.json`` written next."""
+    out_dir = Path(out_dir)
+    if out_dir.is_dir():
+        for path in [out_dir / "overlay.png", *out_dir.glob("overlay_*.png")]:
+            if path.is_file() or path.is_symlink():
+                path.unlink()
+
+
 def png_readable(path):
     """Whether ``path`` is a whole, readable image file (Pillow's ``verify``): False when it is
     missing, empty or cut."""
@@ -50,9 +61,8 @@ def write_result(out_dir, result, overlay_rgb=None):
 
     Both are written atomically and ``result.json`` last (an earlier one is removed first), so
     a ``result.json`` is only ever there with its whole overlay: a run killed in between
-    leaves no result that a resumed run would take as finished. Without an overlay, an
-    ``overlay.png`` left in ``out_dir`` by an earlier run is removed: it would show another
-    camera than the ``result.json`` beside it.
+    leaves no result that a resumed run would take as finished. The overlays of an earlier SFO
+    in ``out_dir`` (:func:`remove_overlays`, a joint SFO's too) are removed first.
 
     Returns
     -------
@@ -63,8 +73,7 @@ def write_result(out_dir, result, overlay_rgb=None):
     path = out_dir / "result.json"
     overlay = out_dir / "overlay.png"
     path.unlink(missing_ok=True)
-    if overlay_rgb is None and (overlay.is_file() or overlay.is_symlink()):
-        overlay.unlink()
+    remove_overlays(out_dir)
     if overlay_rgb is not None:
         write_png(overlay, overlay_rgb)
     write_json(path, result.to_dict())
