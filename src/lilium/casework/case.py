@@ -159,7 +159,7 @@ def run_case(
             from .joint_case import run_joint_methods
 
             joints = run_joint_methods(
-                skull, records, methods, options, seed, out, log, calibrations, skull_inputs
+                skull, skull_inputs, records, methods, options, seed, out, log, calibrations
             )
         run = _CaseRun(skull, skull_inputs, out, options, seed, calibrations, log)
         entries = run.entries(records, methods, joints)

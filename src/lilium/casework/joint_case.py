@@ -47,7 +47,7 @@ def check_joint_case(photos, methods):
 
 
 def run_joint_methods(
-    skull, records, methods, options, seed, out, log=print, calibrations=None, skull_inputs=None
+    skull, skull_inputs, records, methods, options, seed, out, log=print, calibrations=None
 ):
     """Run every joint-capable method of ``methods`` once on all the photos; write each.
 
@@ -58,6 +58,9 @@ def run_joint_methods(
     Parameters
     ----------
     skull : Skull
+    skull_inputs : dict of str -> path
+        The skull's labelled files (:func:`~lilium.casework.inputs.load_skull`), for the
+        input fingerprint.
     records : list of PhotoRecord
         From :func:`~lilium.casework.inputs.load_photos`.
     methods : sequence of str
@@ -68,9 +71,6 @@ def run_joint_methods(
     log : callable
     calibrations : Calibrations, optional
         For the joint SFO's identification (default: the shipped calibration).
-    skull_inputs : dict of str -> path, optional
-        The skull's labelled files (:func:`~lilium.casework.inputs.load_skull`), for the
-        input fingerprint.
 
     Returns
     -------
@@ -88,7 +88,7 @@ def run_joint_methods(
             continue
         folder = Path(out) / JOINT_FOLDER / method_tag(method, options.variant)
         fingerprint = sfo_fingerprint(
-            method, options, seed, skull, skull_inputs or {}, photos, [r.inputs for r in records]
+            method, options, seed, skull, skull_inputs, photos, [r.inputs for r in records]
         )
         sfo = (method, skull, photos, options, seed)
         result, reused = _resumed_joint(folder, sfo, fingerprint, calibrations, log)
