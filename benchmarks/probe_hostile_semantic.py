@@ -359,39 +359,26 @@ def _write_in(name, text):
 # -- command lines ----------------------------------------------------------------------------
 
 
-def _sfo(skull, photo, *extra, method="posest-sfo"):
+def _photos_command(command, skull, photos, extra, method):
+    """``lilium <command> --skull S --photo P ... --out OUT --method M EXTRA`` of a probe."""
+
     def argv(ws):
-        photos = photo if isinstance(photo, (list, tuple)) else [photo]
-        out = ["sfo", "--skull", skull(ws)]
+        out = [command, "--skull", skull(ws)]
         for p in photos:
             out += ["--photo", p(ws)]
-        return [
-            *out,
-            "--out",
-            ws.out,
-            "--method",
-            method,
-            *(e(ws) if callable(e) else e for e in extra),
-        ]
+        rest = (e(ws) if callable(e) else e for e in extra)
+        return [*out, "--out", ws.out, "--method", method, *rest]
 
     return argv
+
+
+def _sfo(skull, photo, *extra, method="posest-sfo"):
+    photos = photo if isinstance(photo, (list, tuple)) else [photo]
+    return _photos_command("sfo", skull, photos, extra, method)
 
 
 def _case(skull, photos, *extra, method="posest-sfo"):
-    def argv(ws):
-        out = ["case", "--skull", skull(ws)]
-        for p in photos:
-            out += ["--photo", p(ws)]
-        return [
-            *out,
-            "--out",
-            ws.out,
-            "--method",
-            method,
-            *(e(ws) if callable(e) else e for e in extra),
-        ]
-
-    return argv
+    return _photos_command("case", skull, photos, extra, method)
 
 
 def _lineup(skull, candidates, *extra, method="posest-sfo"):

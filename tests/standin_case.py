@@ -192,3 +192,27 @@ def terms_database(path, n_subjects=3, result=None, seed=0):
                      result=json.dumps(data) if result is None else result(k, data))
             )  # fmt: skip
     return path
+
+
+def toy_dataset(out, seed=3, n_photos=1, image_sizes=((640, 480),), **kwargs):
+    """A small generated dataset of two toy-head subjects (fast to make and to run).
+
+    ``n_photos`` frontal (and as many lateral) photos per subject, at ``image_sizes``; other
+    keywords go to :func:`lilium.synthetic.dataset.generate_dataset` (``experiments``,
+    ``subject_writer``, ``no_mandible_share``, ...). Returns its index.
+    """
+    from lilium.synthetic.dataset import generate_dataset
+    from lilium.synthetic.photos import CameraRanges
+    from lilium.synthetic.toyhead import make_toy_subject, write_toy_subject
+
+    kwargs.setdefault("subject_writer", write_toy_subject)
+    return generate_dataset(
+        out,
+        2,
+        n_photos,
+        seed=seed,
+        workers=1,
+        ranges=CameraRanges(image_sizes=tuple(image_sizes)),
+        subject_factory=make_toy_subject,
+        **kwargs,
+    )

@@ -14,22 +14,13 @@ from lilium.synthetic.noise import (
 )
 from lilium.synthetic.photos import CameraRanges
 from lilium.synthetic.toyhead import make_toy_subject, write_toy_subject
+from standin_case import toy_dataset
 
 SMALL = CameraRanges(image_sizes=((640, 480), (800, 600)))
 
 
 def _generate(out, seed=7, **kw):
-    return ds.generate_dataset(
-        out,
-        2,
-        2,
-        seed=seed,
-        workers=1,
-        ranges=SMALL,
-        subject_factory=make_toy_subject,
-        subject_writer=write_toy_subject,
-        **kw,
-    )
+    return toy_dataset(out, seed, n_photos=2, image_sizes=SMALL.image_sizes, **kw)
 
 
 @pytest.fixture(scope="module")

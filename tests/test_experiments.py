@@ -23,9 +23,7 @@ from lilium.experiments.config import (
 )
 from lilium.experiments.runner import enumerate_tasks, load_dataset, run_experiment
 from lilium.experiments.store import KEY_COLUMNS, ResultStore
-from lilium.synthetic import dataset as ds
-from lilium.synthetic.photos import CameraRanges
-from lilium.synthetic.toyhead import make_toy_subject, write_toy_subject
+from standin_case import toy_dataset
 
 #: Tiny protocol: 2 toy subjects x (1 frontal + 1 lateral) photos, POSEST-SFO and Lilium base.
 TINY = """
@@ -52,16 +50,7 @@ max_seconds = 5
 @pytest.fixture(scope="module")
 def dataset(tmp_path_factory):
     out = tmp_path_factory.mktemp("experiment-ds")
-    ds.generate_dataset(
-        out,
-        2,
-        1,
-        seed=3,
-        workers=1,
-        ranges=CameraRanges(image_sizes=((640, 480),)),
-        subject_factory=make_toy_subject,
-        subject_writer=write_toy_subject,
-    )
+    toy_dataset(out)
     return out
 
 

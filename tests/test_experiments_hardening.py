@@ -21,23 +21,12 @@ from lilium.experiments.runner import Task, run_task
 from lilium.experiments.store import KEY_COLUMNS, ResultStore
 from lilium.io.locks import RunLock
 from lilium.optimisation.de import DEOptions
-from lilium.synthetic import dataset as ds
-from lilium.synthetic.photos import CameraRanges
-from lilium.synthetic.toyhead import make_toy_subject, write_toy_subject
+from standin_case import toy_dataset
 from test_experiments import db_keys, write_config
 
 
 def _generate(out, seed):
-    ds.generate_dataset(
-        out,
-        2,
-        1,
-        seed=seed,
-        workers=1,
-        ranges=CameraRanges(image_sizes=((640, 480),)),
-        subject_factory=make_toy_subject,
-        subject_writer=write_toy_subject,
-    )
+    toy_dataset(out, seed)
     return out
 
 

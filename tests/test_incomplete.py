@@ -34,24 +34,14 @@ from lilium.synthetic import incomplete
 from lilium.synthetic.photos import CameraRanges
 from lilium.synthetic.subjects import MANDIBLE_LANDMARKS
 from lilium.synthetic.toyhead import make_toy_subject, write_toy_subject
+from standin_case import toy_dataset
 
 SMALL = CameraRanges(image_sizes=((640, 480), (800, 600)))
 TINY_DE = DEOptions(population_size=8, max_generations=4)
 
 
 def _generate(out, seed=5, **kw):
-    return ds.generate_dataset(
-        out,
-        2,
-        1,
-        seed=seed,
-        experiments=("A", "C"),
-        workers=1,
-        ranges=SMALL,
-        subject_factory=make_toy_subject,
-        subject_writer=write_toy_subject,
-        **kw,
-    )
+    return toy_dataset(out, seed, image_sizes=SMALL.image_sizes, experiments=("A", "C"), **kw)
 
 
 @pytest.fixture(scope="module")

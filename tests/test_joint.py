@@ -20,9 +20,7 @@ from lilium.methods.joint import (
 )
 from lilium.optimisation import DEOptions
 from lilium.report.html import relative_href
-from lilium.synthetic import dataset as ds
-from lilium.synthetic.photos import CameraRanges
-from lilium.synthetic.toyhead import make_toy_subject, write_toy_subject
+from standin_case import toy_dataset
 
 TINY_DE = DEOptions(population_size=8, max_generations=6, max_seconds=None)
 
@@ -36,17 +34,7 @@ PHOTO_KEYS = {"photo", "camera", "fitness", "terms", "terms_off"}
 def dataset(tmp_path_factory):
     """Two toy subjects, each with one frontal and one lateral photo (Exps. A and C)."""
     out = tmp_path_factory.mktemp("joint-ds")
-    ds.generate_dataset(
-        out,
-        2,
-        1,
-        seed=3,
-        workers=1,
-        experiments=("A", "C"),
-        ranges=CameraRanges(image_sizes=((640, 480),)),
-        subject_factory=make_toy_subject,
-        subject_writer=write_toy_subject,
-    )
+    toy_dataset(out, experiments=("A", "C"))
     return out
 
 

@@ -16,8 +16,8 @@ from lilium.experiments.dataset import dataset_fingerprint
 from lilium.experiments.store import ResultStore, database_error
 from lilium.synthetic import dataset as ds
 from lilium.synthetic.incomplete import curve_kept
-from lilium.synthetic.photos import CameraRanges
 from lilium.synthetic.toyhead import make_toy_subject, write_toy_subject
+from standin_case import toy_dataset
 from test_experiments import db_keys, write_config
 
 #: POSEST-SFO only (deterministic, fast).
@@ -28,17 +28,7 @@ PER_EXPERIMENT = 8
 
 
 def _generate(out, seed=3, writer=write_toy_subject, **kwargs):
-    return ds.generate_dataset(
-        out,
-        2,
-        1,
-        seed=seed,
-        workers=1,
-        ranges=CameraRanges(image_sizes=((640, 480),)),
-        subject_factory=make_toy_subject,
-        subject_writer=writer,
-        **kwargs,
-    )
+    return toy_dataset(out, seed, subject_writer=writer, **kwargs)
 
 
 @pytest.fixture(scope="module")
