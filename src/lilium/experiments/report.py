@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.paths import same_file
 from .config import EXPERIMENTS, VIEW_GROUPS, method_label, method_order, view_group
 from .identification import (
     identification_markdown,
@@ -505,13 +506,6 @@ REPORT_FILES = (
 )
 
 
-def _same_file(a, b):
-    try:
-        return a.resolve() == b.resolve() or (a.exists() and a.samefile(b))
-    except OSError:
-        return False
-
-
 def check_database_not_output(db, out_dir):
     """Refuse, before anything is written, a database that a report file in ``out_dir`` would
     overwrite (``lilium report in/summary.csv --out in``).
@@ -523,7 +517,7 @@ def check_database_not_output(db, out_dir):
     """
     db, out_dir = Path(db), Path(out_dir)
     for name in REPORT_FILES:
-        if _same_file(out_dir / name, db):
+        if same_file(out_dir / name, db):
             raise ValueError(
                 f"--out {out_dir}: lilium report writes {name} there, over the database {db}; "
                 "give another --out"

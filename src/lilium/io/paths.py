@@ -64,6 +64,16 @@ def safe_id(name, default="photo"):
     return text
 
 
+def same_file(a, b):
+    """Whether the paths ``a`` and ``b`` name one file: the same path once links are resolved,
+    or a hard link (False when either cannot be looked at, e.g. does not exist)."""
+    a, b = Path(a), Path(b)
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and a.samefile(b))
+    except OSError:
+        return False
+
+
 def printable(text):
     """``text`` for a terminal line: every character that is not printable (control
     characters, a newline, the bidirectional overrides that would reverse the rest of the

@@ -37,12 +37,12 @@ def landmark_mask_distances_px(landmarks_uv, mask):
     landmarks_uv : ndarray of shape (N, 2)
         ``(u = column, v = row)`` pixels; rounded to the nearest pixel, clipped to the image.
     mask : ndarray of shape (H, W), bool
-        The face mask, not empty.
+        The face mask.
 
     Returns
     -------
     ndarray of shape (N,)
-        Pixels.
+        Pixels; ``inf`` for every landmark off an empty mask.
     """
     h, w = mask.shape
     cols = np.clip(np.rint(landmarks_uv[:, 0]), 0, w - 1).astype(int)
@@ -50,7 +50,9 @@ def landmark_mask_distances_px(landmarks_uv, mask):
     out = np.zeros(len(rows))
     outside = ~mask[rows, cols]
     if not outside.any():
-        return out  # the clean case: no distance transform
+        return out  # the clean case: no look at the whole mask, no distance transform
+    if not mask.any():
+        return np.full(len(rows), np.inf)
     from scipy.ndimage import distance_transform_edt  # off the `lilium sfo` start-up path
 
     # The crop holding the whole mask and every landmark gives the same distances, cheaper.
@@ -85,11 +87,13 @@ def landmark_mask_ratios(photo):
     if mask is None or not photo.landmarks_uv:
         return {}
     mask = np.asarray(mask, bool)
-    if not mask.any():
-        return {}
     names = list(photo.landmarks_uv)
     uv = np.array([np.asarray(photo.landmarks_uv[n], float) for n in names])
-    ratios = landmark_mask_distances_px(uv, mask) / mask_diagonal_px(mask)
+    ratios = landmark_mask_distances_px(uv, mask)
+    if np.isinf(ratios).any():
+        return {}  # an empty mask (refused where masks are read)
+    if ratios.any():  # the clean case skips the scan of the whole mask for its diagonal
+        ratios = ratios / mask_diagonal_px(mask)
     return dict(zip(names, ratios.tolist(), strict=True))
 
 

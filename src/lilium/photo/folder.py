@@ -18,6 +18,7 @@ Rules (docs/photo.md):
 
 from pathlib import Path
 
+from ..io.paths import same_file
 from ..io.prepared import PREPARED_BY, written_by_lilium_photo
 
 __all__ = [
@@ -32,13 +33,6 @@ __all__ = [
 #: The files ``lilium photo`` writes in its folder.
 IMAGE_FILES = ("image.png", "image.jpg", "image.jpeg")
 OWN_FILES = (*IMAGE_FILES, "photo.json", "face_mask.png", "face_curve.json", "review.html")
-
-
-def _same_file(a, b):
-    try:
-        return a.resolve() == b.resolve() or a.samefile(b)
-    except OSError:
-        return False
 
 
 def claim_folder(out, image_path):
@@ -67,7 +61,7 @@ def claim_folder(out, image_path):
     if out.exists() and not out.is_dir():
         raise ValueError(f"{out}: exists and is not a folder; give a folder for --out")
     present = [out / name for name in OWN_FILES if (out / name).exists()]
-    present = [p for p in present if not _same_file(p, image_path)]  # the photo: read, kept
+    present = [p for p in present if not same_file(p, image_path)]  # the photo: read, kept
     if not present:
         return []
     meta_path = out / "photo.json"
@@ -107,7 +101,7 @@ def check_photo_not_output(out, image_path, kept_name=None):
         ``kept_name``: the message names the photo and the fix.
     """
     for name in OWN_FILES:
-        if name != kept_name and _same_file(out / name, image_path):
+        if name != kept_name and same_file(out / name, image_path):
             raise ValueError(
                 f"{image_path}: the photo is {out / name}, a file lilium photo writes in --out "
                 f"{out}, so preparing it would replace it; give another --out or rename the photo"
