@@ -589,14 +589,17 @@ def test_landmark_tension_is_what_a_camera_off_the_landmarks_costs():
     view = _view(rng)
     cam = view.camera
     tensions = []
-    for angle in (0.0, 0.01, 0.03):
+    for angle in (0.0, 0.03, 0.06):
         moved = Camera.from_rt(_rotation([angle, 0.0, 0.0]) @ cam.R, cam.t, cam.focal_px,
                                cam.principal_point_px)
         chi2 = landmark_chi2([replace(view, camera=moved)])[0]
         refit = landmark_chi2(refit_views([replace(view, camera=moved)]))[0]
         assert refit <= chi2 + 1e-9  # the refit only accepts better fits
         tensions.append(landmark_tension({"landmark_chi2": chi2, "landmark_refit": refit}))
-    assert tensions[0] < 0.1 < tensions[1] < tensions[2]
+    # At the true camera the refit only overfits the noise: seven camera parameters against
+    # 80 coordinates take about 7 / 80 of the chi2: a tension near 0.09, 0.04-0.17 over draws
+    # (which also differ between machines: the soft tissue's draw goes through LAPACK).
+    assert tensions[0] < 0.25 < tensions[1] < tensions[2]
     assert landmark_tension({"landmark_chi2": 1.0}) is None  # older terms: filled by the model
     assert "landmark_tension" in CALIBRATED_TERMS
 
