@@ -2,6 +2,8 @@
 benchmarks/probe_hostile_semantic.py): landmarks off the face mask, implausible soft-tissue
 depths, the curve of the other view."""
 
+import subprocess
+import sys
 from dataclasses import replace
 
 import numpy as np
@@ -83,6 +85,38 @@ def test_a_landmark_just_off_the_mask_edge_passes():
     photo = _mask_photo()
     near = dict(photo.landmarks_uv, p00=np.array([200.0 + 80 + 5, 150.0]))  # 5 px off the edge
     assert check_landmarks_in_mask(replace(photo, landmarks_uv=near)) == []
+
+
+def test_landmark_distances_are_the_distance_transform():
+    """The windowed search gives a Euclidean distance transform's distances (scipy's, as the
+    reference) on masks of several pieces, for landmarks on, next to, far from the mask and at
+    the image's edge; and it loads no scipy.ndimage (0.15 s of a `lilium sfo` start)."""
+    from scipy.ndimage import distance_transform_edt
+
+    from lilium.methods.photo_checks import landmark_mask_distances_px
+
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        mask = np.zeros((rng.integers(40, 300), rng.integers(40, 300)), bool)
+        h, w = mask.shape
+        for _ in range(rng.integers(1, 4)):
+            r, c = rng.integers(0, h), rng.integers(0, w)
+            mask[r : r + rng.integers(1, 30), c : c + rng.integers(1, 30)] = True
+        uv = np.column_stack([rng.uniform(-5, w + 5, 30), rng.uniform(-5, h + 5, 30)])
+        rows = np.clip(np.rint(uv[:, 1]), 0, h - 1).astype(int)
+        cols = np.clip(np.rint(uv[:, 0]), 0, w - 1).astype(int)
+        expected = distance_transform_edt(~mask)[rows, cols]
+        np.testing.assert_allclose(landmark_mask_distances_px(uv, mask), expected, rtol=1e-12)
+    assert np.isinf(landmark_mask_distances_px(uv, np.zeros_like(mask))).all()
+    code = (
+        "import sys, numpy as np\n"
+        "from lilium.methods.photo_checks import landmark_mask_distances_px\n"
+        "mask = np.zeros((50, 60), bool); mask[10:20, 10:20] = True\n"
+        "d = landmark_mask_distances_px(np.array([[40.0, 40.0]]), mask)\n"
+        "print(round(float(d[0]), 6), 'scipy.ndimage' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == [str(round(float(np.hypot(21, 21)), 6)), "False"]
 
 
 # -- implausible soft-tissue depths -----------------------------------------------------------

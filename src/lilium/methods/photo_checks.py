@@ -42,7 +42,8 @@ def landmark_mask_distances_px(landmarks_uv, mask):
     Returns
     -------
     ndarray of shape (N,)
-        Pixels; ``inf`` for every landmark off an empty mask.
+        Pixels (the Euclidean distance between pixel centres, as a distance transform gives);
+        ``inf`` for every landmark off an empty mask.
     """
     h, w = mask.shape
     cols = np.clip(np.rint(landmarks_uv[:, 0]), 0, w - 1).astype(int)
@@ -50,18 +51,34 @@ def landmark_mask_distances_px(landmarks_uv, mask):
     out = np.zeros(len(rows))
     outside = ~mask[rows, cols]
     if not outside.any():
-        return out  # the clean case: no look at the whole mask, no distance transform
+        return out  # the clean case: no look at the whole mask
     if not mask.any():
         return np.full(len(rows), np.inf)
-    from scipy.ndimage import distance_transform_edt  # off the `lilium sfo` start-up path
-
-    # The crop holding the whole mask and every landmark gives the same distances, cheaper.
-    mr, mc = np.nonzero(mask)
-    r0, r1 = min(mr.min(), rows.min()), max(mr.max(), rows.max()) + 1
-    c0, c1 = min(mc.min(), cols.min()), max(mc.max(), cols.max()) + 1
-    dist = distance_transform_edt(~mask[r0:r1, c0:c1])
-    out[outside] = dist[rows[outside] - r0, cols[outside] - c0]
+    for k in np.flatnonzero(outside):
+        out[k] = _distance_to_mask_px(mask, rows[k], cols[k])
     return out
+
+
+def _distance_to_mask_px(mask, row, col):
+    """Distance from pixel ``(row, col)`` to the nearest pixel of a non-empty ``mask``.
+
+    Searched in square windows around the pixel, doubled until one holds a mask pixel within
+    its half-width: any pixel outside a window of half-width ``r`` is farther than ``r``, so
+    that one is the nearest of all. A landmark a few pixels off the face (the clean case) costs
+    a window of a few hundred pixels, not a distance transform of the whole photo (0.17 s at
+    24 MP).
+    """
+    h, w = mask.shape
+    radius = 8
+    while True:
+        r0, r1 = max(row - radius, 0), min(row + radius + 1, h)
+        c0, c1 = max(col - radius, 0), min(col + radius + 1, w)
+        rr, cc = np.nonzero(mask[r0:r1, c0:c1])
+        if len(rr):
+            nearest = np.sqrt(np.min((rr + r0 - row) ** 2 + (cc + c0 - col) ** 2))
+            if nearest <= radius or (r1 - r0 == h and c1 - c0 == w):
+                return float(nearest)
+        radius *= 2
 
 
 def mask_diagonal_px(mask):
