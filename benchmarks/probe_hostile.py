@@ -16,7 +16,8 @@ Probes of ``lilium photo`` and ``lilium import-ct`` (whose fixes belong to the p
 issue 28) are counted apart. Those of ``lilium lineup``, ``lilium calibrate``, ``--calibration``
 and the joint SFO are in ``probe_hostile_casework.py``; more of ``lilium photo``, ``lilium
 import-ct`` and ``lilium synth`` (EXIF, image modes, DICOM series, NIfTI affines, counts) are in
-``probe_hostile_inputs.py``. ::
+``probe_hostile_inputs.py``; degenerate or damaged geometry (mesh fragments, unreferenced vertices,
+twins at one place, planar landmarks, masks of every pixel) in ``probe_hostile_geometry.py``. ::
 
     python benchmarks/probe_hostile.py --work /tmp/probes [--only SUBSTRING] [--limit-s 60]
 
@@ -534,6 +535,7 @@ def photo_and_ct_probes():
 def all_probes():
     # The newer entry points' probes live in their own module (each reads in one sitting).
     from probe_hostile_casework import casework_probes
+    from probe_hostile_geometry import geometry_probes
     from probe_hostile_inputs import input_probes
     from probe_hostile_outputs import output_probes
     from probe_hostile_resume import resume_probes
@@ -553,6 +555,7 @@ def all_probes():
         + output_probes()
         + resume_probes()
         + semantic_probes()
+        + geometry_probes()
     )
 
 

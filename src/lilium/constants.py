@@ -102,6 +102,12 @@ MIN_LANDMARK_SPREAD_RATIO = 0.02
 #: Smallest extent of the cranial landmarks as a fraction of the skull mesh's extent.
 MIN_CRANIAL_EXTENT_FRACTION = 0.05
 
+#: A connected part of a skull mesh whose bounding box lies more than this (mm) from the part
+#: holding the cranial landmarks is not this skull's bone (a stray fragment, a second copy, scan
+#: debris): it is left out, with warning ``mesh_part_left_out``. A separate mandible, teeth or
+#: vertebrae touch or nearly touch the cranium's box and stay.
+PART_APART_MM = 20.0
+
 #: Physical range of each camera prior (docs/checks.md), with its unit: a focal prior from 10 px
 #: (no lens) to 1,000,000 px (an 800 mm lens on a 100 MP sensor is 270,000 px); a
 #: subject-to-camera distance from 5 cm to 100 m. A prior outside it is a unit or typing error.

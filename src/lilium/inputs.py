@@ -58,6 +58,8 @@ class Skull:
     landmarks_file : str or None
         The cranial landmark file, named in the messages about its labels (None: unknown, the
         messages then name the skull).
+    warnings : tuple of CaseWarning
+        Found while reading the skull (``mesh_part_left_out``); every result on it repeats them.
     """
 
     id: str
@@ -66,6 +68,7 @@ class Skull:
     landmarks_mm: dict
     axes: dict
     landmarks_file: str | None = None
+    warnings: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -114,6 +117,7 @@ class Photo:
     prior_sources: dict = field(default_factory=dict)
     warnings: tuple = ()
     landmark_sources: dict = field(default_factory=dict)
+    mask_file: str | None = None
 
 
 @dataclass(frozen=True)

@@ -326,7 +326,7 @@ def _prepared_image(path, taken, out, view, mask, sensor_width_mm, log):
     prepare_bare_photo(path, folder, view=view, sensor_width_mm=sensor_width_mm, log=log)
     photo = replace(read_photo(folder), id=photo_id)
     if mask is not None:  # the user's own mask wins over the automatic one
-        photo = replace(photo, face_mask=read_mask(mask, photo.image_size_wh))
+        photo = replace(photo, face_mask=read_mask(mask, photo.image_size_wh), mask_file=str(mask))
     inputs = {"photo": path, "photo.json": folder / "photo.json"}
     if mask is None and (folder / "face_mask.png").is_file():
         inputs["face mask"] = folder / "face_mask.png"

@@ -75,3 +75,31 @@ def cluster_kernel(v, faces, cell_mm, dense_limit):
             kept[n_kept, 0], kept[n_kept, 1], kept[n_kept, 2] = a, b, c
             n_kept += 1
     return merged, kept[:n_kept].copy()
+
+
+@njit
+def _root(parent, i):
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]  # path halving
+        i = parent[i]
+    return i
+
+
+@njit
+def component_kernel(faces, n_vertices):
+    """Each face's connected component as the smallest vertex index of that component, (F,)
+    int64: union-find over the faces' corners (faces sharing a vertex are connected)."""
+    parent = np.arange(n_vertices)
+    for f in range(faces.shape[0]):
+        a = _root(parent, faces[f, 0])
+        for k in range(1, 3):
+            b = _root(parent, faces[f, k])
+            if a < b:
+                parent[b] = a
+            elif b < a:
+                parent[a] = b
+                a = b
+    out = np.empty(faces.shape[0], np.int64)
+    for f in range(faces.shape[0]):
+        out[f] = _root(parent, faces[f, 0])
+    return out

@@ -14,9 +14,11 @@ from ..constants import (
     MIN_LANDMARK_EXTENT_PX,
     MIN_LANDMARK_SPREAD_RATIO,
     MIN_PHOTO_SIDE_PX,
+    PART_APART_MM,
     VIEWS,
 )
-from ..inputs import Photo, Priors, Skull
+from ..geometry.mesh import compact, parts_apart, point_surface_distance
+from ..inputs import CaseWarning, Photo, Priors, Skull
 from ..softtissue.depths import DepthStats, check_depth_table
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from ..softtissue.normals import surface_normals_at
@@ -170,17 +172,9 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
         landmarks = points_from_object(lm_path, "landmarks", raw, "cranial")
     else:
         landmarks = read_landmarks(lm_path, "cranial")
+    vertices, faces, warnings = _skull_part(mesh_path, vertices, faces, landmarks)
     extent = np.ptp(vertices, axis=0).max()
-    sample = vertices[:: max(1, len(vertices) // 20_000)]  # a CT skull's: a sample first
-    for name, p in landmarks.items():
-        gap = np.min(np.linalg.norm(sample - p, axis=1))  # >= the whole mesh's gap
-        if gap > 0.1 * extent:
-            gap = np.min(np.linalg.norm(vertices - p, axis=1))
-        if gap > 0.1 * extent:
-            raise ValueError(
-                f"{lm_path}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
-                "must be in the mesh's frame and units"
-            )
+    _check_on_mesh(lm_path, landmarks, vertices, faces, 0.1 * extent)
     check_landmark_layout(lm_path, landmarks, extent * MIN_CRANIAL_EXTENT_FRACTION, "mm")
     axes = {}
     axes_path = Path(axes_path) if axes_path else None
@@ -196,7 +190,48 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
     if missing:
         normals = surface_normals_at(vertices, faces, np.array([landmarks[n] for n in missing]))
         axes.update(zip(missing, normals, strict=True))
-    return Skull(skull_id, vertices, faces, landmarks, axes)
+    return Skull(skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings))
+
+
+def _skull_part(mesh_path, vertices, faces, landmarks):
+    """The mesh without the parts apart from its cranial landmarks' part (:data:`PART_APART_MM`)
+    and without unreferenced vertices; and the warning that names what was left out."""
+    apart, parts = parts_apart(vertices, faces, np.array(list(landmarks.values())), PART_APART_MM)
+    warnings = []
+    if parts:
+        faces = faces[~apart]
+        sizes = "; ".join(f"{n} faces, {gap:.0f} mm away" for n, gap in parts[:3])
+        more = f"; and {len(parts) - 3} more" if len(parts) > 3 else ""
+        warnings.append(
+            CaseWarning(
+                "mesh_part_left_out",
+                f"{mesh_path}: {len(parts)} fragment(s) of the mesh lie apart from the skull (the "
+                f"part holding its cranial landmarks) and are left out ({sizes}{more}); delete "
+                "them from the mesh if they are not this skull's bone",
+            )
+        )
+    used = np.zeros(len(vertices), bool)
+    used[faces.reshape(-1)] = True
+    if not used.all():
+        vertices, faces = compact(vertices, faces)
+    return vertices, faces, warnings
+
+
+def _check_on_mesh(lm_path, landmarks, vertices, faces, tolerance_mm):
+    """Raise when a cranial landmark lies farther than ``tolerance_mm`` from the skull's surface
+    (its triangles, not only its vertices: a coarse mesh has vertices far apart)."""
+    sample = vertices[:: max(1, len(vertices) // 20_000)]  # a CT skull's: a sample first
+    for name, p in landmarks.items():
+        gap = np.min(np.linalg.norm(sample - p, axis=1))  # >= the whole mesh's gap
+        if gap > tolerance_mm:
+            gap = np.min(np.linalg.norm(vertices - p, axis=1))
+        if gap > tolerance_mm:
+            gap = point_surface_distance(p[None], vertices, faces)[0]
+        if gap > tolerance_mm:
+            raise ValueError(
+                f"{lm_path}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
+                "must be in the mesh's frame and units"
+            )
 
 
 def _interval(path, priors, key):
@@ -316,6 +351,7 @@ def read_photo(folder, load_image=True):
         image,
         landmark_sources=sources,
         warnings=unknown_key_warnings(meta_path, meta),
+        mask_file=str(mask_path) if mask is not None else None,
     )
 
 
@@ -424,6 +460,7 @@ def photo_from_files(
         None,
         priors or Priors(),
         image,
+        mask_file=None if mask_path is None else str(mask_path),
     )
 
 

@@ -147,6 +147,12 @@ def _mask_pixels(im):
     return np.asarray(im.convert("RGB")).max(axis=2) > 0
 
 
+#: Largest share of a photo's pixels a face mask may cover: a head that fills even a tight
+#: portrait leaves the corners as background; a mask of (nearly) every pixel is a blank or
+#: inverted file, and with it the skull could never leave the head (P_skof silently 0).
+MASK_MAX_SHARE = 0.99
+
+
 def read_mask(path, image_size_wh):
     """Read a face mask (non-zero = face) as ``(H, W)`` bool, checking size and coverage.
 
@@ -172,10 +178,16 @@ def read_mask(path, image_size_wh):
         )
     if not mask.any():
         raise ValueError(f"{path}: the face mask is empty; paint the face/head pixels non-zero")
-    if mask.all():
+    share = np.count_nonzero(mask) / mask.size
+    if share >= MASK_MAX_SHARE:
+        left = mask.size - np.count_nonzero(mask)
+        whole = (
+            f"all but {left} px of the photo" if left else "the whole photo (every pixel non-zero)"
+        )
         raise ValueError(
-            f"{path}: the face mask covers the whole photo (every pixel non-zero); the mask is "
-            "the head as seen on a zero background: paint the background black (0), or, for a "
-            "mask drawn in its alpha channel, make the background transparent"
+            f"{path}: the face mask covers {whole}, leaving no background to tell the head "
+            "from; the mask is the head as seen on a zero background: paint the background "
+            "black (0), or, for a mask drawn in its alpha channel, make the background "
+            "transparent"
         )
     return mask

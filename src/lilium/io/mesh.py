@@ -178,11 +178,22 @@ def check_mesh(vertices_mm, faces, source="mesh"):
     if extent.min() <= 1e-3 * extent.max():
         raise ValueError(f"{source}: degenerate mesh (flat or a line, extent {extent.tolist()})")
     lo, hi = PLAUSIBLE_EXTENT_MM
+    if extent.max() > hi and _largest_part_extent_mm(vertices_mm, faces) <= hi:
+        return  # a skull with a part far from it: the skull reader leaves that out and says so
     if not lo <= extent.max() <= hi:
         raise ValueError(
             f"{source}: the mesh spans {extent.max():.3g} units; a skull in millimetres spans "
             f"{lo:.0f}-{hi:.0f}; rescale it to millimetres"
         )
+
+
+def _largest_part_extent_mm(vertices_mm, faces):
+    """Largest side of the bounding box of the mesh's connected part with the most faces."""
+    from ..geometry.mesh import face_components
+
+    labels = face_components(faces, len(vertices_mm))
+    corners = faces[labels == np.argmax(np.bincount(labels))].reshape(-1)
+    return float(np.ptp(vertices_mm[corners], axis=0).max())
 
 
 def write_mesh(path, vertices_mm, faces):

@@ -50,7 +50,12 @@ from ..fitness.camera_penalty import head_deviation_deg
 from ..inputs import CaseWarning
 from ..softtissue.landmarks import side, twin
 from ..validation import fmt_number, fmt_range
-from .photo_checks import check_landmarks_in_mask, check_photo_labels
+from .photo_checks import (
+    check_landmarks_in_mask,
+    check_photo_labels,
+    coincident_message,
+    coincident_pairs,
+)
 
 #: Anterior landmarks the anterior direction aims at when nasion is missing, in order.
 ANTERIOR_TARGETS = ("glabella", "subspinale", "prosthion", "metopion", "pogonion", "gnathion")
@@ -247,17 +252,21 @@ def label_handedness(landmarks_mm, vertices_mm):
 
 
 def check_skull_labels(skull):
-    """Raise when the skull's left and right labels (or its mesh) are mirrored.
+    """Raise when the skull's left and right labels (or its mesh) are mirrored, or a bilateral
+    pair's twins lie at one place (one copied from the other).
 
     Raises
     ------
     ValueError
         Naming ``skull.landmarks_file`` and what to swap.
     """
+    where = skull.landmarks_file or f"skull {skull.id!r}: cranial landmarks"
+    together = coincident_pairs(skull.landmarks_mm)
+    if together:
+        raise ValueError(coincident_message(where, together, "mm"))
     handedness = label_handedness(skull.landmarks_mm, skull.vertices_mm)
     if handedness is None or handedness >= 0:
         return
-    where = skull.landmarks_file or f"skull {skull.id!r}: cranial landmarks"
     raise ValueError(
         f"{where}: left and right are mirrored (the _r minus _l direction, anterior and superior "
         f"form a left-handed frame, {handedness:+.2f}); swap every _l and _r name in this file "
@@ -516,7 +525,8 @@ def landmark_error(camera, facial_landmarks_mm, photo):
 def finish_result(result, skull, photo):
     """A result with its warnings, priors' provenance and landmark error attached.
 
-    Warnings, in order: the photo's own (read with it, e.g. ``exif_focal_unusable``), the
+    Warnings, in order: the skull's own (read with it: ``mesh_part_left_out``), the photo's own
+    (read with it, e.g. ``exif_focal_unusable``), the
     method's (e.g. ``focal_cap``), the missing or violated priors, ``chin_unconstrained``,
     ``view_mismatch``.
 
@@ -530,7 +540,7 @@ def finish_result(result, skull, photo):
     -------
     SfoResult
     """
-    warnings = [*photo.warnings, *result.warnings]
+    warnings = [*skull.warnings, *photo.warnings, *result.warnings]
     warnings += prior_warnings(photo, result.camera, result.facial_landmarks_mm)
     error = None
     if result:

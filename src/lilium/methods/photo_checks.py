@@ -143,7 +143,7 @@ def check_landmarks_in_mask(photo):
     worst = f"up to {ratios[off[0]]:.2f} of the mask's bounding-box diagonal"
     counted = f"{len(off)} of {len(ratios)} facial landmarks lie outside {mask}"
     if 2 * len(off) > len(ratios):
-        raise ValueError(f"{where}: {counted} ({worst}; {_names(off)}): {MASK_FIX}")
+        raise ValueError(f"{where}: {counted} ({worst}; {_names(off)}){_small(photo)}: {MASK_FIX}")
     return [
         CaseWarning(
             "landmark_outside_mask",
@@ -153,11 +153,22 @@ def check_landmarks_in_mask(photo):
     ]
 
 
+def _small(photo):
+    """A clause for a mask far smaller than the landmarks' box (a pixel, a line), else ""."""
+    uv = np.array([np.asarray(p, float) for p in photo.landmarks_uv.values()])
+    box = float(np.prod(np.ptp(uv, axis=0) + 1))
+    area = int(np.count_nonzero(photo.face_mask))
+    if area >= 0.1 * box:
+        return ""
+    return f"; the mask covers {area} px against {box:.0f} px for the landmarks' box"
+
+
 def _where(photo):
     """The landmark file (else the photo) and the mask, as the message names them."""
+    mask = f"the face mask {photo.mask_file}" if photo.mask_file else None
     if photo.landmarks_file:
-        return str(photo.landmarks_file), f"the face mask of photo {photo.id!r}"
-    return f"photo {photo.id!r}", "its face mask"
+        return str(photo.landmarks_file), mask or f"the face mask of photo {photo.id!r}"
+    return f"photo {photo.id!r}", mask or "its face mask"
 
 
 def _names(names, limit=8):
@@ -192,8 +203,34 @@ PHOTO_LOWER_MIDLINE = ("subnasale", "labiale_superius", "pogonion", "gnathion")
 
 #: A frontal photo's pair is reversed when its ``_l`` twin lies left of its ``_r`` twin by more
 #: than this share of the landmarks' extent (on 322 generated frontal photos, Exp. A-C, every
-#: pair lay the right way round by at least 0.13 of the extent).
+#: pair lay the right way round by at least 0.13 of the extent); and its twins are at one place
+#: (one copied from the other) when they lie closer than this share apart. The same share of
+#: the cranial landmarks' extent tells a skull's twins at one place.
 PAIR_REVERSED_FRACTION = 0.02
+
+
+def coincident_pairs(landmarks):
+    """Base names of the bilateral pairs whose twins lie at one place: closer than
+    :data:`PAIR_REVERSED_FRACTION` of the landmarks' extent (2D or 3D points)."""
+    points = np.asarray(list(landmarks.values()), float)
+    limit = PAIR_REVERSED_FRACTION * float(np.ptp(points, axis=0).max())
+    return [
+        name[:-2]
+        for name, p in landmarks.items()
+        if side(name) == "l"
+        and twin(name) in landmarks
+        and np.linalg.norm(np.asarray(p, float) - landmarks[twin(name)]) <= limit
+    ]
+
+
+def coincident_message(where, bases, unit):
+    """The error for twins at one place (``unit``: ``"px"`` or ``"mm"``)."""
+    names = ", ".join(f"{b}_l and {b}_r" for b in bases)
+    return (
+        f"{where}: {names} lie at one place (under 2 % of the landmarks' extent apart, in "
+        f"{unit}): one was copied from the other or placed on the wrong side; place each on its "
+        "own side, or delete the one that is not seen"
+    )
 
 
 def _upside_down(landmarks_uv):
@@ -228,6 +265,9 @@ def check_photo_labels(photo):
         )
     if photo.view != "frontal":
         return
+    together = coincident_pairs(lm)
+    if together:
+        raise ValueError(coincident_message(where, together, "px"))
     pairs, reversed_pairs = photo_pair_order(lm)
     if not pairs:
         return
@@ -240,7 +280,8 @@ def check_photo_labels(photo):
         )
     extent = float(np.ptp(np.asarray(list(lm.values()), float), axis=0).max())
     swapped = [
-        b for b in reversed_pairs
+        b
+        for b in reversed_pairs
         if lm[f"{b}_r"][0] - lm[f"{b}_l"][0] > PAIR_REVERSED_FRACTION * extent
     ]
     if swapped:

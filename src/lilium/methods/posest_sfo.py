@@ -161,6 +161,17 @@ def focal_cap_message(photo, focal_px=None):
 
 
 def _failure_message(pose, skull, photo):
+    if pose.code == "no_sample":
+        n = len(correspondences(skull, photo).facial_names)
+        where = photo.landmarks_file or f"photo {photo.id!r}"
+        if skull.landmarks_file:
+            where = f"{where} and {skull.landmarks_file}"
+        return (
+            f"POSEST failed: {pose.message} from the {n} landmark pairs of {where}: too few "
+            "(4 pairs fix a camera only when they are exact), or nearly on one plane (the "
+            "midline alone); add landmarks off the midline (bilateral pairs: exocanthion, "
+            "zygion, gonion, ...), or run --method lilium, which needs no minimal sample"
+        )
     if pose.code == "rejected":
         return f"POSEST failed: {facing_failure(skull, photo)}"
     if pose.code == "focal_cap":

@@ -100,7 +100,8 @@ class PoseResult:
     code : str
         Why it failed, for callers: ``"focal_cap"`` (focal length above ``focal_max_px``),
         ``"rejected"`` (``camera_check`` refused every camera that was otherwise valid),
-        ``"other"``; "" on success.
+        ``"no_sample"`` (no minimal sample gave a real camera: too few or near-planar
+        points), ``"other"``; "" on success.
     capped_focal_px : float or None
         On success: the focal length of a camera that fitted better than the one returned but
         was refused for exceeding ``focal_max_px`` (the cap was hit; None when not). On a
@@ -195,7 +196,7 @@ def posest(uv_px, points_mm, principal_point_px, options=PosestOptions(), rng=0,
     ransac = options.ransac_for(uv)
     hyp = msac(uv_c, X, ransac, rng)
     if not hyp:
-        return failure(hyp.message)
+        return failure(hyp.message, "no_sample")
     R, t, f, _ = hyp.candidates
     tau_sq = ransac.threshold_px**2
     sq = reprojection_sq_errors(uv_c, X, R, t, f)
