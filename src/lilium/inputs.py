@@ -29,7 +29,8 @@ class CaseWarning:
         ``view_mismatch``, ``no_focal_prior``, ``no_scd_prior``, ``outside_prior``,
         ``exif_focal_unusable``, ``implausible_prior``, ``focal_cap``, ``chin_unconstrained``
         (no chin pair and no chin-jaw curve), ``unknown_key`` (a key of ``photo.json`` that
-        Lilium does not read).
+        Lilium does not read), ``mesh_part_left_out`` (parts of the skull mesh apart from the
+        skull, left out); docs/checks.md lists them all.
     message : str
         What is wrong and what fixes it.
     """
