@@ -17,7 +17,9 @@ issue 28) are counted apart. Those of ``lilium lineup``, ``lilium calibrate``, `
 and the joint SFO are in ``probe_hostile_casework.py``; more of ``lilium photo``, ``lilium
 import-ct`` and ``lilium synth`` (EXIF, image modes, DICOM series, NIfTI affines, counts) are in
 ``probe_hostile_inputs.py``; degenerate or damaged geometry (mesh fragments, unreferenced vertices,
-twins at one place, planar landmarks, masks of every pixel) in ``probe_hostile_geometry.py``. ::
+twins at one place, planar landmarks, masks of every pixel) in ``probe_hostile_geometry.py``; the
+same case transformed in ways that must not change the answer (resampled, padded, another file
+format, the skull moved, inputs in another order) in ``probe_hostile_metamorphic.py``. ::
 
     python benchmarks/probe_hostile.py --work /tmp/probes [--only SUBSTRING] [--limit-s 60]
 
@@ -537,6 +539,7 @@ def all_probes():
     from probe_hostile_casework import casework_probes
     from probe_hostile_geometry import geometry_probes
     from probe_hostile_inputs import input_probes
+    from probe_hostile_metamorphic import metamorphic_probes
     from probe_hostile_outputs import output_probes
     from probe_hostile_resume import resume_probes
     from probe_hostile_runs import run_probes
@@ -556,6 +559,7 @@ def all_probes():
         + resume_probes()
         + semantic_probes()
         + geometry_probes()
+        + metamorphic_probes()
     )
 
 

@@ -132,9 +132,11 @@ def make_standin_case(folder, seed=0):
     return subject_dir, photo_dir
 
 
-def scaled_photo(photo_dir, folder, factor):
+def scaled_photo(photo_dir, folder, factor, moved=0.015):
     """Another photo of the stand-in: its image and mask resized by ``factor``, its landmarks
-    and focal prior scaled with them (no ground truth). Not a copy: its bytes differ.
+    and focal prior scaled with them (no ground truth), and each landmark moved at random by
+    about ``moved`` of the landmarks' extent, as another photo's pose, expression and hand move
+    them (``moved=0``: a resized copy, which a case refuses as the same photo given twice).
 
     Returns
     -------
@@ -150,9 +152,12 @@ def scaled_photo(photo_dir, folder, factor):
         size = (round(image.width * factor), round(image.height * factor))
         image.resize(size).save(folder / name)
     data = json.loads((photo_dir / "photo.json").read_text())
+    uv = np.array(list(data["landmarks"].values()), float)
+    rng = np.random.default_rng(round(1000 * factor))
+    uv = uv + rng.normal(0.0, moved * np.ptp(uv, axis=0).max(), uv.shape)
     data["landmarks"] = {
         k: [(u + 0.5) * factor - 0.5, (v + 0.5) * factor - 0.5]
-        for k, (u, v) in data["landmarks"].items()
+        for k, (u, v) in zip(data["landmarks"], uv.tolist(), strict=True)
     }
     data["priors"]["focal_px"] = [f * factor for f in data["priors"]["focal_px"]]
     data.pop("ground_truth", None)

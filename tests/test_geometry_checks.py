@@ -210,3 +210,37 @@ def test_a_mask_of_one_pixel_says_so(standin, tmp_path):
     assert "the mask covers 1 px against" in str(err.value)
     json.dumps(str(err.value))  # one line
     assert "\n" not in str(err.value)
+
+
+def test_a_triangle_soup_stays_whole(standin, tmp_path):
+    """An STL holds loose triangles (no shared vertices): every triangle is a part of its own,
+    and the parts touch, so the skull stays whole; a fragment apart is still found."""
+    clean = read_skull(standin[0])
+    v, f = clean.vertices_mm, clean.faces
+    soup_v, soup_f = v[f].reshape(-1, 3), np.arange(3 * len(f)).reshape(-1, 3)
+    apart, parts = parts_apart(soup_v, soup_f, np.array(list(clean.landmarks_mm.values())), 20.0)
+    assert not apart.any() and parts == []
+    blob_v = np.vstack([soup_v, soup_v[:300] * 0.05 + [0.0, -300.0, 0.0]])
+    blob_f = np.vstack([soup_f, soup_f[:100] + len(soup_v)])
+    apart, parts = parts_apart(blob_v, blob_f, np.array(list(clean.landmarks_mm.values())), 20.0)
+    assert apart.sum() == 100 and len(parts) == 100
+
+
+def test_a_skull_in_centimetres_is_refused(standin, tmp_path):
+    from lilium.io.mesh import check_mesh
+
+    v, f = read_mesh(standin[0] / "skull.ply")
+    with pytest.raises(ValueError, match="rescale it to millimetres"):
+        check_mesh(v / 10, f, "skull.ply")
+
+
+def test_an_stl_skull_reads_as_its_ply(standin, tmp_path):
+    """STL stores loose triangles: read, they are welded back into the PLY's surface."""
+    from lilium.geometry.mesh import weld
+
+    v, f = read_mesh(standin[0] / "skull.ply")
+    write_mesh(tmp_path / "skull.stl", v, f)
+    sv, sf = read_mesh(tmp_path / "skull.stl")
+    assert len(sv) == len(np.unique(v, axis=0)) and len(sf) == len(f)
+    np.testing.assert_allclose(sv[sf], v[f], atol=1e-4)  # float32 in the file
+    assert weld(v, f)[0] is v  # no duplicates: unchanged

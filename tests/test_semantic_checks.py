@@ -202,3 +202,38 @@ def test_an_implausible_depth_is_in_the_result(case, tmp_path, capsys):
     warnings = json.loads((out / "result.json").read_text())["warnings"]
     (depth,) = [w for w in warnings if w["code"] == "implausible_depth"]
     assert "d.csv" in depth["message"] and "nasion" in depth["message"]
+
+
+# -- one photo given twice --------------------------------------------------------------------
+
+
+def test_a_photo_and_its_resized_copy_are_one_photo():
+    from lilium.methods.photo_checks import check_distinct_photos, copy_residual
+
+    rng = np.random.default_rng(4)
+    photo = replace(_mask_photo(), landmarks_file="a/photo.json")
+    uv = np.array(list(photo.landmarks_uv.values()))
+    turn = np.array([[np.cos(0.05), -np.sin(0.05)], [np.sin(0.05), np.cos(0.05)]])
+    copy = (uv - 100) @ turn.T * 0.5 + 7 + rng.normal(0, 0.05, uv.shape)  # resized, rounded
+    assert copy_residual(uv, copy) < 0.002
+    # the same person again: landmarks moved by about 1 % of the face (pose, expression, hand)
+    other = uv + rng.normal(0, 0.012 * np.ptp(uv, axis=0).max(), uv.shape)
+    assert copy_residual(uv, other) > 0.005
+    copied = replace(
+        photo,
+        id="copy",
+        landmarks_file="b/photo.json",
+        landmarks_uv=dict(zip(photo.landmarks_uv, copy, strict=True)),
+    )
+    with pytest.raises(ValueError, match="b/photo.json: its 20 landmarks lie where a/photo.json"):
+        check_distinct_photos([photo, copied])
+    again = replace(copied, landmarks_uv=dict(zip(photo.landmarks_uv, other, strict=True)))
+    check_distinct_photos([photo, again])
+    check_distinct_photos([photo, replace(copied, view="lateral_left")])  # another view
+
+
+def test_a_camera_just_outside_a_prior_reads_apart_from_its_bound():
+    from lilium.methods.checks import _apart
+
+    assert _apart(3554.6, (3555.2, 3929.0)) == "3554.6"
+    assert _apart(3000.0, (3555.2, 3929.0)) == "3000"

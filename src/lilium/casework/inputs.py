@@ -31,7 +31,7 @@ from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
 from ..io.paths import safe_id
 from ..io.prepared import read_prepared
-from ..methods.photo_checks import check_landmarks_in_mask
+from ..methods.photo_checks import check_distinct_photos, check_landmarks_in_mask
 from ..validation import check_prior, fmt_range
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 
@@ -283,6 +283,7 @@ def load_photos(
             photo, id=unique_id(photo.id, _taken(records)), warnings=(*photo.warnings, *off_mask)
         )
         records.append(PhotoRecord(photo, inputs, notes, origin))
+    check_distinct_photos([r.photo for r in records])
     return records
 
 

@@ -66,26 +66,30 @@ def keep_largest_component(vertices, faces):
 
 
 def parts_apart(vertices, faces, anchors, gap_mm):
-    """The connected components of a mesh that lie apart from the part holding ``anchors``.
+    """The connected parts of a mesh that lie apart from the part holding ``anchors``.
 
-    The part holding the anchors is every component with the vertex nearest to one of them;
-    a component is apart when its bounding box is more than ``gap_mm`` from that part's.
+    The skull grows from the parts holding the vertex nearest to each anchor: any part whose
+    bounding box comes within ``gap_mm`` of the grown bounding box joins it, until none does.
+    So a mesh split into pieces that touch (an STL's loose triangles, an OBJ cut along its
+    texture seams, a separate mandible) stays whole, and only what lies beyond ``gap_mm`` of
+    everything else is apart.
 
     Parameters
     ----------
     vertices : ndarray of shape (V, 3)
     faces : ndarray of shape (F, 3), int
-    anchors : ndarray of shape (A, 3)
-        Points on the part to keep (a skull's cranial landmarks), A >= 1.
+    anchors : ndarray of shape (A, 3) or None
+        Points on the part to keep (a skull's cranial landmarks), A >= 1; None: the part
+        with the most faces.
     gap_mm : float
 
     Returns
     -------
     apart : ndarray of shape (F,), bool
-        The faces of the components apart (all False for a mesh of one piece).
+        The faces of the parts apart (all False for a mesh of one piece).
     parts : list of (int, float)
-        Each component apart: its face count and the gap between its bounding box and the
-        kept part's, largest gap first.
+        Each part apart: its face count and the gap between its bounding box and the kept
+        one's, largest gap first.
     """
     labels = face_components(faces, len(vertices))
     n = int(labels.max()) + 1 if len(labels) else 0
@@ -97,22 +101,51 @@ def parts_apart(vertices, faces, anchors, gap_mm):
     hi = np.full((n, 3), -np.inf)
     np.minimum.at(lo, corner_label, vertices[corners])
     np.maximum.at(hi, corner_label, vertices[corners])
-    vertex_label = np.full(len(vertices), -1)
-    vertex_label[corners] = corner_label
-    used = np.flatnonzero(vertex_label >= 0)
-    held = set()
-    for point in np.asarray(anchors, float):
-        held.add(int(vertex_label[used[np.argmin(np.sum((vertices[used] - point) ** 2, 1))]]))
-    held = sorted(held)
-    keep_lo, keep_hi = lo[held].min(axis=0), hi[held].max(axis=0)
-    gap = np.linalg.norm(np.maximum(0.0, np.maximum(lo - keep_hi, keep_lo - hi)), axis=1)
-    far = gap > gap_mm
-    far[held] = False
     counts = np.bincount(labels, minlength=n)
+    kept = np.zeros(n, bool)
+    if anchors is None:
+        kept[np.argmax(counts)] = True
+    else:
+        vertex_label = np.full(len(vertices), -1)
+        vertex_label[corners] = corner_label
+        used = np.flatnonzero(vertex_label >= 0)
+        for point in np.asarray(anchors, float):
+            nearest = used[np.argmin(np.sum((vertices[used] - point) ** 2, axis=1))]
+            kept[vertex_label[nearest]] = True
+    while True:
+        box_lo, box_hi = lo[kept].min(axis=0), hi[kept].max(axis=0)
+        gap = np.linalg.norm(np.maximum(0.0, np.maximum(lo - box_hi, box_lo - hi)), axis=1)
+        joining = ~kept & (gap <= gap_mm)
+        if not joining.any():
+            break
+        kept |= joining
     parts = sorted(
-        ((int(counts[c]), float(gap[c])) for c in np.flatnonzero(far)), key=lambda part: -part[1]
+        ((int(counts[c]), float(gap[c])) for c in np.flatnonzero(~kept)), key=lambda p: -p[1]
     )
-    return far[labels], parts
+    return ~kept[labels], parts
+
+
+def weld(vertices, faces):
+    """Merge the vertices at exactly one position into one (the first's place in the order).
+
+    An STL holds every triangle with vertices of its own, and an OBJ is often split along its
+    texture seams: welded, the mesh is connected again (its silhouettes, contours and parts are
+    the surface's, not each triangle's). A mesh without duplicates comes back unchanged.
+
+    Returns
+    -------
+    vertices : ndarray of shape (V', 3)
+    faces : ndarray of shape (F, 3), int64
+    """
+    v = np.ascontiguousarray(vertices, dtype=float)
+    key = v.view(np.dtype((np.void, v.dtype.itemsize * 3))).reshape(-1)
+    _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+    if len(first) == len(v):
+        return vertices, faces
+    order = np.argsort(first)
+    rank = np.empty(len(first), np.int64)
+    rank[order] = np.arange(len(first))
+    return v[first[order]], rank[inverse.reshape(-1)][np.asarray(faces, dtype=np.int64)]
 
 
 def compact(vertices, faces):

@@ -11,8 +11,12 @@ from .paths import naming_errors
 
 MESH_SUFFIXES = (".ply", ".obj", ".stl")
 
-#: A skull in millimetres spans roughly 100-300 mm; outside this the unit is probably wrong.
-PLAUSIBLE_EXTENT_MM = (20.0, 1000.0)
+#: A skull in millimetres spans roughly 100-300 mm (an adult's length 170-210 mm, a mandible
+#: alone about 100 mm); outside this range the unit is wrong. The lower bound refuses a skull in
+#: centimetres (13-22 units), which the landmark checks cannot catch when its landmarks are in
+#: centimetres too: the depth table in mm then makes the soft tissue ten times too thick, and the
+#: true person was excluded.
+PLAUSIBLE_EXTENT_MM = (30.0, 1000.0)
 
 
 def import_trimesh():
@@ -54,6 +58,9 @@ def read_mesh(path):
     Returns
     -------
     vertices_mm : ndarray of shape (V, 3)
+        Vertices at one position merged (:func:`~lilium.geometry.mesh.weld`) for the formats
+        read through trimesh (STL, OBJ, text PLY) and for a binary PLY of more vertices than
+        faces (loose triangles); any other binary PLY comes back as stored.
     faces : ndarray of shape (F, 3), int
 
     Raises
@@ -70,8 +77,14 @@ def read_mesh(path):
     if path.suffix.lower() == ".ply":
         fast = read_binary_ply(path)
         if fast is not None:
-            check_mesh(*fast, str(path))
-            return fast
+            vertices, faces = fast
+            if len(vertices) > len(faces) and _indexed(vertices, faces):
+                # More vertices than faces: loose triangles (a closed mesh has about F / 2)
+                from ..geometry.mesh import weld
+
+                vertices, faces = weld(vertices, faces)
+            check_mesh(vertices, faces, str(path))
+            return vertices, faces
     trimesh = import_trimesh()  # 0.15 s: only for the layouts read_binary_ply does not read
     try:
         mesh = trimesh.load(path, force="mesh", process=False)
@@ -85,8 +98,18 @@ def read_mesh(path):
         ) from exc
     vertices = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=float)
     faces = np.asarray(getattr(mesh, "faces", np.empty((0, 3))), dtype=np.int64)
+    if _indexed(vertices, faces):
+        from ..geometry.mesh import weld
+
+        vertices, faces = weld(vertices, faces)  # an STL's loose triangles, an OBJ's seams
     check_mesh(vertices, faces, str(path))
     return vertices, faces
+
+
+def _indexed(vertices, faces):
+    """Whether the faces index existing, finite vertices (else check_mesh names the fault)."""
+    valid = len(faces) and faces.min() >= 0 and faces.max() < len(vertices)
+    return bool(valid) and bool(np.all(np.isfinite(vertices)))
 
 
 #: PLY scalar types and their numpy dtypes (little endian).
@@ -188,11 +211,13 @@ def check_mesh(vertices_mm, faces, source="mesh"):
 
 
 def _largest_part_extent_mm(vertices_mm, faces):
-    """Largest side of the bounding box of the mesh's connected part with the most faces."""
-    from ..geometry.mesh import face_components
+    """Largest side of the bounding box of the mesh without its parts apart from the part with
+    the most faces (:func:`~lilium.geometry.mesh.parts_apart`)."""
+    from ..constants import PART_APART_MM
+    from ..geometry.mesh import parts_apart
 
-    labels = face_components(faces, len(vertices_mm))
-    corners = faces[labels == np.argmax(np.bincount(labels))].reshape(-1)
+    apart, _ = parts_apart(vertices_mm, faces, None, PART_APART_MM)
+    corners = faces[~apart].reshape(-1)
     return float(np.ptp(vertices_mm[corners], axis=0).max())
 
 

@@ -375,6 +375,17 @@ def scd_point_mm(facial_landmarks_mm):
     return np.mean([np.asarray(v, float) for v in facial_landmarks_mm.values()], axis=0)
 
 
+def _apart(value, bounds):
+    """``value`` as :func:`fmt_number` writes it, with decimals added while it reads like one of
+    ``bounds`` (3554.6 px just under a prior from 3555 px is not "3555 px")."""
+    text = fmt_number(value)
+    for decimals in range(1, 4):
+        if text not in (fmt_number(bounds[0]), fmt_number(bounds[1])):
+            break
+        text = f"{value:.{decimals}f}"
+    return text
+
+
 def prior_warnings(photo, camera=None, facial_landmarks_mm=None):
     """Warnings about the priors: missing ones, and a camera outside a given one.
 
@@ -422,7 +433,7 @@ def prior_warnings(photo, camera=None, facial_landmarks_mm=None):
             out.append(
                 CaseWarning(
                     "outside_prior",
-                    f"the {label} found, {fmt_number(value)} {unit}, lies outside its prior "
+                    f"the {label} found, {_apart(value, bounds)} {unit}, lies outside its prior "
                     f"{fmt_range(*bounds, unit)} ({_source(photo, key, bounds)}); "
                     "check the prior and the landmarks",
                 )

@@ -209,6 +209,62 @@ PHOTO_LOWER_MIDLINE = ("subnasale", "labiale_superius", "pogonion", "gnathion")
 PAIR_REVERSED_FRACTION = 0.02
 
 
+#: Two photos of one case are copies of one photo (one perhaps resized, recompressed or its
+#: landmarks placed again) when their common landmarks match after scaling, turning and moving
+#: to within this share of their extent (root mean square). Two photos taken apart differ by
+#: the pose, the expression and the hand that placed the landmarks: several per cent.
+COPY_FRACTION = 0.005
+
+
+def copy_residual(uv_a, uv_b):
+    """Root-mean-square residual of ``uv_b`` (N, 2) fitted to ``uv_a`` (N, 2) by a similarity
+    (scale, rotation, translation; no reflection), as a share of ``uv_a``'s extent; ``inf``
+    when either set is a single point."""
+    a = np.asarray(uv_a, float) - np.mean(uv_a, axis=0)
+    b = np.asarray(uv_b, float) - np.mean(uv_b, axis=0)
+    na, nb = np.linalg.norm(a), np.linalg.norm(b)
+    if na == 0 or nb == 0:
+        return np.inf
+    u, sv, vt = np.linalg.svd((b / nb).T @ (a / na))
+    fit = sv[0] + np.sign(np.linalg.det(u @ vt)) * sv[1]  # the best proper rotation's
+    disparity = max(0.0, 1.0 - fit**2)  # of the unit-norm sets
+    rms_px = np.sqrt(disparity / len(a)) * na
+    return float(rms_px / max(np.ptp(a, axis=0).max(), 1e-12))
+
+
+def check_distinct_photos(photos):
+    """Raise when two photos of one person are copies of one photo (:data:`COPY_FRACTION`):
+    counted twice, one photo's evidence would lift the single-photo cap and double its weight.
+
+    Parameters
+    ----------
+    photos : list of Photo
+        The photos of one case (or of one lineup candidate).
+
+    Raises
+    ------
+    ValueError
+        Naming both landmark files (or photos) and the fix.
+    """
+    for i, p in enumerate(photos):
+        for q in photos[i + 1 :]:
+            common = [n for n in p.landmarks_uv if n in q.landmarks_uv]
+            if len(common) < 4 or p.view != q.view:
+                continue
+            residual = copy_residual(
+                [p.landmarks_uv[n] for n in common], [q.landmarks_uv[n] for n in common]
+            )
+            if residual <= COPY_FRACTION:
+                a = p.landmarks_file or f"photo {p.id!r}"
+                b = q.landmarks_file or f"photo {q.id!r}"
+                raise ValueError(
+                    f"{b}: its {len(common)} landmarks lie where {a} has them (to "
+                    f"{residual:.2%} of their extent after scaling): the two are one photo "
+                    "(a copy, perhaps resized); give each photo once, or it counts as two "
+                    "views of the person"
+                )
+
+
 def coincident_pairs(landmarks):
     """Base names of the bilateral pairs whose twins lie at one place: closer than
     :data:`PAIR_REVERSED_FRACTION` of the landmarks' extent (2D or 3D points)."""
