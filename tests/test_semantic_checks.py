@@ -237,3 +237,33 @@ def test_a_camera_just_outside_a_prior_reads_apart_from_its_bound():
 
     assert _apart(3554.6, (3555.2, 3929.0)) == "3554.6"
     assert _apart(3000.0, (3555.2, 3929.0)) == "3000"
+
+
+def test_a_camera_far_outside_its_prior_is_never_support(case, tmp_path, capsys):
+    """POSEST-SFO (no priors in its fit) on the stand-in with a distance prior 4 x the true
+    distance: the camera contradicts what is known of the photo, so no support."""
+    import json
+
+    from cli_helpers import _run
+
+    subject_dir, photo_dir = case
+    meta = json.loads((photo_dir / "photo.json").read_text())
+    runs = {}
+    for name, scale in (("kept", 1.0), ("far", 4.0)):
+        folder = tmp_path / name
+        folder.mkdir()
+        for p in photo_dir.iterdir():
+            (folder / p.name).write_bytes(p.read_bytes())
+        edited = dict(meta, priors=dict(meta["priors"]))
+        edited["priors"]["scd_mm"] = [x * scale for x in meta["priors"]["scd_mm"]]
+        (folder / "photo.json").write_text(json.dumps(edited))
+        out = tmp_path / f"out-{name}"
+        argv = ["sfo", "--method", "posest-sfo", "--skull", subject_dir, "--photo", folder]
+        code, _, err = _run(argv + ["--out", out, "--no-overlay"], capsys)
+        assert code == 0, err
+        runs[name] = json.loads((out / "result.json").read_text())["identification"]
+    assert runs["kept"]["conclusion"].endswith("support") and not runs["kept"]["inconsistent"]
+    far = runs["far"]
+    assert far["log10_lr"] == pytest.approx(runs["kept"]["log10_lr"])  # the same camera
+    assert far["conclusion"] == "undetermined"
+    assert "x outside its prior" in far["inconsistent"]["camera_outside_prior"]

@@ -24,6 +24,7 @@ from ..identification.conclusion import conclude, material_caps
 from ..identification.score import identification_terms, nll_score
 from ..inputs import correspondences
 from ..io.calibration import read_calibration, shipped_cohort, shipped_path
+from ..methods.checks import prior_conflicts
 
 #: Cranial landmarks on the mandible: a skull with none of them has no mandible.
 MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")
@@ -61,17 +62,22 @@ def decision_key(method, variant, photos, joint=False):
     return f"{method}/{variant or ''}/{_group(photos[0])}"
 
 
-def _inconsistent(results, terms):
+def _inconsistent(photos, results, terms, facial_landmarks_mm):
     out = {}
     outside = terms.get("outside_fraction")
     if outside:
         out["skull_outside_head"] = (
             f"{100 * outside:.2g} % of the skull's pixels lie outside the head mask"
         )
-    for result in results:
+    conflicts = []
+    for photo, result in zip(photos, results, strict=True):
         for w in result.warnings:
             if w.code == "view_mismatch":
                 out["view_mismatch"] = w.message
+        facial = getattr(result, "facial_landmarks_mm", None) or facial_landmarks_mm
+        conflicts += prior_conflicts(photo, result.camera, facial)
+    if conflicts:
+        out["camera_outside_prior"] = "; ".join(conflicts)
     return out
 
 
@@ -185,7 +191,7 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
         record["calibration"]["provenance"] = model.provenance
         if len(photos) > 1 and not joint:
             note = "calibrated on one frontal and one lateral photo; these photos differ"
-    inconsistent = _inconsistent(results, terms)
+    inconsistent = _inconsistent(photos, results, terms, facial)
     verdict = conclude(lr, caps, inconsistent)
     return record | {
         "score": nll_score(terms),

@@ -375,6 +375,50 @@ def scd_point_mm(facial_landmarks_mm):
     return np.mean([np.asarray(v, float) for v in facial_landmarks_mm.values()], axis=0)
 
 
+#: A camera whose focal length or subject-to-camera distance lies farther than this factor
+#: outside its prior interval (below ``lo / factor`` or above ``hi * factor``) contradicts what
+#: is known of the photo: its conclusion is never support (a consistency failure,
+#: ``camera_outside_prior``). POSEST-SFO's mean soft tissue commonly trades focal length for
+#: distance by up to about 1.9 x on generated frontal photos; a camera 4 x closer than its
+#: distance prior was "limited support" before.
+PRIOR_CONFLICT_FACTOR = 2.0
+
+
+def prior_conflicts(photo, camera, facial_landmarks_mm=None, factor=PRIOR_CONFLICT_FACTOR):
+    """The camera's focal length and distance that lie beyond ``factor`` outside their priors.
+
+    Parameters
+    ----------
+    photo : Photo
+    camera : Camera
+    facial_landmarks_mm : dict, optional
+        The estimated facial landmarks (the distance is measured to their nasion or centroid);
+        without them the distance is not checked.
+    factor : float
+
+    Returns
+    -------
+    list of str
+        One sentence per value, naming it, its prior and the factor.
+    """
+    p = photo.priors
+    checks = [("focal length", camera.focal_px, p.focal_px, "px")]
+    if facial_landmarks_mm:
+        scd = camera.distance_mm(scd_point_mm(facial_landmarks_mm))
+        checks.append(("subject-to-camera distance", float(np.ravel(scd)[0]), p.scd_mm, "mm"))
+    out = []
+    for label, value, bounds, unit in checks:
+        if bounds is None or value <= 0:
+            continue
+        off = max(bounds[0] / value, value / bounds[1])
+        if off > factor:
+            out.append(
+                f"the {label} found, {fmt_number(value)} {unit}, lies {off:.1f} x outside its "
+                f"prior {fmt_range(*bounds, unit)} in photo {photo.id!r}"
+            )
+    return out
+
+
 def _apart(value, bounds):
     """``value`` as :func:`fmt_number` writes it, with decimals added while it reads like one of
     ``bounds`` (3554.6 px just under a prior from 3555 px is not "3555 px")."""
