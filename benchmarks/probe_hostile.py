@@ -19,7 +19,9 @@ import-ct`` and ``lilium synth`` (EXIF, image modes, DICOM series, NIfTI affines
 ``probe_hostile_inputs.py``; degenerate or damaged geometry (mesh fragments, unreferenced vertices,
 twins at one place, planar landmarks, masks of every pixel) in ``probe_hostile_geometry.py``; the
 same case transformed in ways that must not change the answer (resampled, padded, another file
-format, the skull moved, inputs in another order) in ``probe_hostile_metamorphic.py``. ::
+format, the skull moved, inputs in another order) in ``probe_hostile_metamorphic.py``; what
+the HTML reports and the console show against each ``result.json`` in
+``probe_hostile_report.py``. ::
 
     python benchmarks/probe_hostile.py --work /tmp/probes [--only SUBSTRING] [--limit-s 60]
 
@@ -541,6 +543,7 @@ def all_probes():
     from probe_hostile_inputs import input_probes
     from probe_hostile_metamorphic import metamorphic_probes
     from probe_hostile_outputs import output_probes
+    from probe_hostile_report import report_probes
     from probe_hostile_resume import resume_probes
     from probe_hostile_runs import run_probes
     from probe_hostile_semantic import semantic_probes
@@ -560,6 +563,7 @@ def all_probes():
         + semantic_probes()
         + geometry_probes()
         + metamorphic_probes()
+        + report_probes()
     )
 
 

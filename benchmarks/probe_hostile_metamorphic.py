@@ -974,7 +974,7 @@ def _half_photo(ws):
     from standin_case import scaled_photo
 
     if not _half(ws).exists():
-        scaled_photo(ws.photo, _half(ws), 0.5)
+        scaled_photo(ws.photo, _half(ws), 0.5, moved=0.0)  # a resized copy of the photo
 
 
 # -- the probes --------------------------------------------------------------------------------
