@@ -42,6 +42,8 @@ def face_components(faces, n_vertices):
         vertex_root = np.full(int(labels.max()) + 1, n_vertices)
         np.minimum.at(vertex_root, labels, np.arange(n_vertices))
         roots = vertex_root[labels[faces[:, 0]]]
+    if np.all(roots == roots[0]):
+        return np.zeros(len(faces), np.int64)  # one piece (most meshes): no sort
     return np.unique(roots, return_inverse=True)[1].reshape(-1).astype(np.int64)
 
 
