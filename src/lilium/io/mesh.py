@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import PART_APART_MM
+from ..geometry.mesh import parts_apart, weld
 from .paths import naming_errors
 
 MESH_SUFFIXES = (".ply", ".obj", ".stl")
@@ -80,8 +82,6 @@ def read_mesh(path):
             vertices, faces = fast
             if len(vertices) > len(faces) and _indexed(vertices, faces):
                 # More vertices than faces: loose triangles (a closed mesh has about F / 2)
-                from ..geometry.mesh import weld
-
                 vertices, faces = weld(vertices, faces)
             check_mesh(vertices, faces, str(path))
             return vertices, faces
@@ -99,8 +99,6 @@ def read_mesh(path):
     vertices = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=float)
     faces = np.asarray(getattr(mesh, "faces", np.empty((0, 3))), dtype=np.int64)
     if _indexed(vertices, faces):
-        from ..geometry.mesh import weld
-
         vertices, faces = weld(vertices, faces)  # an STL's loose triangles, an OBJ's seams
     check_mesh(vertices, faces, str(path))
     return vertices, faces
@@ -213,9 +211,6 @@ def check_mesh(vertices_mm, faces, source="mesh"):
 def _largest_part_extent_mm(vertices_mm, faces):
     """Largest side of the bounding box of the mesh without its parts apart from the part with
     the most faces (:func:`~lilium.geometry.mesh.parts_apart`)."""
-    from ..constants import PART_APART_MM
-    from ..geometry.mesh import parts_apart
-
     apart, _ = parts_apart(vertices_mm, faces, None, PART_APART_MM)
     corners = faces[~apart].reshape(-1)
     return float(np.ptp(vertices_mm[corners], axis=0).max())
