@@ -270,6 +270,8 @@ def test_case_joint_reports_every_photo_and_the_shared_landmarks(pair, tmp_path,
         assert f"<td>{name}</td>" in html
     assert relative_href(f"joint/lilium-skof+pll/overlay_{photo_dirs[1].name}.png") in html
     assert "--joint" in html  # the provenance's command line
+    # each photo's section shows its own fitness, named as result.json names it
+    assert html.count("of this photo alone (result.json: <code>fitness_unweighted</code>)") == 2
     log = capsys.readouterr().out
     assert "joint (" in log
     # --joint needs two photos.

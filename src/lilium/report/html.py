@@ -333,6 +333,9 @@ def _terms_table(sfo):
         if k.startswith("p_cam_")
     ]
     score = f"method's own score ({_e(sfo.summary.score_label)})"
+    if sfo.method_label.endswith(" joint"):
+        # result.json's photos[k]: "fitness" is the weighted share, this the unweighted one
+        score += " of this photo alone (result.json: <code>fitness_unweighted</code>)"
     rows.append([f"<b>{score}</b>", f"<b>{_num(sfo.fitness, '{:.4g}')}</b>"])
     s = sfo.summary
     if s.mean_error_px is not None:
