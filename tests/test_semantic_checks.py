@@ -239,9 +239,10 @@ def test_a_camera_just_outside_a_prior_reads_apart_from_its_bound():
     assert _apart(3000.0, (3555.2, 3929.0)) == "3000"
 
 
-def test_a_camera_far_outside_its_prior_is_never_support(case, tmp_path, capsys):
-    """POSEST-SFO (no priors in its fit) on the stand-in with a distance prior 4 x the true
-    distance: the camera contradicts what is known of the photo, so no support."""
+def test_a_camera_whose_perspective_contradicts_its_prior_is_never_support(case, tmp_path, capsys):
+    """POSEST-SFO (no priors in its fit) on the stand-in (about 900 mm away) with a distance
+    prior of a quarter and of twice that: the first contradicts the camera's perspective (no
+    support), the second does not (focal length and distance trade; the same picture)."""
     import json
 
     from cli_helpers import _run
@@ -249,7 +250,7 @@ def test_a_camera_far_outside_its_prior_is_never_support(case, tmp_path, capsys)
     subject_dir, photo_dir = case
     meta = json.loads((photo_dir / "photo.json").read_text())
     runs = {}
-    for name, scale in (("kept", 1.0), ("far", 4.0)):
+    for name, scale in (("kept", 1.0), ("near", 0.25), ("far", 2.0)):
         folder = tmp_path / name
         folder.mkdir()
         for p in photo_dir.iterdir():
@@ -263,7 +264,8 @@ def test_a_camera_far_outside_its_prior_is_never_support(case, tmp_path, capsys)
         assert code == 0, err
         runs[name] = json.loads((out / "result.json").read_text())["identification"]
     assert runs["kept"]["conclusion"].endswith("support") and not runs["kept"]["inconsistent"]
-    far = runs["far"]
-    assert far["log10_lr"] == pytest.approx(runs["kept"]["log10_lr"])  # the same camera
-    assert far["conclusion"] == "undetermined"
-    assert "x outside its prior" in far["inconsistent"]["camera_outside_prior"]
+    near, far = runs["near"], runs["far"]
+    assert near["log10_lr"] == pytest.approx(runs["kept"]["log10_lr"])  # the same camera
+    assert near["conclusion"] == "undetermined"
+    assert "the perspective over the face's depth" in near["inconsistent"]["perspective_mismatch"]
+    assert far["conclusion"] == runs["kept"]["conclusion"] and not far["inconsistent"]

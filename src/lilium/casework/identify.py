@@ -24,7 +24,7 @@ from ..identification.conclusion import conclude, material_caps
 from ..identification.score import identification_terms, nll_score
 from ..inputs import correspondences
 from ..io.calibration import read_calibration, shipped_cohort, shipped_path
-from ..methods.checks import prior_conflicts
+from ..methods.checks import perspective_conflict
 
 #: Cranial landmarks on the mandible: a skull with none of them has no mandible.
 MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")
@@ -75,9 +75,9 @@ def _inconsistent(photos, results, terms, facial_landmarks_mm):
             if w.code == "view_mismatch":
                 out["view_mismatch"] = w.message
         facial = getattr(result, "facial_landmarks_mm", None) or facial_landmarks_mm
-        conflicts += prior_conflicts(photo, result.camera, facial)
-    if conflicts:
-        out["camera_outside_prior"] = "; ".join(conflicts)
+        conflicts.append(perspective_conflict(photo, result.camera, facial))
+    if any(conflicts):
+        out["perspective_mismatch"] = "; ".join(c for c in conflicts if c)
     return out
 
 

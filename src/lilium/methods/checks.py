@@ -375,48 +375,56 @@ def scd_point_mm(facial_landmarks_mm):
     return np.mean([np.asarray(v, float) for v in facial_landmarks_mm.values()], axis=0)
 
 
-#: A camera whose focal length or subject-to-camera distance lies farther than this factor
-#: outside its prior interval (below ``lo / factor`` or above ``hi * factor``) contradicts what
-#: is known of the photo: its conclusion is never support (a consistency failure,
-#: ``camera_outside_prior``). POSEST-SFO's mean soft tissue commonly trades focal length for
-#: distance by up to about 1.9 x on generated frontal photos; a camera 4 x closer than its
-#: distance prior was "limited support" before.
-PRIOR_CONFLICT_FACTOR = 2.0
+#: Depth of a face along the line of sight (mm, nose tip to ear) over which a camera's
+#: perspective is judged (:func:`perspective_conflict`).
+FACE_DEPTH_MM = 100.0
+
+#: A camera whose perspective over the face's depth differs from the one its distance prior
+#: allows by more than this share contradicts what is known of the photo: its conclusion is
+#: never support (a consistency failure, ``perspective_mismatch``).
+PERSPECTIVE_MISMATCH = 0.1
 
 
-def prior_conflicts(photo, camera, facial_landmarks_mm=None, factor=PRIOR_CONFLICT_FACTOR):
-    """The camera's focal length and distance that lie beyond ``factor`` outside their priors.
+def perspective_conflict(photo, camera, facial_landmarks_mm):
+    """The camera's distance when its perspective contradicts the photo's distance prior.
+
+    The perspective of a camera at distance ``d`` magnifies the front of a face
+    ``FACE_DEPTH_MM`` deep by ``D / d`` more than its back; the camera contradicts the prior
+    ``[lo, hi]`` when ``D |1/d - 1/d'|`` exceeds :data:`PERSPECTIVE_MISMATCH` for ``d'`` the
+    nearest distance the prior allows. Focal length and distance trade against each other
+    (POSEST-SFO's mean soft tissue often lands at twice the true distance and focal length on
+    a photo from 2.5 m: the same picture, 0.02 apart in perspective), so only a camera whose
+    perspective differs is a contradiction: 204 mm from a face photographed from 810-990 mm
+    (0.37 apart) read "limited support" before.
 
     Parameters
     ----------
     photo : Photo
     camera : Camera
-    facial_landmarks_mm : dict, optional
+    facial_landmarks_mm : dict or None
         The estimated facial landmarks (the distance is measured to their nasion or centroid);
-        without them the distance is not checked.
-    factor : float
+        None: nothing to measure.
 
     Returns
     -------
-    list of str
-        One sentence per value, naming it, its prior and the factor.
+    str or None
+        A sentence naming the distance, the prior and the difference; None when consistent.
     """
-    p = photo.priors
-    checks = [("focal length", camera.focal_px, p.focal_px, "px")]
-    if facial_landmarks_mm:
-        scd = camera.distance_mm(scd_point_mm(facial_landmarks_mm))
-        checks.append(("subject-to-camera distance", float(np.ravel(scd)[0]), p.scd_mm, "mm"))
-    out = []
-    for label, value, bounds, unit in checks:
-        if bounds is None or value <= 0:
-            continue
-        off = max(bounds[0] / value, value / bounds[1])
-        if off > factor:
-            out.append(
-                f"the {label} found, {fmt_number(value)} {unit}, lies {off:.1f} x outside its "
-                f"prior {fmt_range(*bounds, unit)} in photo {photo.id!r}"
-            )
-    return out
+    bounds = photo.priors.scd_mm
+    if bounds is None or not facial_landmarks_mm:
+        return None
+    found = float(np.ravel(camera.distance_mm(scd_point_mm(facial_landmarks_mm)))[0])
+    if found <= 0:
+        return None
+    nearest = min(max(found, bounds[0]), bounds[1])
+    apart = FACE_DEPTH_MM * abs(1.0 / found - 1.0 / nearest)
+    if apart <= PERSPECTIVE_MISMATCH:
+        return None
+    return (
+        f"the camera found is {fmt_number(found)} mm from the face of photo {photo.id!r}, its "
+        f"distance prior {fmt_range(*bounds, 'mm')}: the perspective over the face's depth "
+        f"differs by {apart:.0%} (more than {PERSPECTIVE_MISMATCH:.0%})"
+    )
 
 
 def _apart(value, bounds):
