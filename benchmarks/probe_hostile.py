@@ -21,7 +21,8 @@ twins at one place, planar landmarks, masks of every pixel) in ``probe_hostile_g
 same case transformed in ways that must not change the answer (resampled, padded, another file
 format, the skull moved, inputs in another order) in ``probe_hostile_metamorphic.py``; what
 the HTML reports and the console show against each ``result.json`` in
-``probe_hostile_report.py``. ::
+``probe_hostile_report.py``; experiments, reports and calibrations that must repeat whatever
+the workers, resumes and orders in ``probe_hostile_determinism.py``. ::
 
     python benchmarks/probe_hostile.py --work /tmp/probes [--only SUBSTRING] [--limit-s 60]
 
@@ -539,6 +540,7 @@ def photo_and_ct_probes():
 def all_probes():
     # The newer entry points' probes live in their own module (each reads in one sitting).
     from probe_hostile_casework import casework_probes
+    from probe_hostile_determinism import determinism_probes
     from probe_hostile_geometry import geometry_probes
     from probe_hostile_inputs import input_probes
     from probe_hostile_metamorphic import metamorphic_probes
@@ -564,6 +566,7 @@ def all_probes():
         + geometry_probes()
         + metamorphic_probes()
         + report_probes()
+        + determinism_probes()
     )
 
 

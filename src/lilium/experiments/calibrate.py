@@ -25,6 +25,7 @@ photo once.
 - ``joint``: a joint SFO (SPEC section 9) of the pair: its shared soft tissue and two cameras.
 """
 
+import hashlib
 import json
 from collections import defaultdict
 from pathlib import Path
@@ -51,7 +52,7 @@ from ..io.calibration import shipped_cohort
 from ..io.case import read_photo, read_skull
 from ..synthetic.subjects import axes_on_skull, make_subjects
 from .config import view_group
-from .store import COLUMNS, ResultStore
+from .store import COLUMNS, ResultStore, task_key
 
 #: Key of an SFO's identification terms in its stored ``result`` JSON (the runner writes
 #: them; ``_joint``: a joint SFO's decision over both photos, on its frontal row).
@@ -146,19 +147,19 @@ def stored_rows(db):
         read, naming the database and the row.
     """
     with ResultStore(db, read_only=True) as store:
-        rows = [dict(r) for r in store.rows(list(COLUMNS))]
+        rows = [dict(r) for r in store.rows(list(COLUMNS), with_id=True)]
         config = store.get_meta("config")
-    for k, r in enumerate(rows):
-        r["data"] = _stored_result(db, k, r.get("result"))
+    for r in rows:
+        r["data"] = _stored_result(db, r.pop("id"), r.get("result"))
     return rows, (config or {}).get("dataset")
 
 
-def _stored_result(db, k, text):
-    """Row ``k``'s ``result`` JSON parsed and checked (None when empty)."""
+def _stored_result(db, row_id, text):
+    """The ``result`` JSON of the row of id ``row_id``, parsed and checked (None when empty)."""
 
     def damaged(what):
         return ValueError(
-            f"{db}: row {k + 1} holds {what}; the database was edited or damaged: restore it, "
+            f"{db}: row {row_id} holds {what}; the database was edited or damaged: restore it, "
             "or delete that row (lilium experiment then runs its SFO again)"
         )
 
@@ -333,6 +334,7 @@ def decisions(rows, terms, inputs=None, cohort_cache=None):
             (r, t)
         )
     for (run, person, skull_id), groups in sorted(by_person.items()):
+        # The k-th frontal with the k-th lateral photo, in photo-id order (the rows' key order)
         for (fr, ft), (lr, lt) in zip(groups.get("frontal", []), groups.get("lateral", []),
                                       strict=False):
             joint = run[1] == "lilium-joint"
@@ -495,11 +497,22 @@ def fit_models(decision_pairs, provenance, log=print, validated=None):
     return models
 
 
+def _content_key(rows):
+    """A SHA-256 of a database's rows (their keys and results, in key order)."""
+    digest = hashlib.sha256()
+    for r in rows:
+        digest.update(repr(task_key(r)).encode())
+        digest.update(str(r.get("result") or "").encode())
+    return digest.hexdigest()
+
+
 def database_decisions(dbs, dataset=None, log=print):
     """The decisions of one or several results databases, pooled.
 
     Subjects of different databases are different people even when their ids agree (two
-    dataset seeds both have an ``s01``), so each id is prefixed with its database's index.
+    dataset seeds both have an ``s01``), so each id is prefixed with its database's index, the
+    databases taken in the order of their contents (:func:`_content_key`), whatever the order
+    they are given in.
 
     Parameters
     ----------
@@ -516,8 +529,11 @@ def database_decisions(dbs, dataset=None, log=print):
         Every row, with its ``terms`` and the database index ``db``.
     """
     pooled, all_rows = defaultdict(list), []
-    for k, db in enumerate(dbs):
-        rows, root = stored_rows(db)
+    read = [(db, *stored_rows(db)) for db in dbs]
+    # In the order of their contents, not of the command line: the subject folds are dealt
+    # from the prefixed ids, so the cross-validated figures must not depend on that order.
+    read.sort(key=lambda item: _content_key(item[1]))
+    for k, (db, rows, root) in enumerate(read):
         root = dataset or root
         inputs = DatasetInputs(root) if root and Path(root, "dataset.json").is_file() else None
         cache = {}

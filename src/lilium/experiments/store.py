@@ -284,17 +284,24 @@ class ResultStore:
     def count(self):
         return self.conn.execute("SELECT COUNT(*) FROM sfo").fetchone()[0]
 
-    def rows(self, columns=None):
-        """All rows as dicts (``columns`` default: every column but ``result``)."""
-        columns = columns or [c for c in COLUMNS if c != "result"]
-        cur = self.conn.execute(f"SELECT {', '.join(columns)} FROM sfo ORDER BY id")
-        rows = [dict(zip(columns, r, strict=True)) for r in cur.fetchall()]
+    def rows(self, columns=None, with_id=False):
+        """All rows as dicts (``columns`` default: every column but ``result``), in the order
+        of their key (:data:`KEY_COLUMNS`), not of their insertion: which worker finished
+        first, a resume or a Dask run must not change what a report or a calibration pairs
+        and sums. ``with_id``: each dict also holds the row's ``id`` (what messages name)."""
+        columns = list(columns or [c for c in COLUMNS if c != "result"])
+        order = ", ".join(KEY_COLUMNS)
+        cur = self.conn.execute(f"SELECT id, {', '.join(columns)} FROM sfo ORDER BY {order}")
+        fetched = cur.fetchall()
+        rows = [dict(zip(columns, r[1:], strict=True)) for r in fetched]
         numeric = [c for c in columns if c in _NUMERIC_COLUMNS]
-        for k, row in enumerate(rows):  # SQLite stores any value in any column
+        for (row_id, *_), row in zip(fetched, rows, strict=True):  # SQLite: any value anywhere
+            if with_id:
+                row["id"] = row_id
             for c in numeric:
                 if row[c] is not None and not isinstance(row[c], (int, float)):
                     raise ValueError(
-                        f"{self.path}: row {k + 1} holds {str(row[c])[:40]!r} in the numeric "
+                        f"{self.path}: row {row_id} holds {str(row[c])[:40]!r} in the numeric "
                         f"column {c}; the database was edited or damaged: restore it, or delete "
                         "that row (lilium experiment then runs its SFO again)"
                     )

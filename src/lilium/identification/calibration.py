@@ -402,20 +402,23 @@ def cllr(log10_lr, same):
 
 def pav_log10_lr(scores, same):
     """The pool-adjacent-violators log10 LR of ``scores`` (higher = more likely the same):
-    the best monotone calibration of these very scores (for Cllr_min)."""
+    the best monotone calibration of these very scores (for Cllr_min). Pairs of equal score
+    are pooled first (one LR for all of them, from their share of same-person pairs), so the
+    result does not depend on the order the pairs come in."""
     scores = np.asarray(scores, float)
     same = np.asarray(same, bool)
-    order = np.argsort(scores, kind="stable")
     from scipy.optimize import isotonic_regression
 
-    post = isotonic_regression(same[order].astype(float)).x
+    _, inverse, counts = np.unique(scores, return_inverse=True, return_counts=True)
+    inverse = inverse.reshape(-1)
+    share = np.bincount(inverse, weights=same.astype(float)) / counts
+    post = isotonic_regression(share, weights=counts.astype(float)).x[inverse]
     n1, n0 = same.sum(), (~same).sum()
     eps = 1e-12
     with np.errstate(divide="ignore"):
-        lr = np.log10(np.clip(post, eps, 1 - eps) / np.clip(1 - post, eps, 1)) - np.log10(n1 / n0)
-    out = np.empty_like(scores)
-    out[order] = lr
-    return out
+        return np.log10(np.clip(post, eps, 1 - eps) / np.clip(1 - post, eps, 1)) - np.log10(
+            n1 / n0
+        )
 
 
 def performance(log10_lr, same):
