@@ -320,3 +320,30 @@ def test_demo_options_name_themselves(case, tmp_path, capsys, args, needle):
     args = [str(case[0] / "skull.ply") if a is None else a for a in args]
     line = _one_line_error(capsys, ["demo", *args], needle)
     assert "Not a directory" not in line and "non-negative integer" not in line
+
+
+def test_report_says_on_the_console_when_the_lr_is_not_computed(tmp_path, capsys):
+    """Rows without stored terms whose dataset has moved: the report is written, and the
+    console (not only report.md) says the LR is missing and how to give the dataset; a
+    --dataset that is no dataset is a one-line error."""
+    import json
+
+    from lilium.experiments.store import ResultStore
+    from standin_case import terms_database
+
+    db = terms_database(
+        tmp_path / "r.sqlite", result=lambda k, data: json.dumps({"camera": data["camera"]})
+    )
+    with ResultStore(db) as store:
+        store.set_meta("config", {"dataset": str(tmp_path / "moved")})
+    code, _, err = _run(["report", db, "--out", tmp_path / "rep"], capsys)
+    assert code == 0, err
+    assert "Identification LR not computed" in (tmp_path / "rep" / "report.md").read_text()
+    assert "lilium report: warning: identification LR not computed" in err
+    assert "give --dataset DIR" in err
+    _one_line_error(
+        capsys,
+        ["report", db, "--out", tmp_path / "rep2", "--dataset", tmp_path / "moved"],
+        "--dataset",
+        "give the dataset folder lilium synth wrote",
+    )

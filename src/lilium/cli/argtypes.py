@@ -111,6 +111,21 @@ def existing_file(what):
 
 
 @_path_checked
+def dataset_folder(text):
+    """A folder ``lilium synth`` wrote (it holds ``dataset.json``)."""
+    path = Path(text)
+    if not (path / "dataset.json").is_file():
+        state = "not found" if not path.exists() else "holds no dataset.json"
+        raise argparse.ArgumentTypeError(
+            f"{text}: {state}; give the dataset folder lilium synth wrote"
+        )
+    return path
+
+
+dataset_folder.__name__ = "dataset folder"
+
+
+@_path_checked
 def output_folder(text):
     """An output folder that exists or can be made, and can be written to.
 

@@ -3,7 +3,7 @@
 import time
 from pathlib import Path
 
-from .argtypes import output_folder
+from .argtypes import dataset_folder, output_folder
 
 
 def register(subparsers):
@@ -23,7 +23,7 @@ def register(subparsers):
     p.add_argument("--out", type=output_folder, required=True, help="output folder")
     p.add_argument(
         "--dataset",
-        type=Path,
+        type=dataset_folder,
         help="the dataset folder, when it moved since the databases were written",
     )
     p.set_defaults(func=run)

@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from .argtypes import output_folder
+from .argtypes import dataset_folder, output_folder
 
 
 def register(subparsers):
@@ -17,12 +17,23 @@ def register(subparsers):
     )
     p.add_argument("db", type=Path, help="results database written by lilium experiment")
     p.add_argument("--out", type=output_folder, required=True, help="output folder")
+    p.add_argument(
+        "--dataset",
+        type=dataset_folder,
+        help="the dataset folder, when it moved since the database was written (for the "
+        "identification LR of rows without stored terms)",
+    )
     p.set_defaults(func=run)
 
 
 def run(args):
+    import sys
+
     from ..experiments.report import write_report
 
-    paths = write_report(args.db, args.out)
+    def warn(line):
+        print(f"lilium report: warning: {line}", file=sys.stderr)
+
+    paths = write_report(args.db, args.out, dataset=args.dataset, log=warn)
     print(f"report: {paths['markdown']} ({len(paths)} files in {args.out})")
     return 0

@@ -524,9 +524,13 @@ def check_database_not_output(db, out_dir):
             )
 
 
-def write_report(db, out_dir):
+def write_report(db, out_dir, dataset=None, log=None):
     """Write ``report.md``, the CSV tables and the PNG plots (:data:`REPORT_FILES`) to
     ``out_dir``; a database one of them would overwrite is refused first.
+
+    ``dataset``: the dataset folder when it moved since the database was written (its rows
+    without stored terms need it for the identification LR); ``log`` receives one line when
+    the LR could not be computed (the report says so too).
 
     Returns
     -------
@@ -565,7 +569,9 @@ def write_report(db, out_dir):
         t["score"] = SCORE_FITNESS
     lr_note = ""
     try:
-        lr_paths, lr_table, _, _ = lr_identification([db], out_dir, log=lambda line: None)
+        lr_paths, lr_table, _, _ = lr_identification(
+            [db], out_dir, dataset=dataset, log=lambda line: None
+        )
         paths.update(lr_paths)
         identification += lr_table
         lr_note = (
@@ -577,6 +583,8 @@ def write_report(db, out_dir):
         )
     except (ValueError, OSError) as exc:
         lr_note = f"\n\nIdentification LR not computed: {exc}.\n"
+        if log is not None:
+            log(f"identification LR not computed: {exc}")
     paths.update(write_identification(rows, identification, out_dir))
     md = out_dir / "report.md"
     md.write_text(
