@@ -570,6 +570,78 @@ def all_probes():
     )
 
 
+def run_group(probes, label, doc, argv=None, limit_s=60, base=None, note=None, hooks=None):
+    """Run one group of probes alone, with the verdicts of :func:`main`, and print one line per
+    probe that did not pass (every probe with ``--verbose``) and a summary; 0 when all passed.
+
+    Parameters
+    ----------
+    probes : callable
+        Returns the group's list of :class:`Probe`.
+    label, doc : str
+        The summary line's name; the module docstring (its first paragraph is the help).
+    limit_s : int
+        The default ``--limit-s``.
+    base : callable, optional
+        ``base(folder)`` writes the probes' shared inputs (default: the stand-in case).
+    note : callable, optional
+        ``note(probe, ws, verdict, verbose)``: text added to the probe's line ("" for none);
+        a probe's line is printed whenever the note has text.
+    hooks : dict, optional
+        ``"arguments"``: ``f(parser)`` adds options; ``"before"``: ``f(args, base)`` runs
+        before the probes and may return an exit status that ends the run there; ``"after"``:
+        ``f()`` runs after them (e.g. to close a cluster).
+    """
+    hooks = hooks or {}
+    parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    parser.add_argument("--work", type=Path, required=True, help="scratch folder (emptied)")
+    parser.add_argument("--only", help="run the probes whose name holds this text")
+    parser.add_argument("--limit-s", type=int, default=limit_s, help="time limit per probe")
+    parser.add_argument("--list", action="store_true", help="list the probes and stop")
+    parser.add_argument("--verbose", action="store_true", help="a line for every probe")
+    parser.add_argument("--keep", action="store_true", help="keep each probe's folder")
+    if "arguments" in hooks:
+        hooks["arguments"](parser)
+    args = parser.parse_args(argv)
+    args.work = args.work.resolve()
+    os.environ.pop("LILIUM_DEBUG", None)  # as users run it: the CLI's own handlers on
+    chosen = [p for p in probes() if not args.only or args.only in p.name]
+    if args.list:
+        for p in chosen:
+            print(f"{p.expect:5} {p.name}")
+        print(f"{len(chosen)} probes")
+        return 0
+    if args.work.exists():
+        shutil.rmtree(args.work)
+    shared = args.work / "base"
+    if base is None:
+        from standin_case import make_standin_case
+
+        make_standin_case(shared, seed=0)
+    else:
+        base(shared)
+    if "before" in hooks and (code := hooks["before"](args, shared)) is not None:
+        return code
+    counts, start = collections.Counter(), time.monotonic()
+    for k, probe in enumerate(chosen):
+        ws = Workspace(args.work / f"p{k:03d}", shared)
+        try:
+            verdict, seconds, detail = run_probe(probe, ws, args.limit_s)
+        except Exception as exc:  # noqa: BLE001 - a probe's own set-up or check failed
+            verdict, seconds, detail = "traceback", 0.0, f"probe set-up/check: {exc!r}"
+        counts[verdict] += 1
+        extra = note(probe, ws, verdict, args.verbose) if note is not None else ""
+        if verdict != "pass" or args.verbose or extra:
+            print(f"[{verdict}] {probe.name} ({seconds:.1f} s): {detail}{extra}", flush=True)
+        if not args.keep:
+            shutil.rmtree(ws.root, ignore_errors=True)
+    if "after" in hooks:
+        hooks["after"]()
+    parts = ", ".join(f"{v} {counts[v]}" for v in VERDICTS)
+    print(f"{label}: {len(chosen)} probes in {time.monotonic() - start:.0f} s: {parts}")
+    return 0 if counts["pass"] == len(chosen) else 1
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--work", type=Path, required=True, help="scratch folder (emptied)")

@@ -38,7 +38,6 @@ prints one line per probe (``--verbose``: with what was measured), the counts pe
 exits 1 when a probe did not pass.
 """
 
-import argparse
 import atexit
 import collections
 import csv
@@ -50,10 +49,9 @@ import shutil
 import sqlite3
 import subprocess
 import sys
-import time
 from pathlib import Path
 
-from probe_hostile import VERDICTS, Probe, Workspace, run_probe
+from probe_hostile import Probe, Workspace
 from probe_hostile_casework import _quiet_main
 from probe_hostile_runs import _in
 
@@ -843,50 +841,26 @@ def determinism_probes():
 # fmt: on
 
 
+def _measured(probe, ws, verdict, verbose):
+    """What a probe measured: always for the known limit, for every probe with --verbose."""
+    measured = MEASURED.get(ws.root.name)
+    return f" -- {measured}" if measured and (verbose or "known limit" in probe.name) else ""
+
+
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--work", type=Path, required=True, help="scratch folder (emptied)")
-    parser.add_argument("--only", help="run the probes whose name holds this text")
-    parser.add_argument("--limit-s", type=int, default=120, help="time limit per probe")
-    parser.add_argument("--list", action="store_true", help="list the probes and stop")
-    parser.add_argument("--verbose", action="store_true", help="what each probe measured")
-    parser.add_argument("--keep", action="store_true", help="keep each probe's folder")
-    args = parser.parse_args(argv)
-    os.environ.pop("LILIUM_DEBUG", None)  # as users run it: the CLI's own handlers on
-    probes = [p for p in determinism_probes() if not args.only or args.only in p.name]
-    if args.list:
-        for p in probes:
-            print(f"{p.expect:5} {p.name}")
-        print(f"{len(probes)} probes")
-        return 0
-    if args.work.exists():
-        shutil.rmtree(args.work)
-    base = args.work / "base"  # the probes bring their own inputs
-    base.mkdir(parents=True)
-    counts = collections.Counter()
-    start = time.monotonic()
-    for k, probe in enumerate(probes):
-        ws = Workspace(args.work / f"p{k:03d}", base)
-        t0 = time.monotonic()
-        try:
-            verdict, seconds, detail = run_probe(probe, ws, args.limit_s)
-        except Exception as exc:  # noqa: BLE001 - a probe's own set-up failed
-            verdict, seconds, detail = "traceback", 0.0, f"probe set-up: {exc!r}"
-        counts[verdict] += 1
-        total = time.monotonic() - t0
-        line = f"[{verdict}] {probe.name} ({seconds:.1f} s, {total:.1f} s with set-up)"
-        if verdict != "pass":
-            line += f": {detail}"
-        measured = MEASURED.get(ws.root.name)
-        if measured and (args.verbose or "known limit" in probe.name):
-            line += f" -- {measured}"
-        print(line, flush=True)
-        if not args.keep:
-            shutil.rmtree(ws.root, ignore_errors=True)
-    _close_clusters()
-    parts = ", ".join(f"{v} {counts[v]}" for v in VERDICTS if counts[v])
-    print(f"{len(probes)} probes in {time.monotonic() - start:.0f} s: {parts}")
-    return 0 if counts["pass"] == len(probes) else 1
+    """Run this group alone (the same verdicts as ``probe_hostile.py``)."""
+    from probe_hostile import run_group
+
+    return run_group(
+        determinism_probes,
+        "determinism",
+        __doc__,
+        argv,
+        limit_s=120,
+        base=lambda folder: folder.mkdir(parents=True),  # the probes bring their own inputs
+        note=_measured,
+        hooks={"after": _close_clusters},
+    )
 
 
 if __name__ == "__main__":

@@ -24,7 +24,6 @@ seed and budget, so the DE need not converge). ::
 """
 
 import json
-import shutil
 import sys
 from pathlib import Path
 
@@ -641,48 +640,9 @@ def geometry_probes():
 
 def main(argv=None):
     """Run this group alone (the same verdicts as ``probe_hostile.py``)."""
-    import argparse
-    import collections
-    import os
+    from probe_hostile import run_group
 
-    from probe_hostile import VERDICTS, Workspace, run_probe
-
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--work", type=Path, required=True, help="scratch folder (emptied)")
-    parser.add_argument("--only", help="run the probes whose name holds this text")
-    parser.add_argument("--limit-s", type=int, default=60, help="time limit per probe")
-    parser.add_argument("--list", action="store_true", help="list the probes and stop")
-    parser.add_argument("--verbose", action="store_true", help="a line for every probe")
-    parser.add_argument("--keep", action="store_true", help="keep each probe's folder")
-    args = parser.parse_args(argv)
-    os.environ.pop("LILIUM_DEBUG", None)
-    probes = [p for p in geometry_probes() if not args.only or args.only in p.name]
-    if args.list:
-        for p in probes:
-            print(f"{p.expect:5} {p.name}")
-        print(f"{len(probes)} probes")
-        return 0
-    from standin_case import make_standin_case
-
-    if args.work.exists():
-        shutil.rmtree(args.work)
-    base = args.work / "base"
-    make_standin_case(base, seed=0)
-    counts = collections.Counter()
-    for k, probe in enumerate(probes):
-        ws = Workspace(args.work / f"g{k:03d}", base)
-        try:
-            verdict, seconds, detail = run_probe(probe, ws, args.limit_s)
-        except Exception as exc:  # noqa: BLE001 - a probe's own set-up or check failed
-            verdict, seconds, detail = "traceback", 0.0, f"probe set-up/check: {exc!r}"
-        counts[verdict] += 1
-        if verdict != "pass" or args.verbose:
-            print(f"[{verdict}] {probe.name} ({seconds:.1f} s): {detail}", flush=True)
-        if not args.keep:
-            shutil.rmtree(ws.root, ignore_errors=True)
-    parts = ", ".join(f"{v} {counts[v]}" for v in VERDICTS)
-    print(f"geometry: {sum(counts.values())} probes: {parts}")
-    return 0 if counts["pass"] == sum(counts.values()) else 1
+    return run_group(geometry_probes, "geometry", __doc__, argv)
 
 
 if __name__ == "__main__":

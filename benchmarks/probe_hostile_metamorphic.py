@@ -51,14 +51,12 @@ seeds a side). Run alone::
     python benchmarks/probe_hostile_metamorphic.py --work /tmp/meta [--only TEXT] [--spread]
 """
 
-import argparse
 import contextlib
 import io
 import json
 import re
 import shutil
 import sys
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -66,7 +64,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from probe_hostile import ROOT, Probe, Workspace, run_probe  # noqa: E402
+from probe_hostile import ROOT, Probe, Workspace  # noqa: E402
 from probe_hostile_semantic import _dump, _in, _json, _syn, _then  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "tests"))
@@ -1159,52 +1157,33 @@ def spread(work, base):
             shutil.rmtree(s)
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--work", type=Path, required=True, help="scratch folder (emptied)")
-    parser.add_argument("--only", help="run the probes whose name holds this text")
-    parser.add_argument("--limit-s", type=int, default=120, help="time limit per probe")
-    parser.add_argument("--list", action="store_true", help="list the probes and stop")
-    parser.add_argument("--spread", action="store_true", help="print the seed spread and stop")
-    parser.add_argument("--verbose", action="store_true", help="a line for every probe")
-    args = parser.parse_args(argv)
-    import os
+def _note(probe, ws, verdict, verbose):
+    """What a passing probe measured, for ``--verbose``."""
+    last = NOTES.pop("last", "")
+    return f" {last}" if verdict == "pass" and verbose and last else ""
 
-    os.environ.pop("LILIUM_DEBUG", None)
-    probes = [p for p in metamorphic_probes() if not args.only or args.only in p.name]
-    if args.list:
-        for p in probes:
-            print(f"{p.expect:5} {p.name}")
-        print(f"{len(probes)} probes")
-        return 0
-    from standin_case import make_standin_case
 
-    if args.work.exists():
-        shutil.rmtree(args.work)
-    base = args.work / "base"
-    make_standin_case(base, seed=0)
+def _spread_first(args, base):
     if args.spread:
         spread(args.work, base)
         return 0
-    counts, start = {}, time.monotonic()
-    for k, probe in enumerate(probes):
-        ws = Workspace(args.work / f"p{k:03d}", base)
-        try:
-            verdict, seconds, detail = run_probe(probe, ws, args.limit_s)
-        except Exception as exc:  # noqa: BLE001 - a probe's own set-up failed
-            verdict, seconds, detail = "traceback", 0.0, f"probe set-up: {exc!r}"
-        counts[verdict] = counts.get(verdict, 0) + 1
-        if verdict != "pass" or args.verbose:
-            note = NOTES.pop("last", "") if verdict == "pass" else ""
-            print(f"[{verdict}] {probe.name} ({seconds:.1f} s): {detail} {note}", flush=True)
-        NOTES.pop("last", None)
-        shutil.rmtree(ws.root, ignore_errors=True)
-    total = time.monotonic() - start
-    print(
-        f"{len(probes)} probes in {total:.0f} s: "
-        + ", ".join(f"{v} {n}" for v, n in counts.items())
-    )  # noqa: E501
-    return 0 if counts.get("pass", 0) == len(probes) else 1
+    return None
+
+
+def main(argv=None):
+    """Run this group alone (the same verdicts as ``probe_hostile.py``); ``--spread`` prints
+    the seed spread the tolerances come from and stops."""
+    from probe_hostile import run_group
+
+    hooks = {
+        "arguments": lambda p: p.add_argument(
+            "--spread", action="store_true", help="print the seed spread and stop"
+        ),
+        "before": _spread_first,
+    }
+    return run_group(
+        metamorphic_probes, "metamorphic", __doc__, argv, limit_s=120, note=_note, hooks=hooks
+    )
 
 
 if __name__ == "__main__":

@@ -33,13 +33,10 @@ arms it; nothing else changes). Budgets: POSEST-SFO, or Lilium with 5 x 2. ::
     python benchmarks/probe_hostile_report.py --work /tmp/report-probes [--only TEXT]
 """
 
-import argparse
 import base64
-import collections
 import importlib
 import io
 import re
-import shutil
 import sys
 import urllib.parse
 from html.parser import HTMLParser
@@ -1120,41 +1117,10 @@ def report_probes():
 
 
 def main(argv=None):
-    from probe_hostile import VERDICTS, Workspace, run_probe
+    """Run this group alone (the same verdicts as ``probe_hostile.py``)."""
+    from probe_hostile import run_group
 
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--work", type=Path, required=True, help="scratch folder (emptied)")
-    parser.add_argument("--only", help="run the probes whose name holds this text")
-    parser.add_argument("--limit-s", type=int, default=120, help="time limit per probe")
-    parser.add_argument("--verbose", action="store_true", help="a line for every probe")
-    args = parser.parse_args(argv)
-    args.work = args.work.resolve()
-    import os
-
-    os.environ.pop("LILIUM_DEBUG", None)
-    from standin_case import make_standin_case
-
-    probes = [p for p in report_probes() if not args.only or args.only in p.name]
-    if args.work.exists():
-        shutil.rmtree(args.work)
-    base = args.work / "base"
-    make_standin_case(base, seed=0)
-    counts = collections.Counter()
-    for k, probe in enumerate(probes):
-        ws = Workspace(args.work / f"p{k:03d}", base)
-        try:
-            verdict, seconds, detail = run_probe(probe, ws, args.limit_s)
-        except Exception as exc:  # noqa: BLE001 - a probe's own set-up or check failed
-            import traceback
-
-            verdict, seconds, detail = "traceback", 0.0, f"probe: {exc!r} {traceback.format_exc().splitlines()[-3:]}"  # noqa: E501
-        counts[verdict] += 1
-        if verdict != "pass" or args.verbose:
-            print(f"[{verdict}] {probe.name} ({seconds:.1f} s): {detail}", flush=True)
-        shutil.rmtree(ws.root, ignore_errors=True)
-    total = sum(counts.values())
-    print(f"{total} probes: " + ", ".join(f"{v} {counts[v]}" for v in VERDICTS))
-    return 0 if counts["pass"] == total else 1
+    return run_group(report_probes, "report", __doc__, argv, limit_s=120)
 
 
 if __name__ == "__main__":
