@@ -1,5 +1,6 @@
 """``lilium report``: the paper's tables and plots from an experiment database."""
 
+import sys
 from pathlib import Path
 
 from .argtypes import dataset_folder, output_folder
@@ -27,8 +28,6 @@ def register(subparsers):
 
 
 def run(args):
-    import sys
-
     from ..experiments.report import write_report
 
     def warn(line):
