@@ -213,6 +213,16 @@ def _set(path_key, value):
     return change
 
 
+def _then(*setups):
+    """A probe's set-up made of several set-ups, run in order."""
+
+    def setup(ws):
+        for s in setups:
+            s(ws)
+
+    return setup
+
+
 def _write(where, name, content):
     def setup(ws):
         folder = ws.photo if where == "photo" else ws.skull if where == "skull" else ws.root / "in"
@@ -570,6 +580,42 @@ def all_probes():
     )
 
 
+def _fresh_work(work, base=None):
+    """Empty ``work`` and write the probes' shared inputs into ``work/base`` (``base(folder)``,
+    default the stand-in case); returns that folder."""
+    if work.exists():
+        shutil.rmtree(work)
+    shared = work / "base"
+    if base is None:
+        from standin_case import make_standin_case
+
+        make_standin_case(shared, seed=0)
+    else:
+        base(shared)
+    return shared
+
+
+def _run_probes(probes, args, shared, note=None, owners=False):
+    """Run each probe in its own workspace under ``args.work``; print a line for each that did
+    not pass (each with ``args.verbose``, or with a ``note``); returns the verdicts counted by
+    owner (``{owner: Counter}``); ``owners``: the lines name each probe's owner."""
+    counts = collections.defaultdict(collections.Counter)
+    for k, probe in enumerate(probes):
+        ws = Workspace(args.work / f"p{k:03d}", shared)
+        try:
+            verdict, seconds, detail = run_probe(probe, ws, args.limit_s)
+        except Exception as exc:  # noqa: BLE001 - a probe's own set-up or check failed
+            verdict, seconds, detail = "traceback", 0.0, f"probe set-up/check: {exc!r}"
+        counts[probe.owner][verdict] += 1
+        extra = note(probe, ws, verdict, args.verbose) if note is not None else ""
+        if verdict != "pass" or args.verbose or extra:
+            who = f"{probe.owner}: " if owners else ""
+            print(f"[{verdict}] {who}{probe.name} ({seconds:.1f} s): {detail}{extra}", flush=True)
+        if not args.keep:
+            shutil.rmtree(ws.root, ignore_errors=True)
+    return counts
+
+
 def run_group(probes, label, doc, argv=None, limit_s=60, base=None, note=None, hooks=None):
     """Run one group of probes alone, with the verdicts of :func:`main`, and print one line per
     probe that did not pass (every probe with ``--verbose``) and a summary; 0 when all passed.
@@ -611,30 +657,11 @@ def run_group(probes, label, doc, argv=None, limit_s=60, base=None, note=None, h
             print(f"{p.expect:5} {p.name}")
         print(f"{len(chosen)} probes")
         return 0
-    if args.work.exists():
-        shutil.rmtree(args.work)
-    shared = args.work / "base"
-    if base is None:
-        from standin_case import make_standin_case
-
-        make_standin_case(shared, seed=0)
-    else:
-        base(shared)
+    shared = _fresh_work(args.work, base)
     if "before" in hooks and (code := hooks["before"](args, shared)) is not None:
         return code
-    counts, start = collections.Counter(), time.monotonic()
-    for k, probe in enumerate(chosen):
-        ws = Workspace(args.work / f"p{k:03d}", shared)
-        try:
-            verdict, seconds, detail = run_probe(probe, ws, args.limit_s)
-        except Exception as exc:  # noqa: BLE001 - a probe's own set-up or check failed
-            verdict, seconds, detail = "traceback", 0.0, f"probe set-up/check: {exc!r}"
-        counts[verdict] += 1
-        extra = note(probe, ws, verdict, args.verbose) if note is not None else ""
-        if verdict != "pass" or args.verbose or extra:
-            print(f"[{verdict}] {probe.name} ({seconds:.1f} s): {detail}{extra}", flush=True)
-        if not args.keep:
-            shutil.rmtree(ws.root, ignore_errors=True)
+    start = time.monotonic()
+    counts = _run_probes(chosen, args, shared, note)["rel"]
     if "after" in hooks:
         hooks["after"]()
     parts = ", ".join(f"{v} {counts[v]}" for v in VERDICTS)
@@ -649,6 +676,7 @@ def main(argv=None):
     parser.add_argument("--limit-s", type=int, default=60, help="time limit per probe")
     parser.add_argument("--list", action="store_true", help="list the probes and stop")
     parser.add_argument("--verbose", action="store_true", help="a line for every probe")
+    parser.add_argument("--keep", action="store_true", help="keep each probe's folder")
     parser.add_argument("--range", default=":", help="probes START:STOP only (by index)")
     args = parser.parse_args(argv)
     os.environ.pop("LILIUM_DEBUG", None)  # as users run it: the CLI's own handlers on
@@ -660,25 +688,7 @@ def main(argv=None):
             print(f"{p.owner:5} {p.expect:5} {p.name}")
         print(f"{len(probes)} probes")
         return 0
-    from standin_case import make_standin_case
-
-    if args.work.exists():
-        shutil.rmtree(args.work)
-    base = args.work / "base"
-    make_standin_case(base, seed=0)
-    counts = {owner: collections.Counter() for owner in ("rel", "photo", "ct")}
-    for k, probe in enumerate(probes):
-        ws = Workspace(args.work / f"p{k:03d}", base)
-        try:
-            verdict, seconds, detail = run_probe(probe, ws, args.limit_s)
-        except Exception as exc:  # noqa: BLE001 - a probe's own set-up failed
-            verdict, seconds, detail = "traceback", 0.0, f"probe set-up: {exc!r}"
-        counts[probe.owner][verdict] += 1
-        if verdict != "pass" or args.verbose:
-            print(
-                f"[{verdict}] {probe.owner}: {probe.name} ({seconds:.1f} s): {detail}", flush=True
-            )
-        shutil.rmtree(ws.root, ignore_errors=True)
+    counts = _run_probes(probes, args, _fresh_work(args.work), owners=True)
     for owner, label in (("rel", "this work"), ("photo", "lilium photo"), ("ct", "import-ct")):
         total = sum(counts[owner].values())
         parts = ", ".join(f"{v} {counts[owner][v]}" for v in VERDICTS)

@@ -51,7 +51,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from probe_hostile import Probe, Workspace
+from probe_hostile import Probe, Workspace, _then
 from probe_hostile_casework import _quiet_main
 from probe_hostile_runs import _in
 
@@ -341,14 +341,6 @@ def _prior(argv, into):
 
     def setup(ws):
         assert _quiet_main(argv(ws, _in(ws, into))) == 0, f"the first run ({into}) failed"
-
-    return setup
-
-
-def _then(*setups):
-    def setup(ws):
-        for s in setups:
-            s(ws)
 
     return setup
 

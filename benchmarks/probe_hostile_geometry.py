@@ -86,24 +86,22 @@ F2, F2c = _syn_photo("s02_f00"), _syn_photo("s02_f00", True)
 # -- command lines ----------------------------------------------------------------------------
 
 
-def _sfo(skull, photo, *extra, method="posest-sfo", out=None):
-    def argv(ws):
-        o = out(ws) if out else ws.out
-        rest = [e(ws) if callable(e) else e for e in extra]
-        return ["sfo", "--skull", skull(ws), "--photo", photo(ws), "--out", o, "--method", method,
-                *rest]  # fmt: skip
+def _command(name):
+    """``lilium sfo`` or ``lilium case`` of one skull and one photo (paths of the workspace)."""
 
-    return argv
+    def command(skull, photo, *extra, method="posest-sfo", out=None):
+        def argv(ws):
+            o = out(ws) if out else ws.out
+            rest = [e(ws) if callable(e) else e for e in extra]
+            return [name, "--skull", skull(ws), "--photo", photo(ws), "--out", o,
+                    "--method", method, *rest]  # fmt: skip
+
+        return argv
+
+    return command
 
 
-def _case(skull, photo, *extra, method="posest-sfo", out=None):
-    def argv(ws):
-        o = out(ws) if out else ws.out
-        rest = [e(ws) if callable(e) else e for e in extra]
-        return ["case", "--skull", skull(ws), "--photo", photo(ws), "--out", o, "--method", method,
-                *rest]  # fmt: skip
-
-    return argv
+_sfo, _case = _command("sfo"), _command("case")
 
 
 def _lineup(skull, candidates, *extra, method="posest-sfo", out=None):

@@ -24,7 +24,7 @@ import re
 import shutil
 from html.parser import HTMLParser
 
-from probe_hostile import Probe
+from probe_hostile import Probe, _then
 from probe_hostile_casework import TINY, _inputs_kept, _quiet_main, _second_photo
 
 #: Runs in a browser it is loaded in: marks ``<body>`` (checked with Chromium's ``--dump-dom``).
@@ -158,14 +158,6 @@ def _link(where, target, directory=False):
         link = ws.out / where
         link.parent.mkdir(parents=True, exist_ok=True)
         link.symlink_to(aim, target_is_directory=directory)
-
-    return setup
-
-
-def _then(*setups):
-    def setup(ws):
-        for s in setups:
-            s(ws)
 
     return setup
 

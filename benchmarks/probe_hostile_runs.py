@@ -13,7 +13,7 @@ import os
 import shutil
 import sqlite3
 
-from probe_hostile import Probe, _write
+from probe_hostile import Probe, _then, _write
 
 #: One subject, a frontal and a lateral photo, POSEST-SFO, Exp. A: 2 SFOs, a few seconds.
 BASE = """name = "runs"
@@ -82,14 +82,6 @@ def _rows(ws):
 
 def _stored(n):
     return lambda ws: None if _rows(ws) == n else f"{_rows(ws)} rows stored, not {n}"
-
-
-def _then(*setups):
-    def setup(ws):
-        for s in setups:
-            s(ws)
-
-    return setup
 
 
 def _prior_run(text):

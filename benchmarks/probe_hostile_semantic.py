@@ -23,7 +23,7 @@ import shutil
 
 import numpy as np
 
-from probe_hostile import Probe
+from probe_hostile import Probe, _then
 from probe_hostile_casework import TINY, _quiet_main
 
 # -- inputs -----------------------------------------------------------------------------------
@@ -68,14 +68,6 @@ def _json(path):
 
 def _dump(path, data):
     path.write_text(json.dumps(data))
-
-
-def _then(*setups):
-    def setup(ws):
-        for s in setups:
-            s(ws)
-
-    return setup
 
 
 def _edit_json(where, name, change):
