@@ -74,7 +74,7 @@ def _inconsistent(photos, results, terms, facial_landmarks_mm):
         for w in result.warnings:
             if w.code == "view_mismatch":
                 out["view_mismatch"] = w.message
-        facial = getattr(result, "facial_landmarks_mm", None) or facial_landmarks_mm
+        facial = result.facial_landmarks_mm or facial_landmarks_mm
         conflicts.append(perspective_conflict(photo, result.camera, facial))
     if any(conflicts):
         out["perspective_mismatch"] = "; ".join(c for c in conflicts if c)

@@ -176,11 +176,11 @@ def read_mask(path, image_size_wh):
             f"{path}: the mask is {mask.shape[1]}x{mask.shape[0]} px but the photo is {w}x{h}; "
             "make the mask the photo's size"
         )
-    if not mask.any():
+    face = np.count_nonzero(mask)
+    if face == 0:
         raise ValueError(f"{path}: the face mask is empty; paint the face/head pixels non-zero")
-    share = np.count_nonzero(mask) / mask.size
-    if share >= MASK_MAX_SHARE:
-        left = mask.size - np.count_nonzero(mask)
+    if face >= MASK_MAX_SHARE * mask.size:
+        left = mask.size - face
         whole = (
             f"all but {left} px of the photo" if left else "the whole photo (every pixel non-zero)"
         )

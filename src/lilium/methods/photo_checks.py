@@ -10,6 +10,11 @@
   inverted mask, the mask of another photo or an image rescaled without its landmarks puts
   several landmarks beyond 0.1. A landmark beyond :data:`MASK_OFF_FRACTION` is *off the mask*;
   more than half of them off is an error, some of them a warning ``landmark_outside_mask``.
+- **twins at one place** (:func:`coincident_pairs`): a bilateral pair's ``_l`` and ``_r``
+  closer than :data:`PAIR_REVERSED_FRACTION` of the landmarks' extent (one copied from the
+  other), on a frontal photo and on a skull.
+- **one photo given twice** (:func:`check_distinct_photos`): two photos of one view whose
+  landmarks match after a similarity within :data:`COPY_FRACTION` (a resized copy).
 """
 
 import numpy as np
