@@ -24,7 +24,8 @@ nobody reviewed; fewer than 8 landmark pairs. Exclusion is not capped: a poor ma
 evidence against the same person whatever the material.
 
 **Consistency.** A consistency failure (skull pixels outside the head mask: an implausible
-SFO; the camera disagreeing with the declared view) is never support: the conclusion is at
+SFO; the camera disagreeing with the declared view; a camera whose perspective contradicts the
+photo's distance prior, ``perspective_mismatch``) is never support: the conclusion is at
 most "undetermined" and says why. A camera that disagrees with the declared view is no
 exclusion either (an upside-down or mislabelled photo gave a camera 120 degrees off and
 "moderate support for exclusion"): the conclusion is "undetermined". A failed SFO (no camera)

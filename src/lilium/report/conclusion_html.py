@@ -85,9 +85,10 @@ def conclusion_section(decisions):
         "<p class='note'>Is this the person? The likelihood ratio compares the observations "
         "under \"this skull is the person in the photo\" with \"a random other person\", "
         "calibrated on generated subjects (docs/method.md, Identification). The conclusion "
-        "follows a verbal scale, capped by the material; a skull outside the head is never "
-        "support, and a camera that contradicts the declared view is neither support nor "
-        "exclusion. The fitness in each SFO's "
+        "follows a verbal scale, capped by the material; a skull outside the head, or a camera "
+        "whose perspective contradicts the photo's distance prior, is never support, and a "
+        "camera that contradicts the declared view is neither support nor exclusion. The "
+        "fitness in each SFO's "
         "section is the paper's alignment score, not an identification.</p>\n"
         f"<table class='conclusions'><thead>{head}</thead><tbody>{''.join(rows)}</tbody></table>\n"
     )
