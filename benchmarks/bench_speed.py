@@ -116,6 +116,11 @@ def main(argv=None):
     p.add_argument("--reference-generations", type=int, default=40)
     p.add_argument("--posest-repeats", type=int, default=30)
     p.add_argument("--real-size", action="store_true", help="issue 26's real-size table")
+    p.add_argument(
+        "--aot",
+        action="store_true",
+        help="the kernels built ahead of time against numba's JIT, per SFO, at real sizes",
+    )
     args = p.parse_args(argv)
     if not jit.NUMBA_AVAILABLE:
         p.error("numba is not installed: nothing to compare (pip install 'numba==0.68.1')")
@@ -128,6 +133,8 @@ def main(argv=None):
         roots = [root]
     if args.real_size:
         return real_size_table(roots[0], args)
+    if args.aot:
+        return aot_table(roots[0], args)
     variants = [v for v in args.variants.split(",") if v]
     full = SfoOptions().with_de(
         population_size=args.population, max_generations=args.generations, max_seconds=1e9
@@ -262,6 +269,56 @@ def real_size_table(root, args):
             f"{ratio:6.1f} {result.extra.get('working_faces', 0):>10} "
             f"{result.extra.get('working_scale', 1.0):6.3f}"
         )
+
+
+def aot_table(root, args, repeats=3):
+    """CPU s per SFO with the kernels built ahead of time (``lilium._kernels_aot``) and with
+    numba's JIT, alternating in one process (medians of ``repeats``), on the demo-sized frontal
+    photo and at 600k faces / 2 and 24 MP; and how many calls found no export (they ran on the
+    JIT: the signature list misses them)."""
+    from real_size import photo_at, skull_at
+
+    if not jit._aot_table():
+        raise SystemExit("the kernels were not built ahead of time: python -m pip install -e .")
+    label, skull, photo = next(c for c in photos_of(root) if " frontal " in c[0])
+    full = SfoOptions().with_de(
+        population_size=args.population, max_generations=args.generations, max_seconds=1e9
+    )
+    big = skull_at(skull, 600_000)
+    cases = [(label, skull, photo)]
+    cases += [(f"600k faces, {mp:g} MP", big, photo_at(photo, mp)) for mp in (2.0, 24.0)]
+    missed = []
+    jitted = jit.Kernel.dispatcher
+
+    def dispatcher(kernel):
+        if jit.backend() == "numba":
+            missed.append(kernel.key)
+        return jitted.fget(kernel)
+
+    jit.Kernel.dispatcher = property(dispatcher)
+    print(f"CPU s per SFO, one core, {args.generations} x {args.population}, median of {repeats}")
+    print(f"{'case':<26} {'variant':<9} {'ahead of time':>13} {'JIT':>7} {'ratio':>6}")
+    try:
+        for name, big, image in cases:
+            for variant in ("base", "skof+pll"):
+                options = replace(full, variant=variant)
+                times = {"numba": [], "jit": []}
+                for path in times:  # warm-up: loads either path's kernels
+                    with jit.kernels(path):
+                        run_sfo("lilium", big, image, options.with_de(max_generations=2), 0)
+                for _ in range(repeats):
+                    for path in times:
+                        with jit.kernels(path):
+                            times[path].append(time_sfo("lilium", big, image, options)[0])
+                aot, just_in_time = (statistics.median(times[k]) for k in ("numba", "jit"))
+                print(
+                    f"{name:<26} {variant:<9} {aot:13.3f} {just_in_time:7.3f} "
+                    f"{aot / just_in_time:6.3f}",
+                    flush=True,
+                )
+    finally:
+        jit.Kernel.dispatcher = jitted
+    print(f"calls that found no export: {len(missed)} ({sorted(set(missed)) or 'none'})")
 
 
 if __name__ == "__main__":

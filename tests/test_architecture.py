@@ -14,6 +14,7 @@ LAYERS = {
     "constants": 0,
     "validation": 0,
     "jit": 0,
+    "jit_signatures": 0,
     "geometry": 1,
     "optimisation": 1,
     "softtissue": 2,
@@ -33,6 +34,7 @@ LAYERS = {
     "experiments": 9,
     "demo": 9,
     "cli": 10,
+    "jit_aot": 10,
 }
 
 #: Longest module (lines) that still reads in one sitting.

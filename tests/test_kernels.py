@@ -458,7 +458,27 @@ def test_edge_table_kernel_gives_numpys_topology():
             reference = mesh_edge_topology(f)
         for name in ("edges", "face_edges", "face_dirs", "edges_a", "edges_b"):
             np.testing.assert_array_equal(getattr(compiled, name), getattr(reference, name))
-        assert (compiled.incidence != reference.incidence).nnz == 0
+        for name in ("indptr", "indices", "data"):
+            np.testing.assert_array_equal(
+                getattr(compiled.incidence, name), getattr(reference.incidence, name)
+            )
+        # scipy's CSR of the same entries (sum_duplicates), the product as scipy computes it
+        from scipy import sparse
+
+        n = len(f)
+        scipy_incidence = sparse.csr_matrix(
+            (reference.incidence.data, reference.incidence.indices, reference.incidence.indptr),
+            shape=reference.incidence.shape,
+        )
+        a, b = f.reshape(-1), f[:, [1, 2, 0]].reshape(-1)
+        direct = sparse.csr_matrix(
+            (np.where(a < b, 1.0, -1.0), (compiled.face_edges.reshape(-1), np.arange(3 * n) // 3)),
+            shape=compiled.incidence.shape,
+        )
+        direct.sum_duplicates()
+        assert (direct != scipy_incidence).nnz == 0
+        sign = rng.choice([-1.0, 0.0, 1.0], (4, n))
+        np.testing.assert_array_equal(compiled.incidence @ sign.T, direct @ sign.T)
 
 
 @needs_numba

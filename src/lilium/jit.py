@@ -1,74 +1,161 @@
-"""Compiled kernels: numba when it is there, the numpy reference path otherwise.
+"""Compiled kernels: ahead of time where built, numba's JIT otherwise, the numpy path without numba.
 
 The hot loops of an SFO (the skull raster and P_skof's outside-pixel count, the curve detection and
 pairing of P_pll, the batched Levenberg-Marquardt of the population (plain, and on the camera
 priors for the joint SFO) and its reprojection errors, the cameras' checks and terms (MSE_pix,
 P_cam), the decoding of the genes, the DE's trials, the pinhole projection) have two
-implementations that give the same numbers: a compiled kernel (``_*_kernels.py`` modules, numba,
-``cache=True``, so only the first run on a machine pays the compile time) and the plain numpy code
-they replaced, kept as the reference the tests compare the kernels against and as the fallback. On
-the same inputs integers agree exactly, floats to 1e-9 (most of them bit for bit); since the
-projection itself is compiled, a pixel that rounds at exactly half a pixel may round the other way
-on the two paths (a rare one-pixel difference in a curve or a count).
+implementations that give the same numbers: a compiled kernel (``_*_kernels.py`` modules, written
+for numba) and the plain numpy code they replaced, kept as the reference the tests compare the
+kernels against and as the fallback. On the same inputs integers agree exactly, floats to 1e-9
+(most of them bit for bit); since the projection itself is compiled, a pixel that rounds at
+exactly half a pixel may round the other way on the two paths (a rare one-pixel difference in a
+curve or a count).
 
-numba is a pinned dependency (``pyproject.toml``); should it fail to import (a platform without
-its wheels), Lilium still runs, on the numpy path, only slower. ``LILIUM_KERNELS=numpy`` in the
-environment forces the numpy path (the benchmarks' reference timings); :func:`kernels` switches
-it inside a process (tests).
+A kernel is compiled one of two ways, from the same source:
+
+- **ahead of time**, when the package was installed: ``pip install`` builds the extension module
+  ``lilium._kernels_aot`` with numba's ``pycc`` (``setup.py``, :mod:`lilium.jit_aot`) for the
+  argument types listed in :mod:`lilium.jit_signatures` (those of the demo, ``lilium sfo``,
+  ``case``, ``lineup`` and ``experiment``). A call whose arguments have exactly one of those types
+  runs it, and a process that needs nothing else never imports numba (numba's import and its
+  registries cost about 0.5 s per process; the module loads in about a millisecond). The module
+  carries a hash of the kernels' sources and of that list; after an edit of either, it no longer
+  matches and is not used (run ``pip install -e .`` again to rebuild it). Without a C compiler
+  the build is skipped and everything runs on numba's JIT;
+- **just in time**, for every other call: numba (``cache=True``, so only the first run on a
+  machine pays the compile time, cached in the package's ``__pycache__`` folders).
+
+numba is a pinned dependency (``pyproject.toml``); should it be missing (a platform without its
+wheels), Lilium still runs, on the numpy path, only slower. ``LILIUM_KERNELS=numpy`` in the
+environment forces the numpy path (the benchmarks' reference timings), ``LILIUM_KERNELS=jit``
+numba's JIT without the ahead-of-time module; :func:`kernels` switches them inside a process
+(tests).
 """
 
 import contextlib
+import functools
+import hashlib
+import importlib.util
 import os
+from pathlib import Path
 
-try:  # pragma: no cover - depends on the install
-    import numba as _numba
-except ImportError:  # pragma: no cover
-    _numba = None
+import numpy as np
 
-#: Whether numba imported.
-NUMBA_AVAILABLE = _numba is not None
+#: Whether numba is installed (found, not imported: a process served by the ahead-of-time
+#: module never imports it).
+NUMBA_AVAILABLE = importlib.util.find_spec("numba") is not None
 
+_BACKENDS = ("numba", "jit", "numpy")
 _state = {"backend": "numba" if NUMBA_AVAILABLE else "numpy"}
-if os.environ.get("LILIUM_KERNELS", "").strip().lower() == "numpy":
+if NUMBA_AVAILABLE and os.environ.get("LILIUM_KERNELS", "").strip().lower() in ("numpy", "jit"):
+    _state["backend"] = os.environ["LILIUM_KERNELS"].strip().lower()
+elif os.environ.get("LILIUM_KERNELS", "").strip().lower() == "numpy":
     _state["backend"] = "numpy"
+
+#: Every kernel defined so far, in definition order.
+_KERNELS = []
+_PACKAGE = Path(__file__).parent
+
+
+class Kernel:
+    """A compiled kernel: the ahead-of-time build for the argument types it was built for,
+    numba's JIT for any other.
+
+    Made by :func:`njit`; called like the Python function it wraps. ``py_func`` is that
+    function; ``dispatcher`` numba's dispatcher of it (numba is imported on first use).
+    """
+
+    def __init__(self, py_func, options):
+        self.py_func = py_func
+        self.options = options
+        self.key = f"{py_func.__module__}.{py_func.__qualname__}"
+        self._dispatcher = None
+        self._exports = None
+        functools.update_wrapper(self, py_func)
+        _KERNELS.append(self)
+
+    def __call__(self, *args):
+        if _state["backend"] == "numba":
+            if self._exports is None:
+                self._exports = _aot_exports(self.key)
+            for n_args, fits, function in self._exports:
+                if len(args) == n_args and fits(*args):
+                    return function(*args)
+        return self.dispatcher(*args)
+
+    @property
+    def dispatcher(self):
+        """numba's dispatcher of ``py_func`` (compiled, or loaded from its cache, on a call)."""
+        if self._dispatcher is None:
+            import numba
+
+            _teach_numba()
+            self._dispatcher = numba.njit(**self.options)(self.py_func)
+        return self._dispatcher
+
+    @property
+    def targetoptions(self):
+        """The options numba's inliner reads from a callee (``inline="always"``)."""
+        return {k: v for k, v in self.options.items() if k != "cache"}
+
+    def __repr__(self):
+        return f"<lilium kernel {self.key}>"
+
+
+@functools.cache
+def _teach_numba():
+    """Let numba compile a call of a :class:`Kernel` from another kernel: it types it as the
+    kernel's dispatcher (the module's name holds the Kernel, so numba's cache pickles it by
+    reference, and its inliner reads ``py_func`` and ``targetoptions`` from it)."""
+    from numba.core import types
+    from numba.extending import typeof_impl
+
+    @typeof_impl.register(Kernel)
+    def _typeof_kernel(value, context):
+        return types.Dispatcher(value.dispatcher)
 
 
 def njit(*args, **kwargs):
-    """``numba.njit(cache=True, ...)``, or the plain Python function without numba.
+    """A :class:`Kernel` (numba ``njit(cache=True, ...)`` options), or the plain Python function
+    without numba.
 
     Used as ``@njit`` or ``@njit(...)``. No ``fastmath``: the kernels must round exactly as
     numpy does.
     """
     kwargs.setdefault("cache", True)
-    if _numba is None:  # pragma: no cover
+    if not NUMBA_AVAILABLE:  # pragma: no cover
         if args and callable(args[0]):
             return args[0]
         return lambda f: f
-    return _numba.njit(*args, **kwargs)
+    if args and callable(args[0]):
+        return Kernel(args[0], kwargs)
+    return lambda f: Kernel(f, kwargs)
 
 
 def compiled():
-    """True when the compiled kernels are in use (numba imported and not switched off)."""
-    return _state["backend"] == "numba"
+    """True when the compiled kernels are in use (numba installed and not switched off)."""
+    return _state["backend"] != "numpy"
 
 
 def backend():
-    """``"numba"`` or ``"numpy"``: the path the hot loops take now."""
+    """``"numba"`` (ahead of time where built, else JIT), ``"jit"`` or ``"numpy"``: the path
+    the hot loops take now."""
     return _state["backend"]
 
 
 @contextlib.contextmanager
 def kernels(name):
-    """Run a block on the ``"numba"`` or ``"numpy"`` path.
+    """Run a block on the ``"numba"``, ``"jit"`` (numba without the ahead-of-time module) or
+    ``"numpy"`` path.
 
     Raises
     ------
     ValueError
-        Unknown name, or ``"numba"`` when numba is not installed.
+        Unknown name, or a compiled path when numba is not installed.
     """
-    if name not in ("numba", "numpy"):
-        raise ValueError(f"kernels must be 'numba' or 'numpy', got {name!r}")
-    if name == "numba" and not NUMBA_AVAILABLE:
+    if name not in _BACKENDS:
+        raise ValueError(f"kernels must be one of {', '.join(_BACKENDS)}, got {name!r}")
+    if name != "numpy" and not NUMBA_AVAILABLE:
         raise ValueError("numba is not installed: pip install 'numba==0.68.1'")
     previous = _state["backend"]
     _state["backend"] = name
@@ -76,3 +163,106 @@ def kernels(name):
         yield
     finally:
         _state["backend"] = previous
+
+
+# --- the ahead-of-time module -------------------------------------------------------------------
+
+
+def source_hash():
+    """A 63-bit hash of the kernels' sources and of their signature list (what the ahead-of-time
+    module was built from: a module whose hash differs is stale and not used)."""
+    from .jit_signatures import MODULES
+
+    digest = hashlib.sha256()
+    for name in (*MODULES, "lilium.constants", "lilium.jit_signatures"):
+        path = _PACKAGE.joinpath(*name.split(".")[1:]).with_suffix(".py")
+        digest.update(name.encode() + b"\0" + path.read_bytes())
+    return int.from_bytes(digest.digest()[:8], "little") >> 1
+
+
+def export_name(index):
+    """The ahead-of-time module's name of the ``index``-th signature of
+    :func:`aot_signatures`."""
+    return f"k{index}"
+
+
+def aot_signatures():
+    """``[(kernel key, argument slots, return slot), ...]`` in the module's export order."""
+    from .jit_signatures import SIGNATURES
+
+    return [(key, args, ret) for key in sorted(SIGNATURES) for args, ret in SIGNATURES[key]]
+
+
+@functools.cache
+def _aot_table():
+    """``{kernel key: [(argument specs, function), ...]}`` of the built module; empty when it
+    is absent or stale."""
+    try:
+        from . import _kernels_aot as module
+    except ImportError:
+        return {}
+    try:
+        if module.source_hash() != source_hash():
+            return {}
+    except (AttributeError, OSError):  # pragma: no cover - a broken build
+        return {}
+    table = {}
+    for index, (key, args, _ret) in enumerate(aot_signatures()):
+        function = getattr(module, export_name(index), None)
+        if function is not None:
+            table.setdefault(key, []).append((args, function))
+    return table
+
+
+def _aot_exports(key):
+    """``[(number of arguments, fits, function), ...]`` of one kernel: ``fits(*args)`` is
+    True when the arguments have exactly the types numba would give them for that export (or
+    types it accepts: any layout for an ``"A"`` slot, a writeable array for a read-only one)."""
+    return [(len(args), _matcher(args), function) for args, function in _aot_table().get(key, ())]
+
+
+_SCALAR_TYPES = {
+    "float64": "(float, _np.float64)",
+    "int64": "(int, _np.int64)",
+    "bool": "(bool, _np.bool_)",
+}
+
+
+def _matcher(specs):
+    """A function of the arguments that checks them against ``specs`` in one expression (a
+    kernel may be called thousands of times per SFO: about 0.2 us per argument)."""
+    names = {"_np": np, "_ndarray": np.ndarray}
+
+    def check(spec, value):
+        if isinstance(spec, str):
+            if spec not in _SCALAR_TYPES:
+                return "False"
+            test = f"type({value}) in {_SCALAR_TYPES[spec]}"
+            if spec == "int64":
+                test += f" and {-(2**63)} <= {value} < {2**63}"
+            return test
+        if spec[0] == "tuple":
+            members = [check(s, f"{value}[{i}]") for i, s in enumerate(spec[1])]
+            return " and ".join(
+                [f"type({value}) is tuple", f"len({value}) == {len(spec[1])}", *members]
+            )
+        _, dtype, ndim, layout, readonly = spec
+        dtype_name = f"_d{len(names)}"
+        names[dtype_name] = np.dtype(dtype)
+        tests = [
+            f"type({value}) is _ndarray",
+            f"((_t := {value}.dtype) is {dtype_name} or _t == {dtype_name})",
+            f"{value}.ndim == {ndim}",
+        ]
+        flags = [f"(_f := {value}.flags).aligned"]
+        if layout != "A":
+            flags.append(f"_f.{'c' if layout == 'C' else 'f'}_contiguous")
+        if not readonly:
+            flags.append("_f.writeable")
+        return " and ".join(tests + flags)
+
+    arguments = [f"a{i}" for i in range(len(specs))]
+    body = " and ".join(check(spec, a) for spec, a in zip(specs, arguments, strict=True)) or "True"
+    source = f"def fits({', '.join(arguments)}):\n    return bool({body})\n"
+    exec(compile(source, "<lilium.jit matcher>", "exec"), names)
+    return names["fits"]

@@ -16,7 +16,6 @@ triangle).
 numbers bit for bit on the tests' meshes.
 """
 
-import cv2
 import numpy as np
 
 from ..jit import njit
@@ -89,6 +88,8 @@ def nearest_face_index(uv, faces, depth_mm, shape, keep=None, covered=None):
     if covered is not None:
         gaps = covered & (index < 0)
         if gaps.any():
+            import cv2  # here: the build of the kernels ahead of time has no OpenCV
+
             # OpenCV's dilate takes no int32: dilate a float32 copy (indices < 2^24 stay exact).
             grown = cv2.dilate(index.astype(np.float32), np.ones((3, 3), np.uint8))
             index[gaps] = grown.astype(np.int32)[gaps]

@@ -13,7 +13,9 @@ count made from them, are identical:
 - :func:`member_crossings` the same for one member and an explicit list of faces, the building
   block of the culled P_skof count (:mod:`lilium.fitness._skof_kernels`).
 - :func:`edge_table_kernel` the edges of :func:`~lilium.imaging.raster.mesh_edge_topology` by
-  a counting sort instead of ``np.unique`` (the same edges in the same order).
+  a counting sort instead of ``np.unique`` (the same edges in the same order), and
+  :func:`incidence_kernel` their incidence to the faces by a counting sort instead of a stable
+  argsort.
 """
 
 import numpy as np
@@ -252,3 +254,50 @@ def edge_table_kernel(lo, hi, n_vertices):
                 n_edges += 1
             edge_of[i] = n_edges - 1
     return edges_lo[:n_edges].copy(), edges_hi[:n_edges].copy(), edge_of
+
+
+@njit
+def incidence_kernel(edge_of, direction, n_edges):
+    """The edge-face incidence of :func:`~lilium.imaging.raster.edge_incidence` by a counting
+    sort on the edge (half-edge ``i`` is a side of face ``i // 3``; faces ascend within an
+    edge, a face's sides along one edge summed).
+
+    Parameters
+    ----------
+    edge_of : ndarray of shape (3F,) of int64
+    direction : ndarray of shape (3F,) of float64
+        +1 / -1: the side runs along / against its edge.
+    n_edges : int
+
+    Returns
+    -------
+    indptr : ndarray of shape (E + 1,) of int64
+    indices : ndarray of shape (K,) of int64
+    data : ndarray of shape (K,) of float64
+    """
+    H = edge_of.shape[0]
+    start = np.zeros(n_edges + 1, np.int64)
+    for i in range(H):
+        start[edge_of[i] + 1] += 1
+    for e in range(n_edges):
+        start[e + 1] += start[e]
+    order = np.empty(H, np.int64)
+    fill = start[:-1].copy()
+    for i in range(H):
+        order[fill[edge_of[i]]] = i
+        fill[edge_of[i]] += 1
+    indptr = np.zeros(n_edges + 1, np.int64)
+    indices = np.empty(H, np.int64)
+    data = np.empty(H)
+    k = 0
+    for e in range(n_edges):
+        for j in range(start[e], start[e + 1]):
+            i = order[j]
+            if j > start[e] and indices[k - 1] == i // 3:
+                data[k - 1] += direction[i]
+            else:
+                indices[k] = i // 3
+                data[k] = direction[i]
+                k += 1
+        indptr[e + 1] = k
+    return indptr, indices[:k].copy(), data[:k].copy()

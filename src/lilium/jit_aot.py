@@ -1,0 +1,272 @@
+"""Building the kernels ahead of time (numba's ``pycc``), and the list of signatures it builds.
+
+Not imported by the package at run time (it imports numba); used by ``setup.py`` when the package
+is installed, and by a developer after a change of a kernel's arguments::
+
+    python -m lilium.jit_aot record    # rewrite lilium/jit_signatures.py from real runs
+    python -m lilium.jit_aot build     # build lilium/_kernels_aot (as pip install -e . does)
+
+``record`` runs what a user runs (the demo, ``lilium sfo`` of every Lilium variant and of
+POSEST-SFO on a frontal and a lateral photo, a joint ``lilium case``, a case from a bare skull
+mesh) on numba's JIT and writes down the argument types of every call of a kernel from Python
+(a kernel called only by other kernels is compiled into its callers). ``build`` compiles one
+export per signature, for this machine's CPU (``pip install`` builds where it runs), with the
+sources' hash of :func:`lilium.jit.source_hash`, so that a later edit makes the module stale
+instead of wrong. A call with other argument types goes to numba's JIT, so a missing signature
+costs start-up time, never a wrong answer.
+"""
+
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+#: The modules that define kernels (their sources are hashed into the built module).
+KERNEL_MODULES = (
+    "lilium.fitness._camera_kernels",
+    "lilium.fitness._curve_kernels",
+    "lilium.fitness._pll_kernels",
+    "lilium.fitness._skof_kernels",
+    "lilium.geometry._mesh_kernels",
+    "lilium.geometry._projection_kernels",
+    "lilium.geometry._rotation_kernels",
+    "lilium.identification._cohort_kernels",
+    "lilium.imaging._paint_kernels",
+    "lilium.imaging._raster_kernels",
+    "lilium.optimisation._de_kernels",
+    "lilium.pose._prior_refine_kernels",
+    "lilium.pose._refine_kernels",
+    "lilium.softtissue._cone_kernels",
+)
+
+MODULE_NAME = "_kernels_aot"
+
+
+# --- numba types <-> the plain literals of lilium/jit_signatures.py ------------------------------
+
+
+def type_to_spec(t):
+    """A numba type as a plain literal: ``("array", dtype, ndim, layout, readonly)``,
+    ``("tuple", [...])`` or a scalar's name."""
+    from numba.core import types
+
+    if isinstance(t, types.Array):
+        return ("array", str(t.dtype), t.ndim, t.layout, not t.mutable)
+    if isinstance(t, types.BaseTuple):
+        return ("tuple", [type_to_spec(e) for e in t.types])
+    if isinstance(t, (types.Float, types.Integer, types.Boolean, types.NoneType)):
+        return str(t)
+    raise TypeError(f"no literal for the numba type {t}")
+
+
+def spec_to_type(spec):
+    """The inverse of :func:`type_to_spec`."""
+    import numpy as np
+    from numba import from_dtype
+    from numba.core import types
+
+    if isinstance(spec, str):
+        return types.none if spec == "none" else from_dtype(np.dtype(spec))
+    if spec[0] == "array":
+        _, dtype, ndim, layout, readonly = spec
+        return types.Array(from_dtype(np.dtype(dtype)), ndim, layout, readonly=readonly)
+    return types.Tuple([spec_to_type(s) for s in spec[1]])
+
+
+# --- record -------------------------------------------------------------------------------------
+
+
+def _workloads(folder):
+    """Run what a user runs, in ``folder`` (short DE budgets: the types, not the answers)."""
+    from .cli.main import main
+
+    folder = Path(folder)
+    main(["demo", "--out", str(folder / "demo")])
+    data = folder / "demo" / "data"
+    skull = data / "subjects" / "s01"
+    photos = sorted((data / "photos" / "C").iterdir())
+    short = ["--generations", "15", "--population", "20"]
+    for photo in photos:
+        for variant in ("base", "pll", "skof", "skof+pll"):
+            out = folder / f"sfo-{photo.name}-{variant}"
+            main(
+                [
+                    "sfo",
+                    "--skull",
+                    str(skull),
+                    "--photo",
+                    str(photo),
+                    "--method",
+                    "lilium",
+                    "--variant",
+                    variant,
+                    "--out",
+                    str(out),
+                    *short,
+                ]
+            )
+        main(
+            [
+                "sfo",
+                "--skull",
+                str(skull),
+                "--photo",
+                str(photo),
+                "--out",
+                str(folder / f"sfo-{photo.name}-posest"),
+            ]
+        )
+    joint = ["--photo", str(photos[0]), "--photo", str(photos[1])]
+    main(["case", "--skull", str(skull), *joint, "--joint", "--out", str(folder / "joint"), *short])
+    main(
+        [
+            "case",
+            "--skull",
+            str(skull / "skull.ply"),
+            "--landmarks",
+            str(skull / "cranial_landmarks.json"),
+            "--photo",
+            str(photos[0]),
+            "--out",
+            str(folder / "mesh"),
+            *short,
+        ]
+    )
+
+
+def record():
+    """``[(kernel key, argument specs, return spec), ...]`` of every call from Python in
+    :func:`_workloads`, on numba's JIT."""
+    from . import jit
+
+    seen = {}
+    call = jit.Kernel.__call__
+
+    def recording(kernel, *args):
+        result = call(kernel, *args)
+        import numba
+
+        seen.setdefault(kernel.key, {})[tuple(numba.typeof(a) for a in args)] = kernel
+        return result
+
+    jit.Kernel.__call__ = recording
+    try:
+        with jit.kernels("jit"), tempfile.TemporaryDirectory() as folder:
+            _workloads(folder)
+    finally:
+        jit.Kernel.__call__ = call
+    signatures = {}
+    for key, calls in sorted(seen.items()):
+        for argtypes, kernel in calls.items():
+            (sig,) = [s for s in kernel.dispatcher.nopython_signatures if s.args == argtypes]
+            entry = ([type_to_spec(a) for a in sig.args], type_to_spec(sig.return_type))
+            if entry not in signatures.setdefault(key, []):
+                signatures[key].append(entry)
+    return signatures
+
+
+def write_signatures(signatures, path=None):
+    """Write ``lilium/jit_signatures.py``."""
+    path = Path(path or Path(__file__).with_name("jit_signatures.py"))
+    text = (
+        '"""The argument types the kernels are built for ahead of time (:mod:`lilium.jit`).\n\n'
+        "Written by ``python -m lilium.jit_aot record``; do not edit by hand. Each entry is\n"
+        '``(argument specs, return spec)``: ``("array", dtype, ndim, layout, readonly)``,\n'
+        '``("tuple", [...])`` or a scalar\'s name.\n"""\n\n'
+        f"MODULES = {_literal(KERNEL_MODULES, 10)}\n\n"
+        f"SIGNATURES = {_literal(dict(sorted(signatures.items())), 13)}\n"
+    )
+    path.write_text(text)
+    return path
+
+
+def _literal(value, column, level=0):
+    """``repr(value)`` starting at ``column``, in lines of at most 99 characters (one member per
+    line, indented by nesting ``level``, where it is longer), as ruff formats it."""
+    text = repr(value).replace("'", '"')  # no quotes inside: kernel and type names
+    if column + len(text) < 99 or not isinstance(value, (list, tuple, dict)):
+        return text
+    pad = "    " * (level + 1)
+    if isinstance(value, dict):
+        items = [
+            f'{pad}"{k}": {_literal(v, len(pad) + len(k) + 4, level + 1)},'
+            for k, v in value.items()
+        ]
+        opening, closing = "{", "}"
+    else:
+        items = [f"{pad}{_literal(v, len(pad), level + 1)}," for v in value]
+        opening, closing = ("[", "]") if isinstance(value, list) else ("(", ")")
+    return "\n".join([opening, *items, pad[:-4] + closing])
+
+
+# --- build --------------------------------------------------------------------------------------
+
+
+def build(output_dir, output_file=None, verbose=False):
+    """Compile every signature of :mod:`lilium.jit_signatures` into one extension module in
+    ``output_dir`` (file name ``output_file``, default numba's for this Python); returns its
+    path."""
+    from numba.core import types
+    from numba.pycc import CC
+
+    from . import jit
+
+    _import_kernels()
+    kernels = {k.key: k for k in jit._KERNELS}
+    cc = CC(MODULE_NAME)
+    cc.output_dir = str(output_dir)
+    if output_file:
+        cc.output_file = output_file
+    cc.target_cpu = "host"  # built where it runs, like numba's JIT
+    cc.verbose = verbose
+    cc.export("source_hash", types.int64())(_constant(jit.source_hash()))
+    for index, (key, args, ret) in enumerate(jit.aot_signatures()):
+        signature = spec_to_type(ret)(*[spec_to_type(a) for a in args])
+        cc.export(jit.export_name(index), signature)(kernels[key].dispatcher.py_func)
+    cc.compile()
+    return Path(cc.output_dir) / cc.output_file
+
+
+def _import_kernels():
+    """Import the kernel modules without their packages' ``__init__`` (which import scipy,
+    OpenCV, PoseLib...: the isolated build has only numpy and numba)."""
+    import importlib
+    import types
+
+    root = Path(__file__).parent
+    for name in KERNEL_MODULES:
+        package = name.rsplit(".", 1)[0]
+        if package not in sys.modules:
+            stub = types.ModuleType(package)
+            stub.__path__ = [str(root / package.split(".")[1])]
+            sys.modules[package] = stub
+    for name in KERNEL_MODULES:
+        importlib.import_module(name)
+
+
+def _constant(value):
+    def source_hash():
+        return value
+
+    return source_hash
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    if argv == ["record"]:
+        os.environ.setdefault("LILIUM_KERNELS", "jit")
+        path = write_signatures(record())
+        print(f"wrote {path}")
+    elif argv == ["build"]:
+        start = time.perf_counter()
+        path = build(Path(__file__).parent)
+        print(f"built {path} in {time.perf_counter() - start:.0f} s")
+    else:
+        print("usage: python -m lilium.jit_aot record | build", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

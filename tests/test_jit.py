@@ -1,0 +1,132 @@
+"""The kernels compiled ahead of time (``lilium._kernels_aot``, :mod:`lilium.jit`): a call uses
+them only with exactly the argument types they were built for, they give numba's JIT's numbers,
+a stale build is not used, and a ``lilium sfo`` process served by them never imports numba."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from lilium import jit
+
+built = pytest.mark.skipif(
+    not (jit.NUMBA_AVAILABLE and jit._aot_table()),
+    reason="the kernels were not compiled ahead of time (no C compiler at install)",
+)
+
+SPECS = [
+    ("array", "float64", 2, "C", False),
+    "int64",
+    ("tuple", [("array", "bool", 1, "A", True), "float64"]),
+    "bool",
+]
+
+
+def test_a_call_fits_an_export_only_with_numbas_own_types():
+    fits = jit._matcher(SPECS)
+    a, b = np.zeros((2, 3)), np.zeros(3, bool)
+    assert fits(a, 3, (b, 1.0), True)
+    assert fits(a, np.int64(3), (b[::2], np.float64(1.0)), np.True_)  # any layout for "A"
+    frozen = b.copy()
+    frozen.setflags(write=False)
+    assert fits(a, 3, (frozen, 1.0), False)  # a read-only slot takes a read-only array
+    read_only = a.copy()
+    read_only.setflags(write=False)
+    wrong = [
+        (a.T, 3, (b, 1.0), True),  # Fortran order for a C slot
+        (a[:, ::2], 3, (b, 1.0), True),  # not contiguous
+        (read_only, 3, (b, 1.0), True),  # the kernel may write it
+        (a.astype(np.float32), 3, (b, 1.0), True),
+        (a.astype(">f8"), 3, (b, 1.0), True),  # byte order
+        (a[None], 3, (b, 1.0), True),  # ndim
+        (a, 3.0, (b, 1.0), True),  # a float for an int
+        (a, True, (b, 1.0), True),  # a bool for an int
+        (a, 2**63, (b, 1.0), True),  # beyond int64
+        (a, 3, (b, 1), True),  # an int for a float
+        (a, 3, [b, 1.0], True),  # a list for a tuple
+        (a, 3, (b, 1.0, 2.0), True),
+        (a, 3, (b.astype(np.int8), 1.0), True),
+        (a, 3, (b, 1.0), 1),
+        (a.view(np.recarray), 3, (b, 1.0), True),  # a subclass
+    ]
+    for args in wrong:
+        assert not fits(*args), args
+
+
+@built
+def test_a_stale_build_is_not_used(monkeypatch):
+    """After an edit of a kernel (or of the signature list) the module's hash differs: the
+    kernels run on numba's JIT until the package is built again."""
+    monkeypatch.setattr(jit, "source_hash", lambda: -1)
+    jit._aot_table.cache_clear()
+    try:
+        assert jit._aot_table() == {}
+    finally:
+        monkeypatch.undo()
+        jit._aot_table.cache_clear()
+    assert jit._aot_table()
+
+
+@built
+def test_ahead_of_time_and_jit_give_the_same_sfo(case, monkeypatch):
+    from lilium.io.case import read_photo, read_skull
+    from lilium.methods import SfoOptions, run_sfo
+    from lilium.optimisation import DEOptions
+
+    subject_dir, photo_dir = case
+    skull, photo = read_skull(subject_dir), read_photo(photo_dir)
+    options = SfoOptions(variant="skof+pll", de=DEOptions(max_generations=40, population_size=16))
+    results, missed = {}, []
+    jitted = jit.Kernel.dispatcher
+    for name in ("numba", "jit"):
+        if name == "numba":  # every call of this SFO must find its export
+            monkeypatch.setattr(
+                jit.Kernel, "dispatcher", property(lambda k: missed.append(k.key) or jitted.fget(k))
+            )
+        with jit.kernels(name):
+            results[name] = run_sfo("lilium", skull, photo, options, seed=3)
+        monkeypatch.undo()
+    assert not missed, sorted(set(missed))
+    aot, just_in_time = results["numba"], results["jit"]
+    assert aot.fitness == just_in_time.fitness
+    assert aot.terms == just_in_time.terms
+    np.testing.assert_array_equal(aot.camera.skull2cam, just_in_time.camera.skull2cam)
+
+
+@built
+def test_an_sfo_process_never_imports_numba(case, tmp_path):
+    """Issue 26's start-up: numba's import and registries cost a process about 0.5 s; with the
+    kernels built ahead of time ``lilium sfo`` (Lilium skof+pll) needs neither, nor
+    scipy.sparse (the mesh's edge incidence is built without it)."""
+    subject_dir, photo_dir = case
+    code = (
+        "import sys\n"
+        "from lilium.cli.main import main\n"
+        "code = main(sys.argv[1:])\n"
+        "print('MODULES', [m for m in ('numba', 'scipy.sparse') if m in sys.modules])\n"
+    )
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            code,
+            "sfo",
+            "--skull",
+            str(subject_dir),
+            "--photo",
+            str(photo_dir),
+            "--method",
+            "lilium",
+            "--generations",
+            "20",
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    assert json.loads((tmp_path / "out" / "result.json").read_text())["method"] == "lilium"
+    assert "MODULES []" in out, out
