@@ -56,10 +56,11 @@ def test_a_call_fits_an_export_only_with_numbas_own_types():
 
 
 @built
-def test_a_stale_build_is_not_used(monkeypatch):
-    """After an edit of a kernel (or of the signature list) the module's hash differs: the
-    kernels run on numba's JIT until the package is built again."""
-    monkeypatch.setattr(jit, "source_hash", lambda: -1)
+@pytest.mark.parametrize("changed", ["source_hash", "cpu_fingerprint"])
+def test_a_stale_build_is_not_used(monkeypatch, changed):
+    """After an edit of a kernel (or of the signature list), or on another CPU, the module's
+    hash differs: the kernels run on numba's JIT until the package is built again there."""
+    monkeypatch.setattr(jit, changed, lambda: -1)
     jit._aot_table.cache_clear()
     try:
         assert jit._aot_table() == {}

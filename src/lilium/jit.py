@@ -20,8 +20,9 @@ A kernel is compiled one of two ways, from the same source:
   runs it, and a process that needs nothing else never imports numba (numba's import and its
   registries cost about 0.5 s per process; the module loads in about a millisecond). The module
   carries a hash of the kernels' sources and of that list; after an edit of either, it no longer
-  matches and is not used (run ``pip install -e .`` again to rebuild it). Without a C compiler
-  the build is skipped and everything runs on numba's JIT;
+  matches and is not used (run ``pip install -e .`` again to rebuild it); nor on another CPU
+  than the one it was built for (:func:`cpu_fingerprint`). Without a C compiler the build is
+  skipped and everything runs on numba's JIT;
 - **just in time**, for every other call: numba (``cache=True``, so only the first run on a
   machine pays the compile time, cached in the package's ``__pycache__`` folders).
 
@@ -37,6 +38,7 @@ import functools
 import hashlib
 import importlib.util
 import os
+import platform
 from pathlib import Path
 
 import numpy as np
@@ -180,6 +182,26 @@ def source_hash():
     return int.from_bytes(digest.digest()[:8], "little") >> 1
 
 
+def cpu_fingerprint():
+    """A 63-bit hash of this machine's processor: its architecture and, on Linux, the first
+    processor's model and instruction-set flags in ``/proc/cpuinfo``.
+
+    The module is built for the CPU it was built on (like numba's JIT); on another one (a shared
+    install on a cluster's mixed nodes) its instructions might not exist, so it is not used there.
+    """
+    text = platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as cpuinfo:
+            for line in cpuinfo:
+                if not line.strip():
+                    break  # the first processor's block
+                if line.startswith(("model name", "flags", "Features", "CPU part")):
+                    text += line
+    except OSError:
+        pass
+    return int.from_bytes(hashlib.sha256(text.encode()).digest()[:8], "little") >> 1
+
+
 def export_name(index):
     """The ahead-of-time module's name of the ``index``-th signature of
     :func:`aot_signatures`."""
@@ -202,7 +224,7 @@ def _aot_table():
     except ImportError:
         return {}
     try:
-        if module.source_hash() != source_hash():
+        if module.source_hash() != source_hash() or module.cpu_hash() != cpu_fingerprint():
             return {}
     except (AttributeError, OSError):  # pragma: no cover - a broken build
         return {}

@@ -221,6 +221,7 @@ def build(output_dir, output_file=None, verbose=False):
     cc.target_cpu = "host"  # built where it runs, like numba's JIT
     cc.verbose = verbose
     cc.export("source_hash", types.int64())(_constant(jit.source_hash()))
+    cc.export("cpu_hash", types.int64())(_constant(jit.cpu_fingerprint()))
     for index, (key, args, ret) in enumerate(jit.aot_signatures()):
         signature = spec_to_type(ret)(*[spec_to_type(a) for a in args])
         cc.export(jit.export_name(index), signature)(kernels[key].dispatcher.py_func)
