@@ -49,10 +49,9 @@ NUMBA_AVAILABLE = importlib.util.find_spec("numba") is not None
 
 _BACKENDS = ("numba", "jit", "numpy")
 _state = {"backend": "numba" if NUMBA_AVAILABLE else "numpy"}
-if NUMBA_AVAILABLE and os.environ.get("LILIUM_KERNELS", "").strip().lower() in ("numpy", "jit"):
-    _state["backend"] = os.environ["LILIUM_KERNELS"].strip().lower()
-elif os.environ.get("LILIUM_KERNELS", "").strip().lower() == "numpy":
-    _state["backend"] = "numpy"
+_requested = os.environ.get("LILIUM_KERNELS", "").strip().lower()
+if _requested == "numpy" or (_requested == "jit" and NUMBA_AVAILABLE):
+    _state["backend"] = _requested
 
 #: Every kernel defined so far, in definition order.
 _KERNELS = []

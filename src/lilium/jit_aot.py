@@ -81,62 +81,28 @@ def _workloads(folder):
     """Run what a user runs, in ``folder`` (short DE budgets: the types, not the answers)."""
     from .cli.main import main
 
+    def run(*args):
+        main([str(a) for a in args])
+
     folder = Path(folder)
-    main(["demo", "--out", str(folder / "demo")])
-    data = folder / "demo" / "data"
-    skull = data / "subjects" / "s01"
-    photos = sorted((data / "photos" / "C").iterdir())
-    short = ["--generations", "15", "--population", "20"]
+    run("demo", "--out", folder / "demo")
+    skull = folder / "demo" / "data" / "subjects" / "s01"
+    photos = sorted((folder / "demo" / "data" / "photos" / "C").iterdir())
+    short = ("--generations", 15, "--population", 20)
     for photo in photos:
         for variant in ("base", "pll", "skof", "skof+pll"):
             out = folder / f"sfo-{photo.name}-{variant}"
-            main(
-                [
-                    "sfo",
-                    "--skull",
-                    str(skull),
-                    "--photo",
-                    str(photo),
-                    "--method",
-                    "lilium",
-                    "--variant",
-                    variant,
-                    "--out",
-                    str(out),
-                    *short,
-                ]
-            )
-        main(
-            [
-                "sfo",
-                "--skull",
-                str(skull),
-                "--photo",
-                str(photo),
-                "--out",
-                str(folder / f"sfo-{photo.name}-posest"),
-            ]
-        )
-    joint = ["--photo", str(photos[0]), "--photo", str(photos[1])]
-    main(["case", "--skull", str(skull), *joint, "--joint", "--out", str(folder / "joint"), *short])
-    main(
-        [
-            "case",
-            "--skull",
-            str(skull / "skull.ply"),
-            "--landmarks",
-            str(skull / "cranial_landmarks.json"),
-            "--photo",
-            str(photos[0]),
-            "--out",
-            str(folder / "mesh"),
-            *short,
-        ]
-    )
+            run("sfo", "--skull", skull, "--photo", photo, "--method", "lilium",
+                "--variant", variant, "--out", out, *short)  # fmt: skip
+        run("sfo", "--skull", skull, "--photo", photo, "--out", folder / f"{photo.name}-posest")
+    joint = ("--photo", photos[0], "--photo", photos[1], "--joint")
+    run("case", "--skull", skull, *joint, "--out", folder / "joint", *short)
+    run("case", "--skull", skull / "skull.ply", "--landmarks", skull / "cranial_landmarks.json",
+        "--photo", photos[0], "--out", folder / "mesh", *short)  # fmt: skip
 
 
 def record():
-    """``[(kernel key, argument specs, return spec), ...]`` of every call from Python in
+    """``{kernel key: [(argument specs, return spec), ...]}`` of every call from Python in
     :func:`_workloads`, on numba's JIT."""
     from . import jit
 
