@@ -55,6 +55,14 @@ def test_a_call_fits_an_export_only_with_numbas_own_types():
         assert not fits(*args), args
 
 
+def test_a_kernel_pickles_by_name():
+    import pickle
+
+    from lilium.geometry._projection_kernels import project_kernel
+
+    assert pickle.loads(pickle.dumps(project_kernel)) is project_kernel
+
+
 @built
 @pytest.mark.parametrize("changed", ["source_hash", "cpu_fingerprint"])
 def test_a_stale_build_is_not_used(monkeypatch, changed):

@@ -36,6 +36,7 @@ numba's JIT without the ahead-of-time module; :func:`kernels` switches them insi
 import contextlib
 import functools
 import hashlib
+import importlib
 import importlib.util
 import os
 import platform
@@ -101,6 +102,13 @@ class Kernel:
 
     def __repr__(self):
         return f"<lilium kernel {self.key}>"
+
+    def __reduce__(self):  # pickled by name (a Dask task may carry one), like a function
+        return _kernel_named, (self.py_func.__module__, self.py_func.__qualname__)
+
+
+def _kernel_named(module, qualname):
+    return getattr(importlib.import_module(module), qualname)
 
 
 @functools.cache
