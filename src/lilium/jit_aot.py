@@ -22,24 +22,6 @@ import tempfile
 import time
 from pathlib import Path
 
-#: The modules that define kernels (their sources are hashed into the built module).
-KERNEL_MODULES = (
-    "lilium.fitness._camera_kernels",
-    "lilium.fitness._curve_kernels",
-    "lilium.fitness._pll_kernels",
-    "lilium.fitness._skof_kernels",
-    "lilium.geometry._mesh_kernels",
-    "lilium.geometry._projection_kernels",
-    "lilium.geometry._rotation_kernels",
-    "lilium.identification._cohort_kernels",
-    "lilium.imaging._paint_kernels",
-    "lilium.imaging._raster_kernels",
-    "lilium.optimisation._de_kernels",
-    "lilium.pose._prior_refine_kernels",
-    "lilium.pose._refine_kernels",
-    "lilium.softtissue._cone_kernels",
-)
-
 MODULE_NAME = "_kernels_aot"
 
 
@@ -102,8 +84,9 @@ def _workloads(folder):
 
 
 def record():
-    """``{kernel key: [(argument specs, return spec), ...]}`` of every call from Python in
-    :func:`_workloads`, on numba's JIT."""
+    """``(modules, signatures)``: the modules that define kernels, and ``{kernel key:
+    [(argument specs, return spec), ...]}`` of every call from Python in :func:`_workloads`, on
+    numba's JIT."""
     from . import jit
 
     seen = {}
@@ -129,10 +112,11 @@ def record():
             entry = ([type_to_spec(a) for a in sig.args], type_to_spec(sig.return_type))
             if entry not in signatures.setdefault(key, []):
                 signatures[key].append(entry)
-    return signatures
+    modules = tuple(sorted({kernel.py_func.__module__ for kernel in jit._KERNELS}))
+    return modules, signatures
 
 
-def write_signatures(signatures, path=None):
+def write_signatures(modules, signatures, path=None):
     """Write ``lilium/jit_signatures.py``."""
     path = Path(path or Path(__file__).with_name("jit_signatures.py"))
     text = (
@@ -140,7 +124,7 @@ def write_signatures(signatures, path=None):
         "Written by ``python -m lilium.jit_aot record``; do not edit by hand. Each entry is\n"
         '``(argument specs, return spec)``: ``("array", dtype, ndim, layout, readonly)``,\n'
         '``("tuple", [...])`` or a scalar\'s name.\n"""\n\n'
-        f"MODULES = {_literal(KERNEL_MODULES, 10)}\n\n"
+        f"MODULES = {_literal(modules, 10)}\n\n"
         f"SIGNATURES = {_literal(dict(sorted(signatures.items())), 13)}\n"
     )
     path.write_text(text)
@@ -201,14 +185,16 @@ def _import_kernels():
     import importlib
     import types
 
+    from .jit_signatures import MODULES
+
     root = Path(__file__).parent
-    for name in KERNEL_MODULES:
+    for name in MODULES:
         package = name.rsplit(".", 1)[0]
         if package not in sys.modules:
             stub = types.ModuleType(package)
             stub.__path__ = [str(root / package.split(".")[1])]
             sys.modules[package] = stub
-    for name in KERNEL_MODULES:
+    for name in MODULES:
         importlib.import_module(name)
 
 
@@ -223,7 +209,7 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     if argv == ["record"]:
         os.environ.setdefault("LILIUM_KERNELS", "jit")
-        path = write_signatures(record())
+        path = write_signatures(*record())
         print(f"wrote {path}")
     elif argv == ["build"]:
         start = time.perf_counter()

@@ -202,6 +202,23 @@ def scan_kernel(u, v, sign, face_edges, face_dirs, edges_a, edges_b, r_lo, r_hi,
 
 
 @njit
+def _counting_order(keys, n_keys):
+    """The stable order of ``keys`` (H,) of int64 in ``[0, n_keys)`` by a counting sort, and
+    where each key's run starts in it, ``start`` (n_keys + 1,)."""
+    start = np.zeros(n_keys + 1, np.int64)
+    for i in range(keys.shape[0]):
+        start[keys[i] + 1] += 1
+    for k in range(n_keys):
+        start[k + 1] += start[k]
+    order = np.empty(keys.shape[0], np.int64)
+    fill = start[:-1].copy()
+    for i in range(keys.shape[0]):
+        order[fill[keys[i]]] = i
+        fill[keys[i]] += 1
+    return order, start
+
+
+@njit
 def edge_table_kernel(lo, hi, n_vertices):
     """The distinct edges of a mesh's half-edges and each half-edge's edge, as
     ``np.unique(lo * n_vertices + hi, return_inverse=True)`` gives them (edges sorted by
@@ -219,16 +236,7 @@ def edge_table_kernel(lo, hi, n_vertices):
     edge_of : ndarray of shape (H,) of int64
     """
     H = lo.shape[0]
-    start = np.zeros(n_vertices + 1, np.int64)
-    for i in range(H):
-        start[lo[i] + 1] += 1
-    for v in range(n_vertices):
-        start[v + 1] += start[v]
-    order = np.empty(H, np.int64)
-    fill = start[:-1].copy()
-    for i in range(H):
-        order[fill[lo[i]]] = i
-        fill[lo[i]] += 1
+    order, start = _counting_order(lo, n_vertices)
     edges_lo = np.empty(H, np.int64)
     edges_hi = np.empty(H, np.int64)
     edge_of = np.empty(H, np.int64)
@@ -258,37 +266,13 @@ def edge_table_kernel(lo, hi, n_vertices):
 
 @njit
 def incidence_kernel(edge_of, direction, n_edges):
-    """The edge-face incidence of :func:`~lilium.imaging.raster.edge_incidence` by a counting
-    sort on the edge (half-edge ``i`` is a side of face ``i // 3``; faces ascend within an
-    edge, a face's sides along one edge summed).
-
-    Parameters
-    ----------
-    edge_of : ndarray of shape (3F,) of int64
-    direction : ndarray of shape (3F,) of float64
-        +1 / -1: the side runs along / against its edge.
-    n_edges : int
-
-    Returns
-    -------
-    indptr : ndarray of shape (E + 1,) of int64
-    indices : ndarray of shape (K,) of int64
-    data : ndarray of shape (K,) of float64
-    """
-    H = edge_of.shape[0]
-    start = np.zeros(n_edges + 1, np.int64)
-    for i in range(H):
-        start[edge_of[i] + 1] += 1
-    for e in range(n_edges):
-        start[e + 1] += start[e]
-    order = np.empty(H, np.int64)
-    fill = start[:-1].copy()
-    for i in range(H):
-        order[fill[edge_of[i]]] = i
-        fill[edge_of[i]] += 1
+    """``(indptr, indices, data)`` of :func:`~lilium.imaging.raster.edge_incidence` (its
+    arguments and rows) by a counting sort on the edge: half-edge ``i`` is a side of face
+    ``i // 3``, so faces ascend within an edge, and a face's sides along one edge are summed."""
+    order, start = _counting_order(edge_of, n_edges)
     indptr = np.zeros(n_edges + 1, np.int64)
-    indices = np.empty(H, np.int64)
-    data = np.empty(H)
+    indices = np.empty(edge_of.shape[0], np.int64)
+    data = np.empty(edge_of.shape[0])
     k = 0
     for e in range(n_edges):
         for j in range(start[e], start[e + 1]):

@@ -202,7 +202,7 @@ def mesh_edge_topology(faces):
     return EdgeTopology(
         faces=faces,
         edges=edges,
-        incidence=edge_incidence(edge_of, direction.astype(np.float64), len(edges)),
+        incidence=edge_incidence(edge_of.reshape(-1), direction.astype(np.float64), len(edges)),
         corners=np.ascontiguousarray(faces.T),
         edges_a=np.ascontiguousarray(edges[:, 0]),
         edges_b=np.ascontiguousarray(edges[:, 1]),
