@@ -1,8 +1,8 @@
 """Builds the kernels ahead of time into ``lilium/_kernels_aot`` (numba's pycc; see lilium.jit).
 
 Everything else about the package is in pyproject.toml. The build is optional: without a C
-compiler (or should it fail otherwise) the package installs without the module, says so, and its
-kernels are compiled by numba's JIT on first use, as before.
+compiler (or should it fail otherwise) the package installs without the module (``pip install
+-v`` shows the reason), and its kernels are compiled by numba's JIT on first use, as before.
 """
 
 import sys
@@ -24,7 +24,7 @@ class BuildKernels(build_ext):
         try:
             from lilium.jit_aot import build
 
-            print("lilium: compiling the kernels ahead of time (about 30 s)", file=sys.stderr)
+            print("lilium: compiling the kernels ahead of time (0.5-1 min)", file=sys.stderr)
             build(target.parent, target.name)
         except Exception as error:  # noqa: BLE001 - any failure leaves numba's JIT in charge
             print(

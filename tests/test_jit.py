@@ -3,6 +3,7 @@ them only with exactly the argument types they were built for, they give numba's
 a stale build is not used, and a ``lilium sfo`` process served by them never imports numba."""
 
 import json
+import os
 import subprocess
 import sys
 
@@ -139,3 +140,54 @@ def test_an_sfo_process_never_imports_numba(case, tmp_path):
     ).stdout
     assert json.loads((tmp_path / "out" / "result.json").read_text())["method"] == "lilium"
     assert "MODULES []" in out, out
+
+
+def test_a_numba_that_fails_to_import_leaves_the_numpy_path(tmp_path):
+    """numba installed but broken (built for another numpy): the call that finds out runs in
+    Python, warns once, and the rest takes the numpy path; the answers are the numpy path's."""
+    fake = tmp_path / "numba"
+    fake.mkdir()
+    (fake / "__init__.py").write_text("raise ImportError('Numba needs NumPy 2.3 or less')\n")
+    code = (
+        "import warnings, numpy as np\n"
+        "from lilium import jit\n"
+        "from lilium.imaging.raster import mesh_edge_topology\n"
+        "faces = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])\n"
+        "with warnings.catch_warnings(record=True) as caught:\n"
+        "    warnings.simplefilter('always')\n"
+        "    got = mesh_edge_topology(faces)\n"
+        "    again = mesh_edge_topology(faces)\n"
+        "with jit.kernels('numpy'):\n"
+        "    want = mesh_edge_topology(faces)\n"
+        "assert jit.backend() == 'numpy', jit.backend()\n"
+        "assert (got.edges == want.edges).all() and (again.edges == want.edges).all()\n"
+        "assert (got.incidence.data == want.incidence.data).all()\n"
+        "print(len(caught), caught[0].message)\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(tmp_path), "LILIUM_KERNELS": "jit"}
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
+    ).stdout
+    assert out.startswith("1 numba failed to import (Numba needs NumPy 2.3 or less)"), out
+
+
+def test_the_incidence_of_edges_without_sides_is_zero():
+    """An edge no side runs along (possible through :func:`edge_incidence`'s arguments, not
+    from a mesh) has an empty row, as in scipy's CSR."""
+    from scipy import sparse
+
+    from lilium.imaging.raster import edge_incidence
+
+    edge_of, direction = np.array([0, 2, 2, 4, 0, 2]), np.array([1.0, 1, 1, -1, -1, 1])
+    dense = np.arange(10.0).reshape(2, 5)
+    want = sparse.csr_matrix((direction, (edge_of, np.arange(6) // 3)), shape=(5, 2))
+    want.sum_duplicates()
+    for name in ("numba", "numpy"):
+        with jit.kernels(name if jit.NUMBA_AVAILABLE else "numpy"):
+            got = edge_incidence(edge_of, direction, 5)
+        np.testing.assert_array_equal(got.indptr, want.indptr)
+        np.testing.assert_array_equal(got.indices, want.indices)
+        np.testing.assert_array_equal(got.data, want.data)
+        np.testing.assert_array_equal(got @ dense, want @ dense)
+    with pytest.raises(ValueError, match="three sides per face"):
+        edge_incidence(edge_of[:5], direction[:5], 5)

@@ -26,8 +26,9 @@ A kernel is compiled one of two ways, from the same source:
 - **just in time**, for every other call: numba (``cache=True``, so only the first run on a
   machine pays the compile time, cached in the package's ``__pycache__`` folders).
 
-numba is a pinned dependency (``pyproject.toml``); should it be missing (a platform without its
-wheels), Lilium still runs, on the numpy path, only slower. ``LILIUM_KERNELS=numpy`` in the
+numba is a pinned dependency (``pyproject.toml``); should it be missing, or fail to import (a
+numba built against another numpy), Lilium still runs, on the numpy path, only slower (a failed
+import warns once). ``LILIUM_KERNELS=numpy`` in the
 environment forces the numpy path (the benchmarks' reference timings), ``LILIUM_KERNELS=jit``
 numba's JIT without the ahead-of-time module; :func:`kernels` switches them inside a process
 (tests).
@@ -40,6 +41,7 @@ import importlib
 import importlib.util
 import os
 import platform
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -83,15 +85,19 @@ class Kernel:
             for n_args, fits, function in self._exports:
                 if len(args) == n_args and fits(*args):
                     return function(*args)
-        return self.dispatcher(*args)
+        dispatcher = self.dispatcher
+        if dispatcher is None:  # numba would not import: this call in Python, then numpy's path
+            return self.py_func(*args)
+        return dispatcher(*args)
 
     @property
     def dispatcher(self):
-        """numba's dispatcher of ``py_func`` (compiled, or loaded from its cache, on a call)."""
+        """numba's dispatcher of ``py_func`` (compiled, or loaded from its cache, on a call);
+        None when numba is installed but fails to import."""
         if self._dispatcher is None:
-            import numba
-
-            _teach_numba()
+            numba = _import_numba()
+            if numba is None:
+                return None
             self._dispatcher = numba.njit(**self.options)(self.py_func)
         return self._dispatcher
 
@@ -112,16 +118,29 @@ def _kernel_named(module, qualname):
 
 
 @functools.cache
-def _teach_numba():
-    """Let numba compile a call of a :class:`Kernel` from another kernel: it types it as the
-    kernel's dispatcher (the module's name holds the Kernel, so numba's cache pickles it by
-    reference, and its inliner reads ``py_func`` and ``targetoptions`` from it)."""
-    from numba.core import types
-    from numba.extending import typeof_impl
+def _import_numba():
+    """numba, taught to compile a call of a :class:`Kernel` from another kernel (it types it as
+    the kernel's dispatcher: the module's name holds the Kernel, so numba's cache pickles it by
+    reference, and its inliner reads ``py_func`` and ``targetoptions`` from it); or None, with a
+    warning and the numpy path from then on, when it is installed but fails to import."""
+    try:
+        import numba
+        from numba.core import types
+        from numba.extending import typeof_impl
+    except Exception as error:  # noqa: BLE001 - e.g. a numba built for another numpy
+        warnings.warn(
+            f"numba failed to import ({error}); Lilium runs its numpy reference path (slower)",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+        _state["backend"] = "numpy"
+        return None
 
     @typeof_impl.register(Kernel)
     def _typeof_kernel(value, context):
         return types.Dispatcher(value.dispatcher)
+
+    return numba
 
 
 def njit(*args, **kwargs):

@@ -97,7 +97,7 @@ class EdgeIncidence:
     Attributes
     ----------
     indptr : ndarray of shape (E + 1,) of int64
-        Edge ``e``'s entries are ``indptr[e]:indptr[e + 1]`` (at least one each).
+        Edge ``e``'s entries are ``indptr[e]:indptr[e + 1]``.
     indices : ndarray of shape (K,) of int64
         Their faces, ascending within an edge.
     data : ndarray of shape (K,) of float64
@@ -113,10 +113,12 @@ class EdgeIncidence:
 
     def __matmul__(self, dense):
         """``incidence @ dense`` for a dense ``dense`` (F, S): (E, S) of float64."""
-        products = self.data[:, None] * dense[self.indices]
-        if not len(products):
-            return np.zeros((self.shape[0], dense.shape[1]))
-        return np.add.reduceat(products, self.indptr[:-1], axis=0)
+        out = np.zeros((self.shape[0], dense.shape[1]))
+        rows = np.flatnonzero(self.indptr[1:] > self.indptr[:-1])  # rows with entries
+        if len(rows):
+            products = self.data[:, None] * dense[self.indices]
+            out[rows] = np.add.reduceat(products, self.indptr[rows], axis=0)
+        return out
 
 
 def edge_incidence(edge_of, direction, n_edges):
@@ -133,6 +135,10 @@ def edge_incidence(edge_of, direction, n_edges):
     -------
     EdgeIncidence
     """
+    edge_of = np.asarray(edge_of, np.int64)
+    direction = np.asarray(direction, np.float64)
+    if edge_of.ndim != 1 or len(edge_of) % 3 or direction.shape != edge_of.shape:
+        raise ValueError("edge_of and direction must be (3F,) arrays, three sides per face")
     n_faces = len(edge_of) // 3
     if jit.compiled() and len(edge_of):  # the same rows, compiled (imaging/_raster_kernels.py)
         indptr, indices, data = incidence_kernel(
