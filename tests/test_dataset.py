@@ -127,7 +127,6 @@ def test_cli_synth(tmp_path, monkeypatch, capsys):
     from lilium.cli import synth
 
     monkeypatch.setattr(ds, "_default_subject_api", lambda: (make_toy_subject, write_toy_subject))
-    monkeypatch.setattr(ds, "PNG_COMPRESSION", 0)
     import argparse
 
     parser = argparse.ArgumentParser()

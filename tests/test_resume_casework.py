@@ -127,7 +127,7 @@ def test_a_lineup_resumed_over_changed_inputs_runs_its_sfo_again(case, tmp_path,
 
 
 def test_write_result_writes_result_json_only_after_its_overlay(tmp_path, monkeypatch):
-    from PIL import Image
+    from lilium.io import results
 
     class Result:
         def to_dict(self):
@@ -137,10 +137,10 @@ def test_write_result_writes_result_json_only_after_its_overlay(tmp_path, monkey
     write_result(folder, Result(), np.zeros((4, 5, 3), np.uint8))
     assert png_readable(folder / "overlay.png") and (folder / "result.json").is_file()
 
-    def full(self, fp, *args, **kwargs):
+    def full(path, data):
         raise OSError(27, "File too large")  # what a file-size limit gives: no file name
 
-    monkeypatch.setattr(Image.Image, "save", full)
+    monkeypatch.setattr(results, "_write_bytes", full)
     with pytest.raises(OSError) as caught:
         write_result(folder, Result(), np.zeros((4, 5, 3), np.uint8))
     assert caught.value.filename == str(folder / "overlay.png")
@@ -149,7 +149,7 @@ def test_write_result_writes_result_json_only_after_its_overlay(tmp_path, monkey
     assert list(folder.iterdir()) == []
     monkeypatch.undo()
     write_png(folder / "overlay.png", np.zeros((4, 5, 3), np.uint8))
-    monkeypatch.setattr(Image.Image, "save", full)
+    monkeypatch.setattr(results, "_write_bytes", full)
     with pytest.raises(OSError):
         write_png(folder / "overlay.png", np.ones((4, 5, 3), np.uint8))
     assert [p.name for p in folder.iterdir()] == ["overlay.png"]  # no temporary file left
@@ -184,12 +184,12 @@ def test_a_lineup_resumed_without_a_whole_overlay_runs_the_sfo_again(case, tmp_p
 
 
 def test_a_file_size_limit_names_the_overlay(case, tmp_path, capsys, monkeypatch):
-    from PIL import Image
+    from lilium.io import results
 
-    def full(self, fp, *args, **kwargs):
+    def full(path, data):
         raise OSError(27, "File too large")
 
-    monkeypatch.setattr(Image.Image, "save", full)
+    monkeypatch.setattr(results, "_write_bytes", full)
     monkeypatch.delenv("LILIUM_DEBUG")
     out = tmp_path / "out"
     line = _one_line_error(capsys, _lineup(case, out), "overlay.png")

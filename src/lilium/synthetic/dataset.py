@@ -43,13 +43,11 @@ import numpy as np
 from ..io import jsonio
 from ..io.locks import RunLock
 from ..io.paths import naming_errors
+from ..io.results import write_png
 from ..softtissue.landmarks import CORRESPONDENCES
 from . import incomplete as _incomplete
 from . import noise as _noise
 from . import photos as _photos
-
-#: PNG compression level (0-9): 1 is several times faster than the default for these renders.
-PNG_COMPRESSION = 1
 
 
 def subject_ids(n_subjects):
@@ -61,35 +59,6 @@ def subject_ids(n_subjects):
 def photo_id(subject_id, view, k):
     """``<sid>_f<kk>`` for frontal photos, ``<sid>_l<kk>`` for lateral ones."""
     return f"{subject_id}_{'f' if view == 'frontal' else 'l'}{k:02d}"
-
-
-def write_png(path, image, bilevel=False):
-    """Write an RGB ``(H, W, 3)`` or grey ``(H, W)`` uint8 image as PNG.
-
-    ``bilevel=True`` writes a 1-bit PNG (non-zero -> 255 when read back), about ten times faster
-    than 8-bit for masks.
-
-    Raises
-    ------
-    OSError
-        Naming ``path`` (:func:`~lilium.io.paths.naming_errors`).
-    ValueError
-        OpenCV could not write it (it says no more: a full disk, a file-size limit or no write
-        permission).
-    """
-    image = np.asarray(image)
-    if image.ndim == 3:
-        image = image[..., ::-1]  # RGB -> BGR for OpenCV
-    params = [cv2.IMWRITE_PNG_COMPRESSION, PNG_COMPRESSION]
-    if bilevel:
-        params += [cv2.IMWRITE_PNG_BILEVEL, 1]
-    with naming_errors(path):
-        written = cv2.imwrite(str(path), image, params)
-    if not written:
-        raise ValueError(
-            f"{path}: could not write the PNG (a full disk, a file-size limit or no write "
-            "permission); free space or give another output folder"
-        )
 
 
 def _link_or_copy(src, dst):
