@@ -135,3 +135,37 @@ def test_a_prior_that_contradicts_the_photos_exif_is_named(tmp_path):
     assert not [w for w in with_priors(overlapping, path)[0].warnings if w.code == "prior_conflict"]
     ignored, _ = with_priors(photo, path, use_exif=False)  # --no-exif: EXIF is not read at all
     assert not ignored.warnings
+
+
+def test_a_pngs_exif_is_read_wherever_its_chunk_lies(tmp_path):
+    """PNG keeps EXIF in an ``eXIf`` chunk, before or (as some tools write it) after the pixel
+    data; both are read, and no pixel is decoded to find them (Pillow's ``getexif`` decodes a
+    whole 24 MP photo for it)."""
+    import struct
+    import zlib
+
+    from lilium.io.exif import read_exif
+
+    exif = Image.Exif()
+    exif[0x0110] = "Test camera"  # Pillow writes no eXIf chunk for an empty IFD0
+    exif.get_ifd(0x8769)[0x920A] = IFDRational(5.0)
+    before = tmp_path / "before.png"
+    Image.new("RGB", (40, 30), (90, 90, 90)).save(before, exif=exif)
+    data = before.read_bytes()
+    chunks, at = [], 8
+    while at < len(data):
+        (length,) = struct.unpack(">I", data[at : at + 4])
+        chunks.append(data[at : at + 12 + length])
+        at += 12 + length
+    exif_chunk = next(c for c in chunks if c[4:8] == b"eXIf")
+    rest = [c for c in chunks if c[4:8] != b"eXIf"]
+    after = tmp_path / "after.png"
+    after.write_bytes(data[:8] + b"".join(rest[:-1]) + exif_chunk + rest[-1])
+    assert zlib.crc32(exif_chunk[4:-4]) == struct.unpack(">I", exif_chunk[-4:])[0]
+    for path in (before, after):
+        fields = read_exif(path)
+        assert fields["focal_mm"] == pytest.approx(5.0) and fields["model"] == "Test camera"
+        assert fields["image_size_wh"] == (40, 30)
+    plain = tmp_path / "plain.png"
+    Image.new("RGB", (40, 30)).save(plain)
+    assert "focal_mm" not in read_exif(plain)
