@@ -55,6 +55,11 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh, *, topology=No
     index = nearest_face_index(
         uv, faces, X[faces, 2].mean(axis=1), (height, width), covered=covered
     )
+    shade = np.zeros((height, width), np.float32)
+    box = covered_box(covered)
+    if box is None:
+        return shade, covered
+    index = index[box]  # the per-pixel steps inside the skull's bounding box only
     # Lambert intensity of the triangles seen (the others are never looked up).
     marked = np.zeros(len(faces) + 1, bool)
     marked[index] = True  # -1 (no triangle) marks the extra last slot
@@ -65,9 +70,18 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh, *, topology=No
     intensity = np.zeros(len(faces), np.float32)
     # Two-sided lighting: a skull mesh may be wound either way.
     intensity[seen] = (0.25 + 0.75 * np.abs(normal @ LIGHT_DIR_CAM)).astype(np.float32)
-    shade = np.where(index >= 0, intensity[index], np.float32(0.0))
-    shade[~covered] = 0.0
+    shade[box] = np.where((index >= 0) & covered[box], intensity[index], np.float32(0.0))
     return shade, covered
+
+
+def covered_box(covered):
+    """``(rows, cols)`` slices of the smallest box holding every True pixel of ``covered``
+    (H, W); None when there is none."""
+    rows = np.flatnonzero(covered.any(axis=1))
+    if not rows.size:
+        return None
+    cols = np.flatnonzero(covered[rows[0] : rows[-1] + 1].any(axis=0))
+    return slice(int(rows[0]), int(rows[-1]) + 1), slice(int(cols[0]), int(cols[-1]) + 1)
 
 
 def as_uint8_rgb(image):
@@ -100,15 +114,16 @@ def blend_skull(image, shade, covered, opacity):
         elsewhere; computed in float64 over blocks of rows (:data:`BLEND_BLOCK_PIXELS`).
     """
     out = as_uint8_rgb(image)
-    rows = np.flatnonzero(covered.any(axis=1))
-    if rows.size == 0:
+    box = covered_box(covered)
+    if box is None:
         return out
-    step = max(1, BLEND_BLOCK_PIXELS // max(1, out.shape[1]))
-    for r0 in range(int(rows[0]), int(rows[-1]) + 1, step):
-        r1 = min(r0 + step, int(rows[-1]) + 1)
-        alpha = opacity * covered[r0:r1, :, None]
-        blend = (1 - alpha) * out[r0:r1] + alpha * (shade[r0:r1, :, None] * SKULL_RGB)
-        out[r0:r1] = np.clip(blend, 0, 255).astype(np.uint8)
+    rows, cols = box
+    step = max(1, BLEND_BLOCK_PIXELS // max(1, cols.stop - cols.start))
+    for r0 in range(rows.start, rows.stop, step):
+        block = slice(r0, min(r0 + step, rows.stop)), cols
+        alpha = opacity * covered[block][..., None]
+        blend = (1 - alpha) * out[block] + alpha * (shade[block][..., None] * SKULL_RGB)
+        out[block] = np.clip(blend, 0, 255).astype(np.uint8)
     return out
 
 
