@@ -15,6 +15,7 @@ LAYERS = {
     "validation": 0,
     "jit": 0,
     "jit_signatures": 0,
+    "workers": 0,
     "geometry": 1,
     "optimisation": 1,
     "softtissue": 2,

@@ -58,3 +58,34 @@ def test_ctrl_c_inside_a_compiled_kernel_is_one_line(case, tmp_path, monkeypatch
     monkeypatch.setattr(sfo_cli, "sfo_on_folders", kernel_interrupted)
     assert cli_main.main([str(a) for a in _sfo(case, tmp_path / "out")]) == 130
     assert capsys.readouterr().err == "lilium sfo: interrupted\n"
+
+
+def test_a_pools_worker_ends_without_a_word_on_ctrl_c():
+    """Ctrl-C reaches a pool's workers too: one that is waiting for work (or still starting)
+    ends at once, with no traceback under the parent's one-line message (lilium.workers)."""
+    code = (
+        "import os, signal, time\n"
+        "from concurrent.futures import ProcessPoolExecutor\n"
+        "from multiprocessing import get_context\n"
+        "from lilium.workers import quiet_interrupts, starting_workers\n"
+        "if __name__ == '__main__':\n"
+        "    pool = ProcessPoolExecutor(1, mp_context=get_context('spawn'),\n"
+        "                               initializer=quiet_interrupts)\n"
+        "    with starting_workers():\n"
+        "        pid = pool.submit(os.getpid).result()\n"
+        "    os.kill(pid, signal.SIGINT)\n"
+        "    deadline = time.monotonic() + 30\n"
+        "    while time.monotonic() < deadline:\n"
+        "        try:\n"
+        "            os.kill(pid, 0)\n"
+        "        except ProcessLookupError:\n"
+        "            break\n"
+        "        time.sleep(0.05)\n"
+        "    else:\n"
+        "        raise SystemExit('the worker did not end')\n"
+        "    pool.shutdown(wait=False)\n"
+        "    print('ended')\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert "ended" in done.stdout, done.stderr
+    assert "Traceback" not in done.stderr and "KeyboardInterrupt" not in done.stderr, done.stderr

@@ -6,7 +6,6 @@
 - :mod:`lilium.experiments.dataset` the dataset index, its files and its fingerprint, checked
   before the first SFO
 - :mod:`lilium.experiments.runner`  task enumeration, local process pool or Dask, resume
-- :mod:`lilium.experiments.processes` local workers that end when their parent dies
 - :mod:`lilium.experiments.report`  the paper's tables, Wilcoxon tests and plots
 """
 

@@ -12,7 +12,7 @@ import socket
 import time
 from urllib.parse import urlsplit
 
-from .processes import exit_with_parent
+from ..workers import exit_with_parent, quiet_interrupts, starting_workers
 
 #: Tasks in flight per worker (keeps workers busy without queueing the whole run).
 IN_FLIGHT_PER_WORKER = 3
@@ -48,6 +48,7 @@ def init_worker(parent_pid=None):
 
     cv2.setNumThreads(1)
     if parent_pid is not None:
+        quiet_interrupts()
         exit_with_parent(parent_pid)
 
 
@@ -91,7 +92,8 @@ def local_results(tasks, workers, run):
                 task = next(todo, None)
                 if task is None:
                     return
-                pending[pool.submit(run, task)] = task
+                with starting_workers():
+                    pending[pool.submit(run, task)] = task
 
         fill()
         while pending:

@@ -24,7 +24,7 @@ once.
 Executors: a local process pool (default, all cores) or a Dask distributed cluster
 (``scheduler="tcp://host:8786"``); the dataset folder must then be readable by every worker at
 the same path (a shared file system). Local workers end when the parent process dies, however
-it dies (:func:`lilium.experiments.processes.exit_with_parent`); a Dask cluster is reached before
+it dies (:func:`lilium.workers.exit_with_parent`); a Dask cluster is reached before
 anything else, and a cluster without workers ends the run (:mod:`lilium.experiments.executors`).
 """
 

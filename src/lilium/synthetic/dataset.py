@@ -45,6 +45,7 @@ from ..io.locks import RunLock
 from ..io.paths import naming_errors
 from ..io.results import write_png
 from ..softtissue.landmarks import CORRESPONDENCES
+from ..workers import quiet_interrupts, starting_workers
 from . import incomplete as _incomplete
 from . import noise as _noise
 from . import photos as _photos
@@ -290,8 +291,11 @@ def generate_dataset(
         else:
             # Spawned, not forked, as the experiment runner's workers: a fork after a library
             # started threads (LiteRT's, once `lilium photo` ran in this process) deadlocked.
-            with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
-                futures = {pool.submit(_generate_subject, t): t[1] for t in tasks}
+            with ProcessPoolExecutor(
+                max_workers=workers, mp_context=get_context("spawn"), initializer=quiet_interrupts
+            ) as pool:
+                with starting_workers():  # a Ctrl-C ends the workers without tracebacks
+                    futures = {pool.submit(_generate_subject, t): t[1] for t in tasks}
                 for future in as_completed(futures):
                     results[futures[future]] = future.result()
                     if progress is not None:
