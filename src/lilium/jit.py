@@ -15,10 +15,11 @@ A kernel is compiled one of two ways, from the same source:
 
 - **ahead of time**, when the package was installed: ``pip install`` builds the extension module
   ``lilium._kernels_aot`` with numba's ``pycc`` (``setup.py``, :mod:`lilium.jit_aot`) for the
-  argument types listed in :mod:`lilium.jit_signatures` (those of the demo, ``lilium sfo``,
-  ``case``, ``lineup`` and ``experiment``). A call whose arguments have exactly one of those types
-  runs it, and a process that needs nothing else never imports numba (numba's import and its
-  registries cost about 0.5 s per process; the module loads in about a millisecond). The module
+  argument types listed in :mod:`lilium.jit_signatures` (recorded from the demo, ``lilium sfo``
+  and ``lilium case``, whose SFOs ``lineup`` and ``experiment`` run too). A call whose arguments
+  have exactly one of those types runs it, and a process that needs nothing else never imports
+  numba (numba's import and its registries cost about 0.5 s per process; the module loads in
+  about a millisecond). The module
   carries a hash of the kernels' sources and of that list; after an edit of either, it no longer
   matches and is not used (run ``pip install -e .`` again to rebuild it); nor on another CPU
   than the one it was built for (:func:`cpu_fingerprint`). Without a C compiler the build is
@@ -28,10 +29,9 @@ A kernel is compiled one of two ways, from the same source:
 
 numba is a pinned dependency (``pyproject.toml``); should it be missing, or fail to import (a
 numba built against another numpy), Lilium still runs, on the numpy path, only slower (a failed
-import warns once). ``LILIUM_KERNELS=numpy`` in the
-environment forces the numpy path (the benchmarks' reference timings), ``LILIUM_KERNELS=jit``
-numba's JIT without the ahead-of-time module; :func:`kernels` switches them inside a process
-(tests).
+import warns once). ``LILIUM_KERNELS=numpy`` in the environment forces the numpy path (the
+benchmarks' reference timings), ``LILIUM_KERNELS=jit`` numba's JIT without the ahead-of-time
+module; :func:`kernels` switches them inside a process (tests).
 """
 
 import contextlib
