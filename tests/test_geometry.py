@@ -166,3 +166,28 @@ def test_check_skull2cam_errors(matrix, match):
 def test_check_rotation_names_the_argument():
     with pytest.raises(ValueError, match="head_rotation must be a 3x3"):
         check_rotation(np.eye(4), name="head_rotation")
+
+
+def test_rotation_vectors_and_euler_angles_are_scipys():
+    """matrix_to_rotvec and matrix_to_euler_xyz_deg give scipy's Rotation (not imported by them:
+    scipy.spatial costs a command 0.17 s), near 0 and pi and at gimbal lock too."""
+    import warnings
+
+    from scipy.spatial.transform import Rotation
+
+    from lilium.geometry.rotations import matrix_to_euler_xyz_deg
+
+    rng = np.random.default_rng(3)
+    axes = rng.normal(size=(50, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    edges = [0.0, 1e-12, 1e-5, 1e-3, np.pi - 1e-3, np.pi - 1e-9]
+    angles = np.concatenate([edges, rng.random(44) * np.pi])
+    rotvecs = axes * angles[:, None]
+    R = Rotation.from_rotvec(rotvecs).as_matrix()
+    np.testing.assert_allclose(matrix_to_rotvec(R), Rotation.from_matrix(R).as_rotvec(), atol=1e-12)
+    locked = Rotation.from_euler("xyz", [[30, 90, 0], [-40, -90, 0]], degrees=True).as_matrix()
+    for m in [*R, *locked]:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # scipy warns at gimbal lock
+            want = Rotation.from_matrix(m).as_euler("xyz", degrees=True)
+        np.testing.assert_allclose(matrix_to_euler_xyz_deg(m), want, atol=1e-9)

@@ -106,10 +106,12 @@ def test_ahead_of_time_and_jit_give_the_same_sfo(case, monkeypatch):
 
 
 @built
-def test_an_sfo_process_never_imports_numba(case, tmp_path):
+@pytest.mark.parametrize("command", ["sfo", "case"])
+def test_a_process_never_imports_numba(case, tmp_path, command):
     """Issue 26's start-up: numba's import and registries cost a process about 0.5 s; with the
-    kernels built ahead of time ``lilium sfo`` (Lilium skof+pll) needs neither, nor
-    scipy.sparse (the mesh's edge incidence is built without it)."""
+    kernels built ahead of time ``lilium sfo`` (Lilium skof+pll) and ``lilium case`` (its
+    overlay and report pictures too) need neither, nor scipy.sparse (the mesh's edge incidence
+    is built without it). A kernel whose signature the list misses fails this test."""
     subject_dir, photo_dir = case
     code = (
         "import sys\n"
@@ -117,29 +119,14 @@ def test_an_sfo_process_never_imports_numba(case, tmp_path):
         "code = main(sys.argv[1:])\n"
         "print('MODULES', [m for m in ('numba', 'scipy.sparse') if m in sys.modules])\n"
     )
-    out = subprocess.run(
-        [
-            sys.executable,
-            "-c",
-            code,
-            "sfo",
-            "--skull",
-            str(subject_dir),
-            "--photo",
-            str(photo_dir),
-            "--method",
-            "lilium",
-            "--generations",
-            "20",
-            "--out",
-            str(tmp_path / "out"),
-        ],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout
-    assert json.loads((tmp_path / "out" / "result.json").read_text())["method"] == "lilium"
-    assert "MODULES []" in out, out
+    args = [command, "--skull", subject_dir, "--photo", photo_dir, "--method", "lilium"]
+    args += ["--generations", "20", "--out", tmp_path / "out"]
+    done = subprocess.run(
+        [sys.executable, "-c", code, *map(str, args)], capture_output=True, text=True, check=True
+    )
+    results = list((tmp_path / "out").rglob("result.json"))
+    assert len(results) == 1 and json.loads(results[0].read_text())["method"] == "lilium"
+    assert "MODULES []" in done.stdout, done.stdout
 
 
 def test_a_numba_that_fails_to_import_leaves_the_numpy_path(tmp_path):

@@ -56,11 +56,59 @@ def matrix_to_rotvec(R):
     -------
     rotvec : ndarray of shape (..., 3)
     """
-    from scipy.spatial.transform import Rotation
-
     R = np.asarray(R, dtype=float)
-    flat = R.reshape(-1, 3, 3)
-    return Rotation.from_matrix(flat).as_rotvec().reshape(R.shape[:-2] + (3,))
+    q = _matrix_to_quaternion(R.reshape(-1, 3, 3))  # (N, 4): x, y, z, w with w >= 0
+    sin_half = np.linalg.norm(q[:, :3], axis=1)
+    angle = 2.0 * np.arctan2(sin_half, q[:, 3])
+    small = angle < 1e-3  # angle / sin(angle / 2) by its series near 0
+    scale = np.where(small, 2.0 + angle**2 / 12.0, angle / np.where(small, 1.0, sin_half))
+    return (q[:, :3] * scale[:, None]).reshape(R.shape[:-2] + (3,))
+
+
+def _matrix_to_quaternion(R):
+    """Unit quaternions ``(x, y, z, w)``, ``w >= 0``, of rotation matrices (N, 3, 3): from the
+    largest of ``w`` and the diagonal (Shepperd's method, as scipy's ``Rotation.from_matrix``;
+    scipy.spatial costs a command 0.17 s to import)."""
+    trace = R[:, 0, 0] + R[:, 1, 1] + R[:, 2, 2]
+    choice = np.argmax(np.column_stack([R[:, 0, 0], R[:, 1, 1], R[:, 2, 2], trace]), axis=1)
+    q = np.empty((len(R), 4))
+    for i in range(3):
+        rows = np.flatnonzero(choice == i)
+        j, k = (i + 1) % 3, (i + 2) % 3
+        r = R[rows]
+        q[rows, i] = 1.0 - trace[rows] + 2.0 * r[:, i, i]
+        q[rows, j] = r[:, j, i] + r[:, i, j]
+        q[rows, k] = r[:, k, i] + r[:, i, k]
+        q[rows, 3] = r[:, k, j] - r[:, j, k]
+    rows = np.flatnonzero(choice == 3)
+    r = R[rows]
+    q[rows, 0] = r[:, 2, 1] - r[:, 1, 2]
+    q[rows, 1] = r[:, 0, 2] - r[:, 2, 0]
+    q[rows, 2] = r[:, 1, 0] - r[:, 0, 1]
+    q[rows, 3] = 1.0 + trace[rows]
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    return np.where(q[:, 3:] < 0, -q, q)
+
+
+def matrix_to_euler_xyz_deg(R):
+    """Extrinsic x-y-z Euler angles (degrees) of a rotation matrix (3, 3): ``R = Rz(c) Ry(b)
+    Rx(a)``, ``b`` in [-90, 90] (scipy's ``as_euler("xyz")``; at ``b = +-90`` degrees, where
+    only ``a -+ c`` is defined, ``c = 0``).
+
+    Returns
+    -------
+    ndarray of shape (3,)
+        ``(a, b, c)``.
+    """
+    R = np.asarray(R, dtype=float)
+    b = np.arcsin(np.clip(-R[2, 0], -1.0, 1.0))
+    if abs(R[2, 0]) < 1.0 - 1e-12:
+        a = np.arctan2(R[2, 1], R[2, 2])
+        c = np.arctan2(R[1, 0], R[0, 0])
+    else:  # gimbal lock
+        a = np.arctan2(-np.sign(R[2, 0]) * R[0, 1], R[1, 1])
+        c = 0.0
+    return np.degrees([a, b, c])
 
 
 def geodesic_angle_deg(R_a, R_b):

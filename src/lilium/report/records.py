@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..evaluation.metrics import outside_face
-from ..geometry.rotations import geodesic_angle_deg, matrix_to_rotvec
+from ..geometry.rotations import geodesic_angle_deg, matrix_to_euler_xyz_deg, matrix_to_rotvec
 from ..io.provenance import input_files, software_versions
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
 from ..validation import fmt_range
@@ -133,8 +133,6 @@ def camera_facts(result, photo):
     -------
     CameraFacts
     """
-    from scipy.spatial.transform import Rotation
-
     camera = result.camera
     T, R = camera.skull2cam, camera.R
     rotvec = matrix_to_rotvec(R)
@@ -151,7 +149,7 @@ def camera_facts(result, photo):
         scd_point="facial nasion" if "nasion" in lms else "centroid of the facial landmarks",
         rotation_angle_deg=angle,
         rotation_axis=_floats(axis),
-        euler_xyz_deg=_floats(Rotation.from_matrix(R).as_euler("xyz", degrees=True)),
+        euler_xyz_deg=_floats(matrix_to_euler_xyz_deg(R)),
         translation_mm=_floats(T[:3, 3]),
         skull2cam=tuple(_floats(row) for row in T),
         head_deviation_deg=None if prior is None else float(geodesic_angle_deg(R, prior)),
