@@ -151,10 +151,13 @@ def weld(vertices, faces):
 
 
 def compact(vertices, faces):
-    """Drop unreferenced vertices and re-index the faces (the vertices keep their order)."""
-    faces = np.asarray(faces, dtype=np.int64)
+    """Drop unreferenced vertices and re-index the faces (the vertices keep their order); a
+    mesh whose every vertex is referenced comes back as it is (its faces int64, contiguous)."""
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
     used = np.zeros(len(vertices), bool)
     used[faces.reshape(-1)] = True
+    if used.all():
+        return vertices, faces
     index = np.cumsum(used) - 1
     return vertices[used], index[faces]
 

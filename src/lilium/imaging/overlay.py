@@ -7,7 +7,7 @@ import cv2
 import numpy as np
 
 from ._paint_kernels import nearest_face_index
-from .raster import skull_raster
+from .raster import covered_box, skull_raster
 
 #: Colours (RGB).
 SKULL_RGB = np.array([235, 225, 190], dtype=float)
@@ -72,16 +72,6 @@ def render_mesh_shaded(vertices_mm, faces, camera, image_size_wh, *, topology=No
     intensity[seen] = (0.25 + 0.75 * np.abs(normal @ LIGHT_DIR_CAM)).astype(np.float32)
     shade[box] = np.where((index >= 0) & covered[box], intensity[index], np.float32(0.0))
     return shade, covered
-
-
-def covered_box(covered):
-    """``(rows, cols)`` slices of the smallest box holding every True pixel of ``covered``
-    (H, W); None when there is none."""
-    rows = np.flatnonzero(covered.any(axis=1))
-    if not rows.size:
-        return None
-    cols = np.flatnonzero(covered[rows[0] : rows[-1] + 1].any(axis=0))
-    return slice(int(rows[0]), int(rows[-1]) + 1), slice(int(cols[0]), int(cols[-1]) + 1)
 
 
 def as_uint8_rgb(image):

@@ -39,10 +39,13 @@ from ._raster_kernels import edge_table_kernel, incidence_kernel, scan_kernel
 
 __all__ = [
     "Crossings",
+    "EdgeIncidence",
     "EdgeTopology",
     "check_faces",
     "check_topology",
     "contour_edges",
+    "covered_box",
+    "edge_incidence",
     "face_orientations",
     "mesh_edge_topology",
     "mesh_mask",
@@ -153,6 +156,16 @@ def edge_incidence(edge_of, direction, n_edges):
     data = np.add.reduceat(direction[order], starts) if len(starts) else np.zeros(0)
     indptr = np.searchsorted(edge[starts], np.arange(n_edges + 1)).astype(np.int64)
     return EdgeIncidence(indptr, face[starts].astype(np.int64), data, (int(n_edges), n_faces))
+
+
+def covered_box(covered):
+    """``(rows, cols)`` slices of the smallest box holding every True pixel of ``covered``
+    (H, W); None when there is none."""
+    rows = np.flatnonzero(covered.any(axis=1))
+    if not rows.size:
+        return None
+    cols = np.flatnonzero(covered[rows[0] : rows[-1] + 1].any(axis=0))
+    return slice(int(rows[0]), int(rows[-1]) + 1), slice(int(cols[0]), int(cols[-1]) + 1)
 
 
 def check_faces(faces, n_vertices=None):

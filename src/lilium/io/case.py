@@ -210,10 +210,7 @@ def _skull_part(mesh_path, vertices, faces, landmarks):
                 "them from the mesh if they are not this skull's bone",
             )
         )
-    used = np.zeros(len(vertices), bool)
-    used[faces.reshape(-1)] = True
-    if not used.all():
-        vertices, faces = compact(vertices, faces)
+    vertices, faces = compact(vertices, faces)
     return vertices, faces, warnings
 
 

@@ -19,6 +19,7 @@
 
 import numpy as np
 
+from ..imaging.raster import covered_box
 from ..inputs import CaseWarning
 from ..softtissue.landmarks import side, twin
 
@@ -88,9 +89,8 @@ def _distance_to_mask_px(mask, row, col):
 
 def mask_diagonal_px(mask):
     """Diagonal of the mask's bounding box, pixels (``mask`` (H, W) bool, not empty)."""
-    rows = np.flatnonzero(mask.any(axis=1))
-    cols = np.flatnonzero(mask.any(axis=0))
-    return float(np.hypot(rows[-1] - rows[0] + 1, cols[-1] - cols[0] + 1))
+    rows, cols = covered_box(mask)
+    return float(np.hypot(rows.stop - rows.start, cols.stop - cols.start))
 
 
 def landmark_mask_ratios(photo):
