@@ -24,6 +24,7 @@ from lilium.methods.posest_sfo import mean_depth_landmarks
 from lilium.synthetic import noise as _noise
 from lilium.synthetic import photos as _photos
 from lilium.synthetic.dataset import subject_ids
+from lilium.synthetic.head import prepare_head
 from lilium.synthetic.subjects import MANDIBLE_LANDMARKS, make_subject
 
 
@@ -114,7 +115,7 @@ def sfo_problems(n_subjects, n_photos, seed=0, axes_set=1, mandible=True, views=
         )
         names = sorted(subject.facial_landmarks)
         facial_true = np.array([subject.facial_landmarks[n] for n in names])
-        head = _photos.prepare_head(subject)
+        head = prepare_head(subject)
         kinds = _photos.photo_views(n_photos)
         for k, (view, pseq) in enumerate(zip(kinds, photos_seq.spawn(len(kinds)), strict=True)):
             if views is not None and ("frontal" if view == "frontal" else "lateral") not in views:

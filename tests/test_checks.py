@@ -19,11 +19,11 @@ from lilium.methods.checks import (
     facing_check,
     label_handedness,
     landmark_error,
-    priors_record,
     skull_directions,
 )
 from lilium.methods.lilium import lilium_sfo
 from lilium.methods.posest_sfo import mean_depth_landmarks, posest_sfo
+from lilium.methods.prior_checks import priors_record
 from lilium.softtissue.landmarks import side, twin
 
 MIRROR = np.diag([-1.0, 1.0, 1.0])

@@ -11,7 +11,8 @@ from lilium.fitness.skof import skull_outside_pixels
 from lilium.geometry.camera import Camera
 from lilium.imaging.overlay import draw_overlay, render_mesh_shaded
 from lilium.imaging.raster import mesh_edge_topology, mesh_mask, skull_raster
-from lilium.synthetic.photos import CameraRanges, make_photo, prepare_head
+from lilium.synthetic.head import prepare_head
+from lilium.synthetic.photos import CameraRanges, make_photo
 from lilium.synthetic.toyhead import make_toy_subject
 from raster_oracle import skull_raster_per_triangle
 

@@ -321,7 +321,7 @@ def test_experiment_report_counts_sfos_with_a_term_off(tmp_path):
 
 @pytest.mark.slow
 def test_procedural_subject_without_mandible():
-    from lilium.synthetic.photos import prepare_head
+    from lilium.synthetic.head import prepare_head
     from lilium.synthetic.subjects import make_subject
 
     whole, jawless = make_subject("s", 5), make_subject("s", 5, mandible=False)

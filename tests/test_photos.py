@@ -4,6 +4,7 @@ import pytest
 from scipy import ndimage
 
 from lilium.imaging.raster import mesh_mask
+from lilium.synthetic.head import prepare_head
 from lilium.synthetic.photos import (
     MIN_VISIBLE_LANDMARKS,
     VIEWS,
@@ -12,7 +13,6 @@ from lilium.synthetic.photos import (
     make_photo,
     n_usable_landmarks,
     photo_record,
-    prepare_head,
     sample_camera,
 )
 from lilium.synthetic.render import render_mesh
@@ -202,7 +202,7 @@ def test_procedural_subject_skull_stays_inside_the_face_mask():
 def test_true_skull_projects_inside_the_face_mask():
     """The neck cut never cuts the skull: at the true camera P_skof is 0 (as in a real photo)."""
     from lilium.fitness.skof import skull_outside_pixels
-    from lilium.synthetic.photos import make_photo, prepare_head
+    from lilium.synthetic.photos import make_photo
     from lilium.synthetic.subjects import make_subject
 
     subject = make_subject("s1", rng=1)

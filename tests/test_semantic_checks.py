@@ -233,7 +233,7 @@ def test_a_photo_and_its_resized_copy_are_one_photo():
 
 
 def test_a_camera_just_outside_a_prior_reads_apart_from_its_bound():
-    from lilium.methods.checks import _apart
+    from lilium.methods.prior_checks import _apart
 
     assert _apart(3554.6, (3555.2, 3929.0)) == "3554.6"
     assert _apart(3000.0, (3555.2, 3929.0)) == "3000"

@@ -146,11 +146,12 @@ def test_silhouette_landmarks_are_seen_in_frontal_and_profile_views(subjects):
     """Subnasale, zygia, gonia are seen straight from the front; labiale superius, pogonion
     and gnathion in a true profile (z-buffer test of lilium.synthetic.photos)."""
     from lilium.synthetic import photos as P
+    from lilium.synthetic.head import prepare_head
 
     frontal = ("subnasale", "zygion_l", "zygion_r", "gonion_l", "gonion_r")
     profile = ("labiale_superius", "pogonion", "gnathion")
     for s in subjects:
-        head = P.prepare_head(s)
+        head = prepare_head(s)
         for yaw, names in ((0.0, frontal), (90.0, profile), (-90.0, profile)):
             R = P.head_rotation(yaw, 0.0, 0.0)
             T = np.eye(4)

@@ -24,7 +24,7 @@ from ..identification.conclusion import conclude, material_caps
 from ..identification.score import identification_terms, nll_score
 from ..inputs import correspondences
 from ..io.calibration import read_calibration, shipped_cohort, shipped_path
-from ..methods.checks import perspective_conflict
+from ..methods.prior_checks import perspective_conflict
 
 #: Cranial landmarks on the mandible: a skull with none of them has no mandible.
 MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")

@@ -11,8 +11,8 @@ import numpy as np
 from ..evaluation.metrics import outside_face
 from ..geometry.camera import Camera
 from ..inputs import correspondences
-from ..methods.checks import scd_point_mm
 from ..methods.lilium_terms import PllTerm, TermOff
+from ..methods.prior_checks import scd_point_mm
 from ..softtissue.depths import depth_stats
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
 from .cohort import cohort_terms, refit_views, skull_cohort_terms

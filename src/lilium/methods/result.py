@@ -35,7 +35,7 @@ class SfoResult:
         SPEC section 10 warnings (``view_mismatch``, ``no_focal_prior``, ...).
     priors : dict or None
         The priors used and where each came from
-        (:func:`lilium.methods.checks.priors_record`).
+        (:func:`lilium.methods.prior_checks.priors_record`).
     landmark_error : dict or None
         ``mean_px``, ``mean_mm``, ``per_landmark_px``
         (:func:`lilium.methods.checks.landmark_error`); None when the SFO failed.

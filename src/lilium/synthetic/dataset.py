@@ -49,6 +49,7 @@ from ..workers import quiet_interrupts, starting_workers
 from . import incomplete as _incomplete
 from . import noise as _noise
 from . import photos as _photos
+from .head import prepare_head
 
 
 def subject_ids(n_subjects):
@@ -157,7 +158,7 @@ def _generate_subject(task):
             jsonio.write_json(subject_dir / name, {"axes": axes_set})
             axes_files.append(name)
 
-    head = _photos.prepare_head(subject)
+    head = prepare_head(subject)
     views = _photos.photo_views(n_photos)
     photo_seqs = photos_seq.spawn(len(views))
     counters = {"frontal": 0, "lateral": 0}

@@ -92,7 +92,7 @@ class SyntheticSubject:
         True positions of the cranial landmarks the skull lacks (the mandible's).
     head_skull_vertices_mm : ndarray of shape (V'', 3) or None
         The complete skull the head was built on, when ``skull_vertices_mm`` is not it (no
-        mandible): the photos' neck cut clears it (:func:`~.photos.prepare_head`).
+        mandible): the photos' neck cut clears it (:func:`~.head.prepare_head`).
     """
 
     subject_id: str
