@@ -13,135 +13,37 @@ result that is right; a result is compared with the known camera of the stand-in
 generated photo (``ground_truth`` in ``photo.json``) or with the SFO of the clean input, and a
 wrong camera without a warning is ``silently wrong``.
 
-Inputs: the stand-in case of ``probe_hostile.py`` and a generated dataset of two subjects with
-one frontal and one lateral photo each (experiment A, made once per campaign, about 5 s).
-Budgets: POSEST-SFO, or Lilium with 5 x 2 where the check does not need a converged SFO.
+Inputs: the stand-in case of ``probe_hostile.py`` and the generated dataset of
+``probe_hostile_fixtures.py`` (``_syn``: two subjects with one frontal and one lateral photo
+each, experiment A, made once per campaign, about 5 s). Budgets: POSEST-SFO, or Lilium with
+5 x 2 where the check does not need a converged SFO.
 """
 
-import json
 import shutil
 
 import numpy as np
 
 from probe_hostile import Probe, _then
 from probe_hostile_casework import TINY, _quiet_main
-
-# -- inputs -----------------------------------------------------------------------------------
-
-
-def _in(ws, *parts):
-    return ws.root.joinpath("in", *parts)
-
-
-def _syn(ws):
-    """Set-up: ``in/syn``, a copy of the campaign's generated dataset (made once): subjects
-    ``s01``, ``s02``; photos ``photos/A/s0N_f00`` (frontal), ``s0N_l00`` (lateral)."""
-    cache = ws.root.parent / "semantic-dataset"
-    if not (cache / "dataset.json").is_file():
-        from lilium.synthetic.dataset import generate_dataset
-
-        shutil.rmtree(cache, ignore_errors=True)
-        generate_dataset(cache, 2, 1, seed=0, experiments=("A",), workers=1)
-    if not _in(ws, "syn").exists():
-        shutil.copytree(cache, _in(ws, "syn"))
-
-
-def _subject(name):
-    return lambda ws: _in(ws, "syn", "subjects", name)
-
-
-def _photo(name):
-    return lambda ws: _in(ws, "syn", "photos", "A", name)
-
-
-def _standin_skull(ws):
-    return ws.skull
-
-
-def _standin_photo(ws):
-    return ws.photo
-
-
-def _json(path):
-    return json.loads(path.read_text())
-
-
-def _dump(path, data):
-    path.write_text(json.dumps(data))
-
-
-def _edit_json(where, name, change):
-    """Set-up: ``change(data)`` on ``where(ws)/name`` (``where`` a callable of ``ws``)."""
-
-    def setup(ws):
-        path = where(ws) / name
-        data = _json(path)
-        change(data)
-        _dump(path, data)
-
-    return setup
-
-
-def _edit_landmarks(where, change, name="photo.json"):
-    """Set-up: ``landmarks = change(landmarks, ws)`` in ``where(ws)/name``."""
-
-    def setup(ws):
-        path = where(ws) / name
-        data = _json(path)
-        data["landmarks"] = change(data["landmarks"], ws)
-        _dump(path, data)
-
-    return setup
-
-
-def _image_op(where, op, names=("image.png", "face_mask.png")):
-    """Set-up: ``op(PIL image)`` on the photo's image and mask."""
-
-    def setup(ws):
-        from PIL import Image
-
-        for name in names:
-            path = where(ws) / name
-            if path.is_file():
-                with Image.open(path) as im:
-                    im.load()
-                    out = op(im)
-                out.save(path)
-
-    return setup
-
-
-def _size(where):
-    from PIL import Image
-
-    def get(ws):
-        with Image.open(where(ws) / "image.png") as im:
-            return im.size
-
-    return get
-
+from probe_hostile_fixtures import (
+    _codes,
+    _dump,
+    _edit_json,
+    _edit_landmarks,
+    _image_op,
+    _in,
+    _json,
+    _photo,
+    _result,
+    _rot_err_deg,
+    _size,
+    _standin_photo,
+    _standin_skull,
+    _subject,
+    _syn,
+)
 
 # -- checks -----------------------------------------------------------------------------------
-
-
-def _rot_err_deg(a, b):
-    R = np.asarray(a, float)[:3, :3] @ np.asarray(b, float)[:3, :3].T
-    return float(np.degrees(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))))
-
-
-def _result(ws, rel=None):
-    if rel is None:
-        found = sorted(ws.out.rglob("result.json"))
-        if not found:
-            return None
-        path = found[0]
-    else:
-        path = ws.out / rel
-    return _json(path) if path.is_file() else None
-
-
-def _codes(result):
-    return [w["code"] for w in result.get("warnings", [])]
 
 
 #: Warnings of the clean inputs (POSEST-SFO's focal is loose: ``outside_prior`` on clean
