@@ -7,7 +7,8 @@ SFOs on the numpy reference path (``lilium.jit.kernels("numpy")``) for ``--refer
 generations, next to the compiled path at that budget, which gives the speed-up ratio; and a
 per-term profile of the compiled run (where the time of an SFO goes: the set-up of the problem
 and its terms, camera refinement, P_skof, P_pll, the rest). The numpy path is the one the
-compiled kernels replaced: it gives the same numbers (``tests/test_kernels.py``).
+compiled kernels replaced: it gives the same numbers (``tests/test_kernels_mesh.py``,
+``tests/test_kernels_camera.py``).
 
     python benchmarks/bench_speed.py                       # generated Exp. C photos
     python benchmarks/bench_speed.py --dataset DIR --dataset DIR2   # e.g. a 150k-face skull

@@ -72,7 +72,7 @@ def _runs_off(monkeypatch, own_posest=False):
 
     monkeypatch.setattr(lilium, "refine_batch", run_off)
     # The compiled camera stage refines inside its kernel: take the steps one by one (the same
-    # numbers, tests/test_kernels.py) so that the patched refinement applies.
+    # numbers, tests/test_kernels_camera.py) so that the patched refinement applies.
     monkeypatch.setattr(
         lilium,
         "camera_terms_compiled",

@@ -8,7 +8,7 @@ the same end tangents (unit steps summed left to right, as ``cumsum`` does), the
 ``(a - b) * t + (c - d) * s > 0`` side tests, the same nearest-point rules (the face curve's
 table, then a search whose ties go to the lowest index, as ``argmin``'s), the pairs in curve
 order, and the sums of the terms in pair order. Integers (cuts, pair indices, counts) are
-equal and floats bit for bit equal on finite curves (``tests/test_kernels.py``).
+equal and floats bit for bit equal on finite curves (``tests/test_kernels_mesh.py``).
 """
 
 import math

@@ -15,7 +15,7 @@ pixel (:class:`lilium.fitness.skof.FaceMaskIndex`: the distance to the nearest n
 centre, less half a pixel diagonal and a rounding margin) no triangle of the cluster holds a
 non-face pixel centre and the cluster is skipped; otherwise its faces are projected (each vertex
 once per camera) and go into the exact union raster of :mod:`lilium.imaging._raster_kernels`.
-Nothing is approximated: the count equals the full mesh's (``tests/test_kernels.py`` checks it
+Nothing is approximated: the count equals the full mesh's (``tests/test_kernels_mesh.py`` checks it
 against the numpy raster of every face, on rotated, scaled, off-image and behind-camera skulls).
 
 The vertices are projected with the elementwise formula of :func:`project_vertices`, whose numpy

@@ -5,7 +5,8 @@ The same steps with the same arithmetic as the numpy code, the reference: the ce
 vertex from ``floor((v - min) / cell)``, the cells numbered in the order of their flat index
 (what ``np.unique``'s inverse and the dense ``cumsum`` numbering both give), each cell's mean
 summed in vertex order (as ``np.bincount`` with weights sums), then the faces whose three
-corners fall in three different cells. Bit for bit the numpy result (``tests/test_kernels.py``).
+corners fall in three different cells. Bit for bit the numpy result
+(``tests/test_kernels_mesh.py``).
 """
 
 import numpy as np

@@ -8,7 +8,7 @@ problem takes the same steps. Sums are accumulated in a fixed order, ``exp`` is 
 SIMD ``exp`` differs in the last bit for a few per cent of arguments) and the 7 x 7 system is
 solved by Gaussian elimination with partial pivoting rather than LAPACK, so results agree with
 the numpy path to rounding, not bit for bit: to about 1e-12 relative for Lilium's warm-started
-refinements (``tests/test_kernels.py`` checks 1e-9); where a problem ends in a flat valley (a
+refinements (``tests/test_kernels_camera.py`` checks 1e-9); where a problem ends in a flat valley (a
 distant head, focal length and depth nearly interchangeable) the two paths stop at points that
 differ by up to about 1e-7 relative, within the refinement's own stopping tolerance. A
 singular system (LAPACK's error, where the numpy path turns to a pseudo-inverse) gives a
