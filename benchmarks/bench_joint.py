@@ -316,10 +316,11 @@ def main(argv=None):
 
 def _headsq(args, de):
     import headsq_case
+    import headsq_ct
 
     root = headsq_case.ensure_dataset(args.headsq, n_photos=args.headsq_photos)
     if root is None:
-        print(f"\nheadsq: no CT at {headsq_case.DEFAULT_DATA}; skipped")
+        print(f"\nheadsq: no CT at {headsq_ct.DEFAULT_DATA}; skipped")
         return
     index = read_json(root / "dataset.json")
     for sid, label in (("hq", "complete skull"), ("hq_nm", "without mandible")):

@@ -347,10 +347,11 @@ def sfo_benchmark(n_subjects, n_photos, seed, headsq=None, mandible=True):
     if headsq is None:
         return
     import headsq_case
+    import headsq_ct
 
     root = headsq_case.ensure_dataset(headsq, n_photos=n_photos, seed=seed)
     if root is None:
-        print(f"\nheadsq: no CT at {headsq_case.DEFAULT_DATA}; skipped")
+        print(f"\nheadsq: no CT at {headsq_ct.DEFAULT_DATA}; skipped")
         return
     for sid, label in (("hq", "complete skull"), ("hq_nm", "without mandible")):
         problems = headsq_case.sfo_problems_from_dataset(root, "C", 1, subjects=[sid])

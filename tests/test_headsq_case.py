@@ -13,13 +13,14 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import headsq_case  # noqa: E402
+import headsq_ct  # noqa: E402
 
 pytestmark = pytest.mark.skipif(
-    headsq_case.data_dir() is None, reason="no headsq CT in ../shared/data/headsq"
+    headsq_ct.data_dir() is None, reason="no headsq CT in ../shared/data/headsq"
 )
 
-#: Landmarks the rules place (module notes of headsq_case): 18 cranial, 17 facial; without the
-#: mandible 5 cranial ones fewer.
+#: Landmarks the rules place (module notes of headsq_landmarks): 18 cranial, 17 facial; without
+#: the mandible 5 cranial ones fewer.
 N_CRANIAL = 18
 N_FACIAL = 17
 MANDIBLE = {"infradentale", "pogonion", "gnathion", "gonion_l", "gonion_r"}
@@ -112,6 +113,6 @@ def test_posest_sfo_recovers_the_frontal_camera(case, tmp_path, capsys):
 
 
 def test_absent_data_builds_nothing(tmp_path):
-    assert headsq_case.data_dir(tmp_path / "nowhere") is None
+    assert headsq_ct.data_dir(tmp_path / "nowhere") is None
     assert headsq_case.build_headsq_dataset(tmp_path / "x", data=tmp_path / "nowhere") is None
     assert not (tmp_path / "x").exists()

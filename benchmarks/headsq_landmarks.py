@@ -1,0 +1,301 @@
+"""Landmark placement on the headsq meshes (issue 27): one written rule per landmark.
+
+:func:`place_landmarks` places the cranial landmarks on the complete skull and the facial ones on
+the skin of the headsq CT (``benchmarks/headsq_ct.py`` extracts the meshes, ``headsq_case.py``
+writes the dataset). Frame: the generator's skull frame, mm (x = the subject's left, y = up,
+z = anterior; the origin at the centre of the complete skull's bounding box).
+
+Landmark placement rules (frame above; "frontal height map": the skull rendered by the
+project's rasteriser from straight in front, 1 mm per pixel, the height of a pixel the z of the
+triangle seen there; "depth": how far a pixel lies behind a grey closing of the height map with
+a disk of radius 20 mm, so orbits and the nasal aperture are the connected regions deeper than
+8 mm; a chosen pixel gives the vertex of its triangle nearest to it in x, y):
+
+- orbits: the largest deep region on each side (|x| > 12 mm from the bounding-box centre)
+  in the upper half; the midline is x = the mean of their centroids' x (the frame is shifted
+  so that it is x = 0); an orbit's transverse axis is the row of its centroid;
+- ``ectoconchion``: the first bone pixel lateral of the orbit on its transverse axis;
+- ``dacryon``: the first bone pixel medial of the orbit on its transverse axis (the medial
+  margin: the true dacryon lies a few mm behind it on the medial wall, which the coarse mesh
+  does not resolve);
+- ``orbitale``: the first bone pixel below the orbit's lowest pixel, in its centroid column;
+- nasal aperture: the deep region crossing the midline column nearest below the orbits;
+  ``alare``: the first bone pixel lateral of the aperture on its widest row, each side;
+- midsagittal profile: vertices within 2.5 mm of the midline, the front-most one per 1.5 mm
+  of height (the slice spacing); the cranium's (no mandible vertex) and the mandible's apart
+  (mandible vertices: those of the complete skull more than 2 mm from the mandible-less one);
+- ``nasion``: the most posterior cranium profile point between the orbits' transverse axis and
+  3 mm below the top cut; ``glabella`` (the profile is a plateau up to the cut), ``metopion``,
+  ``bregma``, ``frontotemporale``, ``porion`` and ``mental_foramen`` are not placed;
+- ``prosthion``: the most anterior cranium profile point below the aperture (at 3.2 mm the
+  incisors and the alveolar bone are one surface); ``subspinale``: the most posterior cranium
+  profile point between the aperture's lowest row and ``prosthion``;
+- ``infradentale``: the most anterior mandible profile point in the mandible's top 12 mm;
+  menton (not written): the lowest mandible profile point; ``pogonion``: the mandible profile
+  point (more than 3 mm above menton) farthest in front of the chord infradentale-menton (this
+  chin recedes, so "most anterior" alone would give infradentale); ``gnathion``: the profile
+  point midway (in profile steps) between pogonion and menton;
+- ``gonion``: among the mandible vertices of that side in the posterior 35 % of the mandible's
+  depth, those within 3 mm of the largest ``-y - z`` (the posterior-inferior corner), the most
+  lateral one (the outer surface of the angle);
+- ``zygion``: the cranium vertex of largest |x| at most 20 mm below and 5 mm above
+  ``orbitale``, 5-50 mm behind ``ectoconchion``.
+
+Facial (skin) landmarks; "over C along d": the skin vertex within 2 mm of the ray
+``C + t d``, ``0 < t < 35 mm`` (the radius grows by 1 mm until there is one), the first one
+(smallest ``t``) for rays from the bone surface outwards, the outermost one (largest ``t``)
+for rays from inside the face, which cross airway surfaces first:
+
+- ``nasion``, ``pogonion``, ``gnathion``: first over the cranial one along its bone normal
+  (``surface_normals_at``) with the x component removed (in the midsagittal plane);
+- ``zygion``: first over the cranial one along its bone normal; ``gonion``: first over it
+  along the bisector of its bone normal and the lateral direction (the normal alone points
+  down and back into the neck, where the skin is more than 35 mm away);
+- ``alare``: outermost over the cranial one along +z (the ala in front of the aperture
+  margin);
+- ``exocanthion``: outermost along +z from 5 mm medial of and 15 mm behind ``ectoconchion``;
+  ``endocanthion``: the same from 3 mm lateral of and 15 mm behind ``dacryon`` (the eyes are
+  closed in this CT: these are the lid line's ends, about);
+- skin profile: skin vertices within 2 mm of the midline, the front-most per 1.5 mm of height;
+  ``subnasale``: its most posterior point from 5 mm above ``subspinale`` down to 5 mm above
+  ``prosthion`` (the columella-lip junction; the nose of this head is short and flat);
+  ``labiale_superius``: its most anterior point 3-20 mm below ``subnasale``; stomion (not
+  written): its most posterior point 3-15 mm below ``labiale_superius``;
+- ``cheilion``: outermost along +z (up to 60 mm) from 30 mm behind stomion at x = +-0.4 x
+  (|x| of exocanthion + |x| of endocanthion), about the pupils' columns (an estimate: the mouth
+  corners do not show on a 3.2 mm skin; used only to cut the chin-jaw region). On the
+  pictures they fall on the mouth corners.
+"""
+
+import numpy as np
+
+HEIGHT_MAP_PX_MM = 1.0
+CLOSING_RADIUS_MM = 20.0
+DEEP_MM = 8.0
+
+
+def _height_map(vertices, faces):
+    """Frontal height map of a mesh: (z per pixel or NaN, triangle per pixel, pixel -> x, y)."""
+    from lilium.geometry.camera import Camera
+    from lilium.synthetic import photos, render
+
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    centre = 0.5 * (lo + hi)
+    size = np.ceil((hi[:2] - lo[:2]) / HEIGHT_MAP_PX_MM).astype(int) + 21
+    distance = 1e6
+    focal = distance / HEIGHT_MAP_PX_MM
+    R = photos.R_FRONTAL
+    t = np.array([0.0, 0.0, distance]) - R @ centre
+    pp = 0.5 * (size - 1)
+    camera = Camera.from_rt(R, t, focal, pp)
+    faces_index = render.render_mesh(vertices, faces, camera, tuple(int(s) for s in size))
+    index = faces_index.face_index
+    z_tri = vertices[faces].mean(axis=1)[:, 2]
+    height = np.where(index >= 0, z_tri[np.maximum(index, 0)], np.nan)
+
+    def xy(u, v):
+        return np.array(
+            [centre[0] + (u - pp[0]) * HEIGHT_MAP_PX_MM, centre[1] - (v - pp[1]) * HEIGHT_MAP_PX_MM]
+        )
+
+    return height, index, xy
+
+
+def _pixel_vertex(vertices, faces, index, xy, u, v):
+    """The vertex of the triangle at pixel (u, v) nearest to it in x, y."""
+    tri = faces[index[v, u]]
+    d = np.linalg.norm(vertices[tri, :2] - xy(u, v), axis=1)
+    return vertices[tri[int(np.argmin(d))]].copy()
+
+
+def _deep_regions(height):
+    import cv2
+    from scipy import ndimage as ndi
+
+    inside = np.isfinite(height)
+    floor = np.nanmin(height) - 1.0
+    h = np.where(inside, height, floor).astype(np.float32)
+    r = int(round(CLOSING_RADIUS_MM / HEIGHT_MAP_PX_MM))
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
+    closed = cv2.morphologyEx(h, cv2.MORPH_CLOSE, kernel)
+    hull = cv2.morphologyEx(inside.astype(np.uint8), cv2.MORPH_CLOSE, kernel).astype(bool)
+    deep = hull & ((closed - h) > DEEP_MM)
+    labels, n = ndi.label(deep)
+    return labels, n
+
+
+def _profile(vertices, band_mm, bin_mm, x0=0.0):
+    """Front-most vertex per height bin within ``band_mm`` of x = x0: (K, 3) sorted top-down."""
+    near = vertices[np.abs(vertices[:, 0] - x0) < band_mm]
+    bins = np.round((near[:, 1] - vertices[:, 1].max()) / bin_mm).astype(int)
+    out = []
+    for b in np.unique(bins):
+        sel = near[bins == b]
+        out.append(sel[np.argmax(sel[:, 2])])
+    out = np.array(out)
+    return out[np.argsort(-out[:, 1])]
+
+
+def _over(skin, point, direction, radius_mm=2.0, max_t_mm=35.0, outermost=True):
+    """The outermost (or first) skin vertex within ``radius_mm`` of the ray
+    ``point + t direction``, ``0 < t < max_t_mm`` (outermost: the outer skin, not the airway
+    surfaces a ray from inside the face crosses first)."""
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    rel = skin - point
+    t = rel @ d
+    perp = np.linalg.norm(rel - t[:, None] * d, axis=1)
+    for radius in radius_mm + np.arange(8.0):
+        ok = (t > 0) & (t < max_t_mm) & (perp < radius)
+        if ok.any():
+            k = np.flatnonzero(ok)
+            return skin[k[np.argmax(t[k]) if outermost else np.argmin(t[k])]].copy()
+    raise ValueError(f"no skin over {point} along {d}")
+
+
+def place_landmarks(skull, skull_faces, skin, mandible_mask):
+    """Cranial and facial landmarks by the rules of the module notes (skull frame, mm).
+
+    Parameters
+    ----------
+    skull : ndarray (V, 3), skull_faces : ndarray (F, 3)
+        The complete skull.
+    skin : ndarray (V', 3)
+    mandible_mask : ndarray (V,), bool
+        Which skull vertices are the mandible's.
+
+    Returns
+    -------
+    cranial, facial : dict of str -> ndarray (3,)
+    """
+    from lilium.softtissue.normals import surface_normals_at
+
+    height, index, xy = _height_map(skull, skull_faces)
+    labels, n = _deep_regions(height)
+    H, W = height.shape
+    centre_u = int(np.argmin([abs(xy(u, 0)[0]) for u in range(W)]))
+    rows_in = np.flatnonzero(np.isfinite(height).any(axis=1))
+    top_row, mid_row = rows_in[0], 0.5 * (rows_in[0] + rows_in[-1])
+    regions = []
+    for lab in range(1, n + 1):
+        v, u = np.nonzero(labels == lab)
+        if v.min() > top_row + 2:  # not the open bowl of the cut vault
+            regions.append((lab, u, v))
+    orbits = {}
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        cands = [
+            r for r in regions if sign * xy(r[1].mean(), 0)[0] > 12.0 and r[2].mean() < mid_row
+        ]
+        orbits[side] = max(cands, key=lambda r: len(r[1]))
+    orbit_v = max(o[2].mean() for o in orbits.values())
+    x_mid = float(np.mean([xy(o[1].mean(), 0)[0] for o in orbits.values()]))
+    centre_u = int(np.argmin([abs(xy(u, 0)[0] - x_mid) for u in range(W)]))
+    crossing = [r for r in regions if (r[1] == centre_u).any() and r[2].mean() > orbit_v]
+    aperture = min(crossing, key=lambda r: r[2].mean())
+    cranial = {}
+
+    def vertex(u, v):
+        return _pixel_vertex(skull, skull_faces, index, xy, int(u), int(v))
+
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        lab, u, v = orbits[side]
+        row = int(round(v.mean()))
+        on_row = u[v == row]
+        outer = on_row.max() if sign * (xy(1, 0)[0] - xy(0, 0)[0]) > 0 else on_row.min()
+        inner = on_row.min() if outer == on_row.max() else on_row.max()
+        step = 1 if outer == on_row.max() else -1
+        cranial[f"ectoconchion_{side}"] = vertex(outer + step, row)
+        cranial[f"dacryon_{side}"] = vertex(inner - step, row)
+        col = int(round(u.mean()))
+        bottom = v[u == col].max()
+        cranial[f"orbitale_{side}"] = vertex(col, bottom + 1)
+        # aperture margin on its widest row
+        au, av = aperture[1], aperture[2]
+        rows = np.unique(av)
+        widths = [np.ptp(au[av == r]) for r in rows]
+        wrow = int(rows[int(np.argmax(widths))])
+        line = au[av == wrow]
+        edge = line.max() if step == 1 else line.min()
+        cranial[f"alare_{side}"] = vertex(edge + step, wrow)
+    ap_bottom_y = xy(0, aperture[2].max())[1]
+    orbit_axis_y = 0.5 * (cranial["ectoconchion_l"][1] + cranial["ectoconchion_r"][1])
+
+    cranium = skull[~mandible_mask]
+    mandible = skull[mandible_mask]
+    prof = _profile(cranium, 2.5, 1.5, x_mid)
+    upper = prof[(prof[:, 1] > orbit_axis_y) & (prof[:, 1] < skull[:, 1].max() - 3.0)]
+    cranial["nasion"] = upper[np.argmin(upper[:, 2])]
+    below = prof[prof[:, 1] < ap_bottom_y]
+    cranial["prosthion"] = below[np.argmax(below[:, 2])]
+    between = prof[(prof[:, 1] < ap_bottom_y) & (prof[:, 1] > cranial["prosthion"][1])]
+    cranial["subspinale"] = between[np.argmin(between[:, 2])]
+    mprof = _profile(mandible, 2.5, 1.5, x_mid)
+    top = mprof[mprof[:, 1] > mprof[:, 1].max() - 12.0]
+    cranial["infradentale"] = top[np.argmax(top[:, 2])]
+    menton = mprof[np.argmin(mprof[:, 1])]
+    chord = cranial["infradentale"][1:] - menton[1:]
+    normal = np.array([-chord[1], chord[0]]) / np.linalg.norm(chord)
+    normal *= np.sign(normal[1])  # anterior
+    chin = mprof[mprof[:, 1] > menton[1] + 3.0]
+    cranial["pogonion"] = chin[np.argmax((chin[:, 1:] - menton[1:]) @ normal)]
+    arc = mprof[(mprof[:, 1] < cranial["pogonion"][1]) & (mprof[:, 1] >= menton[1])]
+    cranial["gnathion"] = arc[len(arc) // 2]  # midway (in profile steps) to menton
+    z_lo, z_hi = mandible[:, 2].min(), mandible[:, 2].max()
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        m = mandible[
+            (sign * (mandible[:, 0] - x_mid) > 0) & (mandible[:, 2] < z_lo + 0.35 * (z_hi - z_lo))
+        ]
+        corner = -m[:, 2] - m[:, 1]
+        m = m[corner > corner.max() - 3.0]  # the angle; its outer (lateral) surface
+        cranial[f"gonion_{side}"] = m[np.argmax(sign * (m[:, 0] - x_mid))]
+        o, e = cranial[f"orbitale_{side}"], cranial[f"ectoconchion_{side}"]
+        c = cranium[
+            (cranium[:, 1] > o[1] - 20.0)
+            & (cranium[:, 1] < o[1] + 5.0)
+            & (cranium[:, 2] < e[2] - 5.0)
+            & (cranium[:, 2] > e[2] - 50.0)
+        ]
+        cranial[f"zygion_{side}"] = c[np.argmax(sign * c[:, 0])]
+
+    # facial
+    names = list(cranial)
+    normals = dict(
+        zip(
+            names,
+            surface_normals_at(skull, skull_faces, np.array([cranial[k] for k in names])),
+            strict=True,
+        )
+    )
+    facial = {}
+    z_axis = np.array([0.0, 0.0, 1.0])
+    for name in ("nasion", "pogonion", "gnathion"):
+        d = normals[name] * np.array([0.0, 1.0, 1.0])
+        facial[name] = _over(skin, cranial[name], d, outermost=False)
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        key = f"zygion_{side}"
+        facial[key] = _over(skin, cranial[key], normals[key], outermost=False)
+        key = f"gonion_{side}"
+        d = normals[key] + np.array([sign, 0.0, 0.0])  # bisector of the normal and lateral
+        facial[key] = _over(skin, cranial[key], d, outermost=False)
+        facial[f"alare_{side}"] = _over(skin, cranial[f"alare_{side}"], z_axis)
+        e = cranial[f"ectoconchion_{side}"] - np.array([sign * 5.0, 0.0, -15.0])
+        facial[f"exocanthion_{side}"] = _over(skin, e, z_axis)
+        d = cranial[f"dacryon_{side}"] + np.array([sign * 3.0, 0.0, -15.0])
+        facial[f"endocanthion_{side}"] = _over(skin, d, z_axis)
+    sprof = _profile(skin, 2.0, 1.5, x_mid)
+    window = (sprof[:, 1] < cranial["subspinale"][1] + 5.0) & (
+        sprof[:, 1] > cranial["prosthion"][1] + 5.0
+    )
+    facial["subnasale"] = sprof[window][np.argmin(sprof[window][:, 2])]
+    sn = facial["subnasale"]
+    lip = sprof[(sprof[:, 1] < sn[1] - 3.0) & (sprof[:, 1] > sn[1] - 20.0)]
+    facial["labiale_superius"] = lip[np.argmax(lip[:, 2])]
+    ls = facial["labiale_superius"]
+    gap = sprof[(sprof[:, 1] < ls[1] - 3.0) & (sprof[:, 1] > ls[1] - 15.0)]
+    stomion = gap[np.argmin(gap[:, 2])]
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        half = 0.4 * sum(
+            abs(facial[f"{n}_{side}"][0] - x_mid) for n in ("exocanthion", "endocanthion")
+        )
+        start = np.array([x_mid + sign * half, stomion[1], stomion[2] - 30.0])
+        facial[f"cheilion_{side}"] = _over(skin, start, z_axis, max_t_mm=60.0)
+    return cranial, facial, x_mid
