@@ -72,7 +72,6 @@ LOWER_MIDLINE = ("prosthion", "subspinale", "infradentale", "pogonion", "gnathio
 CHIN_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r")
 
 
-
 def _unit(v):
     n = float(np.linalg.norm(v))
     return None if not np.isfinite(n) or n < 1e-9 else np.asarray(v, float) / n
