@@ -89,3 +89,26 @@ def test_a_pools_worker_ends_without_a_word_on_ctrl_c():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert "ended" in done.stdout, done.stderr
     assert "Traceback" not in done.stderr and "KeyboardInterrupt" not in done.stderr, done.stderr
+
+
+def test_a_pools_worker_ignores_ctrl_c_where_its_parent_does():
+    """A run started in the background ignores SIGINT: its workers inherit that, so a SIGINT
+    sent to the process group leaves the run whole instead of breaking its pool."""
+    code = (
+        "import os, signal\n"
+        "from concurrent.futures import ProcessPoolExecutor\n"
+        "from multiprocessing import get_context\n"
+        "from lilium.workers import quiet_interrupts, starting_workers\n"
+        "if __name__ == '__main__':\n"
+        "    signal.signal(signal.SIGINT, signal.SIG_IGN)\n"
+        "    pool = ProcessPoolExecutor(1, mp_context=get_context('spawn'),\n"
+        "                               initializer=quiet_interrupts)\n"
+        "    with starting_workers():\n"
+        "        pid = pool.submit(os.getpid).result()\n"
+        "    os.kill(pid, signal.SIGINT)\n"
+        "    handler = pool.submit(signal.getsignal, signal.SIGINT).result(timeout=60)\n"
+        "    print(handler == signal.SIG_IGN)\n"
+        "    pool.shutdown()\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.stdout.strip() == "True", done.stderr

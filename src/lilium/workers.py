@@ -7,7 +7,8 @@ task (starting up, importing, waiting for work), under the parent's one-line "in
 the parent starts its workers with SIGINT blocked (:func:`starting_workers`, around the calls
 that may start one; a blocked signal waits, it is not lost), and each worker, first thing
 (:func:`quiet_interrupts`, in the pool's initializer), restores SIGINT's default action, which
-ends a process without a word, and unblocks it. The parent, which holds the results, reports
+ends a process without a word, and unblocks it (a parent that ignores SIGINT, started in the
+background, has workers that ignore it too). The parent, which holds the results, reports
 the interrupt and stops the pool.
 """
 
@@ -76,7 +77,13 @@ def starting_workers():
 
 def quiet_interrupts():
     """In a worker process: a Ctrl-C ends it at once without a traceback (SIGINT's default
-    action; one that arrived while it started, blocked by :func:`starting_workers`, now)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    action; one that arrived while it started, blocked by :func:`starting_workers`, now).
+
+    A worker whose parent ignores SIGINT (a run started in the background by a shell, or under
+    ``nohup``) inherits that and keeps ignoring it: a SIGINT sent to the whole process group
+    would otherwise end the workers under a parent that goes on, which then finds its pool
+    broken."""
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
