@@ -79,10 +79,10 @@ def quiet_interrupts():
     """In a worker process: a Ctrl-C ends it at once without a traceback (SIGINT's default
     action; one that arrived while it started, blocked by :func:`starting_workers`, now).
 
-    A worker whose parent ignores SIGINT (a run started in the background by a shell, or under
-    ``nohup``) inherits that and keeps ignoring it: a SIGINT sent to the whole process group
-    would otherwise end the workers under a parent that goes on, which then finds its pool
-    broken."""
+    A worker whose parent ignores SIGINT (a run started with ``&`` by a shell script: a
+    non-interactive shell's background jobs ignore it) inherits that and keeps ignoring it: a
+    SIGINT sent to the whole process group would otherwise end the workers under a parent that
+    goes on, which then finds its pool broken."""
     if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
         signal.signal(signal.SIGINT, signal.SIG_DFL)
     if hasattr(signal, "pthread_sigmask"):
