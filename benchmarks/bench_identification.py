@@ -22,8 +22,9 @@ again continues, or only prints when all is stored), and prints:
 
 Then, over every database pooled: each decision's cross-validated log10 LR (Cllr, Cllr_min,
 misleading evidence, wrong conclusions), the shipped logistic calibration beside the
-bi-Gaussianized one (SPEC section 12), the rankings by the LR, and with ``--headsq`` the headsq
-CT's conclusions.
+bi-Gaussianized one (SPEC section 12), where the misleading evidence falls (the equal error
+rate no calibration can beat, and look-alike skulls: ``lookalikes.py``), the rankings by the
+LR, and with ``--headsq`` the headsq CT's conclusions.
 
 At the full budget (DE 30 x 750, 8 subjects: 128 SFOs per method, 640 in all) it took 438 s on
 2 workers and 936 s on one (measured); ``--generations 3 --subjects 3`` checks the pipeline in
@@ -60,6 +61,7 @@ from lilium.geometry.camera import Camera
 from lilium.inputs import correspondences
 from lilium.methods.posest_sfo import mean_depth_landmarks
 from lilium.optimisation.de import DEOptions
+from lookalikes import print_lookalikes
 
 TERMS = ("mse_pix", "p_pll", "p_skof", "score")
 
@@ -247,6 +249,8 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
             )
     print(file=file)
     print_calibration_comparison(decision_pairs, validated, file)
+    print(file=file)
+    print_lookalikes(dbs, decision_pairs, validated, file)
     print(file=file)
     print("| ranked by identification log10 LR | view | mean rank | rank-1 | AUC | photos |",
           file=file)

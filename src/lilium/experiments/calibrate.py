@@ -506,6 +506,16 @@ def _content_key(rows):
     return digest.hexdigest()
 
 
+def read_databases(dbs):
+    """``[(db, rows, dataset root), ...]`` (:func:`stored_rows`) of every database, in the
+    order of their contents (:func:`_content_key`), not of the command line: the pooled
+    subject ids carry the index in this order (:func:`database_decisions`), and the subject
+    folds are dealt from those ids, so the cross-validated figures must not depend on it."""
+    read = [(db, *stored_rows(db)) for db in dbs]
+    read.sort(key=lambda item: _content_key(item[1]))
+    return read
+
+
 def database_decisions(dbs, dataset=None, log=print):
     """The decisions of one or several results databases, pooled.
 
@@ -529,11 +539,7 @@ def database_decisions(dbs, dataset=None, log=print):
         Every row, with its ``terms`` and the database index ``db``.
     """
     pooled, all_rows = defaultdict(list), []
-    read = [(db, *stored_rows(db)) for db in dbs]
-    # In the order of their contents, not of the command line: the subject folds are dealt
-    # from the prefixed ids, so the cross-validated figures must not depend on that order.
-    read.sort(key=lambda item: _content_key(item[1]))
-    for k, (db, rows, root) in enumerate(read):
+    for k, (db, rows, root) in enumerate(read_databases(dbs)):
         root = dataset or root
         inputs = DatasetInputs(root) if root and Path(root, "dataset.json").is_file() else None
         cache = {}
