@@ -17,6 +17,7 @@ from lilium.identification.calibration import (
     fit,
     pav_log10_lr,
     performance,
+    ridge_for,
 )
 
 
@@ -215,3 +216,22 @@ def test_landmark_snorm_is_derived_from_the_stored_terms():
         p["terms"].update(cohort_mean=0.0, cohort_sd=1.0, skull_mean=0.0, skull_sd=1.0)
     model = fit([p["terms"] for p in pairs], [p["same"] for p in pairs])
     assert "landmark_snorm" in model.names
+
+
+def test_the_ridge_is_a_prior_worth_a_fixed_number_of_same_person_pairs():
+    """The fitted loss is a mean over each class, so the default penalty falls as the
+    same-person pairs grow: with few of them, the weights of noise terms stay small."""
+    assert ridge_for(12) == pytest.approx(10 * ridge_for(120))
+    rng = np.random.default_rng(8)
+    names = ("landmark_chi2", "cohort_mean", "cohort_sd", "skull_mean", "skull_sd")
+    same = np.r_[np.ones(12, bool), np.zeros(240, bool)]
+    values = rng.normal(0.0, 1.0, (same.size, len(names)))
+    values[:, 0] = np.exp(values[:, 0] + np.where(same, 0.0, 1.5))  # the one real signal
+    terms = [dict(zip(names, map(float, row), strict=True)) for row in values]
+    default = fit(terms, same, names)
+    weak = fit(terms, same, names, ridge=ridge_for(1200))
+    noise = list(names[1:])
+    assert default.weights["landmark_chi2"] < 0 and weak.weights["landmark_chi2"] < 0
+    assert np.linalg.norm([default.weights[n] for n in noise]) < 0.9 * np.linalg.norm(
+        [weak.weights[n] for n in noise]
+    )

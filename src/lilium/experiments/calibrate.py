@@ -35,7 +35,6 @@ import numpy as np
 from ..geometry.camera import Camera
 from ..identification.calibration import (
     CALIBRATED_TERMS,
-    RIDGE,
     VIEWS_LOG10_LR,
     VIEWS_RIDGE,
     VIEWS_TERMS,
@@ -479,7 +478,7 @@ def fit_models(decision_pairs, provenance, log=print, validated=None):
     without it, none)."""
     models = {}
     for key, pairs in sorted(decision_pairs.items()):
-        names, ridge, origin = CALIBRATED_TERMS, RIDGE, dict(provenance, decision=key[2])
+        names, ridge, origin = CALIBRATED_TERMS, None, dict(provenance, decision=key[2])
         if key[2] == "pair_sum":
             if validated is None or key not in validated:
                 continue

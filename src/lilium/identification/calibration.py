@@ -66,14 +66,21 @@ FEATURES = {
 #: (``<method>/<variant>/pair_sum``, :mod:`lilium.experiments.calibrate`).
 VIEWS_TERMS = (VIEWS_LOG10_LR,)
 
-#: L2 penalty on the standardised weights of the terms' models. Cross-validated on 140
-#: generated subjects (docs/method.md, "On 140 subjects"): 1e-3 against the 1e-2 first
-#: shipped lowers the single photos' Cllr (Lilium frontal 0.362 -> 0.341, lateral 0.410 ->
-#: 0.400; POSEST-SFO 0.551 -> 0.463, 0.642 -> 0.566) and leaves Lilium's frontal + lateral
-#: decision as it was (0.192 -> 0.191); 1e-4 is no better, 0.1 and above are worse.
-RIDGE = 1e-3
+#: L2 penalty on the standardised weights of the terms' models, times their number of
+#: same-person pairs: the fitted loss is a mean over each class, so a fixed prior on the
+#: weights is a penalty that shrinks as the same-person pairs (the rarer class) grow. Chosen
+#: on the 152 generated subjects and the joint SFO's 12 (docs/method.md, "On 152 subjects"):
+#: a fixed 1e-3 lowered the single photos' Cllr on 140 subjects against the 1e-2 first
+#: shipped but overfitted the 12-subject joint model (Cllr 0.50 -> 0.76); scaled by the pairs
+#: it keeps both.
+RIDGE_PAIRS = 0.1
 
-#: The views' model's (one feature): with :data:`RIDGE` its slope shrank and its
+
+def ridge_for(n_same):
+    """The terms' models' L2 penalty for a fit on ``n_same`` same-person pairs."""
+    return RIDGE_PAIRS / max(int(n_same), 1)
+
+#: The views' model's (one feature): with the terms' ridge (then 1e-2) its slope shrank and its
 #: cross-validated Cllr rose from 0.25 to 0.30 on the 52 subjects it was first fitted on; a
 #: trace of a penalty keeps the slope finite where a small calibration set separates.
 VIEWS_RIDGE = 1e-4
@@ -235,7 +242,7 @@ def _read_warp(warp):
     return {"knots": knots.tolist(), "ln_lr": ln_lr.tolist()}
 
 
-def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=RIDGE, warp=False):
+def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, warp=False):
     """Fit a :class:`Calibration` on term dictionaries and their labels.
 
     Parameters
@@ -247,8 +254,9 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=RIDGE, 
     names : sequence of str
         Candidate terms; those missing in every pair or constant are left out.
     provenance : dict, optional
-    ridge : float
-        L2 penalty on the standardised weights.
+    ridge : float, optional
+        L2 penalty on the standardised weights (default :func:`ridge_for` the same-person
+        pairs).
     warp : bool
         Warp the logistic regression's LRs by :func:`bigaussian_warp` (fitted on the same
         pairs).
@@ -256,6 +264,7 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=RIDGE, 
     same = np.asarray(same, bool)
     if same.all() or not same.any():
         raise ValueError("a calibration needs both same- and different-person pairs")
+    ridge = ridge_for(same.sum()) if ridge is None else ridge
     raw = {}
     for name in names:
         col = _column(terms_list, name)
@@ -367,7 +376,7 @@ def subject_splits(pairs, folds=FOLDS):
         yield training, [i for i, p in enumerate(pairs) if fold_of[p["person"]] == k]
 
 
-def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS, ridge=RIDGE, warp=False):
+def cross_validated(pairs, folds=FOLDS, names=CALIBRATED_TERMS, ridge=None, warp=False):
     """Cross-validated log10 LR of every pair: each scored by a model that never saw its
     photo's subject (nor any pair with that subject's skull).
 
