@@ -78,7 +78,7 @@ def test_two_views_that_repeat_each_other_are_not_counted_twice():
     LRs count it twice; the calibrated sum (``pair_sum``) learns a slope of about one half and
     costs less, cross-validated; its model is the one ``lilium calibrate`` writes."""
     from lilium.experiments.calibrate import VIEWS_MODEL, fit_models, validate
-    from lilium.identification.calibration import VIEWS_LOG10_LR, VIEWS_TERMS
+    from lilium.identification.calibration import VIEWS_LOG10_LR, VIEWS_RIDGE, VIEWS_TERMS
 
     rng = np.random.default_rng(5)
     pairs = _synthetic_pairs(rng, n_subjects=20, shift=1.0)
@@ -106,6 +106,9 @@ def test_two_views_that_repeat_each_other_are_not_counted_twice():
     model = models["m//pair_sum"]
     assert model.names == VIEWS_TERMS
     assert model.provenance["model"] == VIEWS_MODEL
+    assert model.provenance["ridge"] == VIEWS_RIDGE  # each model says its penalty
+    terms_model = models["m//frontal"]
+    assert terms_model.provenance["ridge"] == pytest.approx(ridge_for(terms_model.n_same))
     lr = model.log10_lr([{VIEWS_LOG10_LR: x} for x in (-2.0, 0.0, 2.0)])
     slope = (lr[2] - lr[0]) / 4.0
     assert 0.35 < slope < 0.7, slope

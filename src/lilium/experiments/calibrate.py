@@ -41,6 +41,7 @@ from ..identification.calibration import (
     cross_validated,
     fit,
     performance,
+    ridge_for,
     subject_splits,
 )
 from ..identification.cohort import Cohort
@@ -490,8 +491,10 @@ def fit_models(decision_pairs, provenance, log=print, validated=None):
             log(f"{'/'.join(key)}: {sum(same)} same- and {len(same) - sum(same)} "
                 f"different-person pairs, fewer than {MIN_PAIRS}: no model")
             continue
+        origin["ridge"] = ridge_for(sum(same)) if ridge is None else ridge
         models["/".join(key)] = fit(
-            [p["terms"] for p in train], same, names, origin, ridge, warp=key[2] in WARPED
+            [p["terms"] for p in train], same, names, origin, origin["ridge"],
+            warp=key[2] in WARPED,
         )
     return models
 
