@@ -66,19 +66,20 @@ FEATURES = {
 #: (``<method>/<variant>/pair_sum``, :mod:`lilium.experiments.calibrate`).
 VIEWS_TERMS = (VIEWS_LOG10_LR,)
 
-#: L2 penalty on the standardised weights of the terms' models, times their number of
-#: same-person pairs: the fitted loss is a mean over each class, so a fixed prior on the
-#: weights is a penalty that shrinks as the same-person pairs (the rarer class) grow. Chosen
-#: on the 152 generated subjects and the joint SFO's 12 (docs/method.md, "On 152 subjects"):
-#: a fixed 1e-3 lowered the single photos' Cllr on 140 subjects against the 1e-2 first
-#: shipped but overfitted the 12-subject joint model (Cllr 0.50 -> 0.76); scaled by the pairs
-#: it keeps both.
+#: The terms' models' L2 penalty on their standardised weights is this over their number of
+#: same-person pairs (:func:`ridge_for`): the fitted loss is a mean over each class, so a
+#: prior worth a fixed number of pairs is a penalty that shrinks as the same-person pairs (the
+#: rarer class) grow. Chosen on 152 generated subjects and the joint SFO's 12 (docs/method.md,
+#: "On 152 subjects"): a fixed 1e-3 lowered the single photos' Cllr on 140 subjects against the
+#: 1e-2 first shipped but overfitted the 12-subject joint model (Cllr 0.50 -> 0.76); scaled by
+#: the pairs it keeps both.
 RIDGE_PAIRS = 0.1
 
 
 def ridge_for(n_same):
     """The terms' models' L2 penalty for a fit on ``n_same`` same-person pairs."""
     return RIDGE_PAIRS / max(int(n_same), 1)
+
 
 #: The views' model's (one feature): with the terms' ridge (then 1e-2) its slope shrank and its
 #: cross-validated Cllr rose from 0.25 to 0.30 on the 52 subjects it was first fitted on; a
