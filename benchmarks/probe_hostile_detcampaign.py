@@ -87,13 +87,10 @@ def _fresh_state():
     """Empty the per-process caches of the experiment's worker code, so that an in-process run
     on 1 worker (which runs its SFOs in this process) starts as a new ``lilium`` process does:
     the cohort terms, skulls, photos and edge topologies of an earlier probe are not reused."""
-    from lilium.experiments import calibrate, runner
+    from lilium.experiments import calibrate, task_io
 
     calibrate._COHORT_TERMS.clear()
-    runner._skull.cache_clear()
-    runner._photo.cache_clear()
-    runner._facial_truth.cache_clear()
-    runner._TOPOLOGIES.clear()
+    task_io.clear_caches()
 
 
 def _dataset_ref(ws):

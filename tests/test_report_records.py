@@ -6,7 +6,7 @@ import hashlib
 import numpy as np
 import pytest
 
-from lilium.experiments.runner import score_result
+from lilium.experiments.task_io import score_result
 from lilium.io.case import read_photo, read_skull
 from lilium.io.provenance import input_files, sha256_of, software_versions
 from lilium.methods.posest_sfo import posest_sfo

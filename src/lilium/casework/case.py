@@ -7,6 +7,7 @@ from ..io.paths import safe_id
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.registry import check_method, method_tag, run_sfo
+from .console import log_warnings, status_text
 from .folders import (
     check_distinct_photos,
     labelled_skull,
@@ -18,6 +19,7 @@ from .folders import (
 )
 from .identify import Calibrations, conclusion_line, identify
 from .inputs import check_runnable, load_photos, load_skull
+from .joint_case import check_joint_case, joint_entry, run_joint_methods
 from .prepared import check_photo_extra
 
 
@@ -139,8 +141,6 @@ def run_case(
         check_photo_extra()
     check_distinct_photos(photos)
     if joint:
-        from .joint_case import check_joint_case
-
         check_joint_case(photos, methods)
     skull, skull_inputs = load_skull(skull_path, landmarks, axes, log=log)
     skull = labelled_skull(skull, skull_inputs)
@@ -156,8 +156,6 @@ def run_case(
         _check_records(skull, skull_inputs, records, methods, options.variant, log)
         joints = {}  # method -> (JointSfoResult, folder), for the joint methods
         if joint:
-            from .joint_case import run_joint_methods
-
             joints = run_joint_methods(
                 skull, skull_inputs, records, methods, options, seed, out, log, calibrations
             )
@@ -198,8 +196,6 @@ class _CaseRun:
 
     def entries(self, records, methods, joints):
         """The report entries of every photo and method (``joints``: the joint SFOs' runs)."""
-        from .joint_case import joint_entry
-
         entries = []
         for k, (photo, inputs, notes, origin) in enumerate(records):
             landmark_info = _landmark_info(origin, self.out)
@@ -252,17 +248,3 @@ class _CaseRun:
             self.log(f"{label}: {conclusion_line(record)}")
             decisions.append((label, record))
         return decisions
-
-
-def status_text(result):
-    """One SFO's outcome for the console: camera and score (and terms off), or the failure."""
-    if not result:
-        return f"FAILED ({result.error})"
-    off = f", off: {', '.join(result.terms_off)}" if result.terms_off else ""
-    return f"focal {result.camera.focal_px:.0f} px, score {result.fitness:.4g}{off}"
-
-
-def log_warnings(result, log):
-    """One console line per SPEC section 10 warning of an SFO."""
-    for warning in result.warnings:
-        log(f"  warning {warning.code}: {warning.message}")

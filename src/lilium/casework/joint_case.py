@@ -12,7 +12,7 @@ from ..inputs import correspondences
 from ..io.jsonio import write_json
 from ..io.results import read_joint_result
 from ..methods.registry import METHODS, method_tag, run_joint_sfo
-from .case import log_warnings, status_text
+from .console import log_warnings, status_text
 from .folders import (
     joint_overlay_name,
     sfo_fingerprint,

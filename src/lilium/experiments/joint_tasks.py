@@ -23,6 +23,15 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from .task_io import (
+    facial_truth,
+    result_columns,
+    score_result,
+    skull_topology,
+    task_photo,
+    task_skull,
+)
+
 #: Joint methods of a config: name -> the registry method it runs jointly.
 JOINT_METHODS = {"lilium-joint": "lilium"}
 
@@ -71,7 +80,6 @@ def run_joint_task(task):
 
     from ..methods import SfoOptions, run_joint_sfo
     from .calibrate import TERMS_KEY, with_terms
-    from .runner import _facial_truth, _photo, _skull, _topology, result_columns, score_result
     from .store import KEY_COLUMNS
 
     start = time.perf_counter()
@@ -84,11 +92,11 @@ def run_joint_task(task):
     )
     rows = [base | common | {"photo": pid, "view": view} for pid, view, _ in members]
     try:
-        skull = _skull(task.subject_dir, task.axes_file)
+        skull = task_skull(task.subject_dir, task.axes_file)
         skull = replace(
             skull, landmarks_file=str(Path(task.subject_dir) / "cranial_landmarks.json")
         )
-        cases = [_photo(folder) for _, _, folder in members]
+        cases = [task_photo(folder) for _, _, folder in members]
         photos = [
             replace(photo, landmarks_file=str(Path(folder) / "photo.json"))
             for (photo, _), (_, _, folder) in zip(cases, members, strict=True)
@@ -100,10 +108,10 @@ def run_joint_task(task):
             row.update(success=0, error=str(exc), task_seconds=time.perf_counter() - start)
             row["finished_at"] = time.time()
         return rows[::-1]
-    topology = _topology(task.subject_dir, skull)
+    topology = skull_topology(task.subject_dir, skull)
     for row, single, photo, (_, truth) in zip(rows, result.photos, photos, cases, strict=True):
         if row["positive"]:
-            truth = replace(truth, facial_landmarks_mm=_facial_truth(task.subject_dir))
+            truth = replace(truth, facial_landmarks_mm=facial_truth(task.subject_dir))
         row.update(score_result(single, skull, photo, truth, topology))
         row.update(result_columns(single, result.fitness if result else None, result))
         with_terms(row, skull, [photo], [single], result.facial_landmarks_mm, [row])

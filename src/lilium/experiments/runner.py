@@ -28,8 +28,6 @@ it dies (:func:`lilium.workers.exit_with_parent`); a Dask cluster is reached bef
 anything else, and a cluster without workers ends the run (:mod:`lilium.experiments.executors`).
 """
 
-import functools
-import json
 import os
 import socket
 import sqlite3
@@ -37,21 +35,20 @@ import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-import numpy as np
-
 from ..io.locks import RunLock
 from ..optimisation.de import DEOptions
 from .dataset import check_index, check_task_files, dataset_fingerprint
 from .executors import connect_scheduler, dask_results, local_results
 from .joint_tasks import JOINT_METHODS, partner_tasks, photo_pairs, run_joint_task
 from .store import KEY_COLUMNS, ResultStore, database_error
-
-#: Cached cases per worker process (skulls are a few MB each).
-SKULL_CACHE = 48
-PHOTO_CACHE = 256
-
-#: Keys of the SFO result dictionary that are not stored (long, and not needed by the report).
-_DROPPED_RESULT_KEYS = ("history", "genes")
+from .task_io import (
+    facial_truth,
+    result_columns,
+    score_result,
+    skull_topology,
+    task_photo,
+    task_skull,
+)
 
 
 @dataclass(frozen=True)
@@ -230,47 +227,6 @@ def enumerate_tasks(cfg, root, index):
 
 
 # -- worker -------------------------------------------------------------------------------------
-@functools.lru_cache(maxsize=SKULL_CACHE)
-def _skull(subject_dir, axes_file):
-    from ..io.case import read_skull
-
-    if axes_file is not None and not os.path.isfile(axes_file):
-        # Checked before the run too; a file gone since is an error row, never a success with
-        # the skull's default axes.
-        raise ValueError(f"{axes_file}: perturbed soft-tissue axes not found")
-    return read_skull(subject_dir, axes_path=axes_file)
-
-
-_TOPOLOGIES = {}
-
-
-def _topology(subject_dir, skull):
-    """Edge topology of a subject's skull mesh (the same for every axis set)."""
-    from ..imaging.raster import mesh_edge_topology
-
-    if subject_dir not in _TOPOLOGIES:
-        if len(_TOPOLOGIES) >= SKULL_CACHE:
-            _TOPOLOGIES.pop(next(iter(_TOPOLOGIES)))
-        _TOPOLOGIES[subject_dir] = mesh_edge_topology(skull.faces)
-    return _TOPOLOGIES[subject_dir]
-
-
-@functools.lru_cache(maxsize=SKULL_CACHE)
-def _facial_truth(subject_dir):
-    from ..io.truth import read_facial_landmarks
-
-    return read_facial_landmarks(subject_dir)
-
-
-@functools.lru_cache(maxsize=PHOTO_CACHE)
-def _photo(photo_dir):
-    """The photo and its :class:`~lilium.io.truth.GroundTruth` (without the 3D landmarks)."""
-    from ..io.case import read_photo
-    from ..io.truth import read_ground_truth
-
-    return read_photo(photo_dir, load_image=False), read_ground_truth(photo_dir)
-
-
 def _run_method(task, skull, photo):
     """Run the task's SFO; its SPEC section 10 warnings land in the row's ``result`` JSON.
 
@@ -283,41 +239,6 @@ def _run_method(task, skull, photo):
     photo = replace(photo, landmarks_file=str(Path(task.photo_dir) / "photo.json"))
     options = SfoOptions(variant=task.variant or None, de=task.de)
     return run_sfo(task.method, skull, photo, options, task.seed)
-
-
-def _finite(value):
-    return float(value) if value is not None and np.isfinite(value) else None
-
-
-def score_result(result, skull, photo, truth=None, topology=None):
-    """Evaluation columns of one SFO (:func:`lilium.evaluation.score`).
-
-    Parameters
-    ----------
-    result : SfoResult
-    skull : Skull
-    photo : Photo
-    truth : GroundTruth, optional
-        With the tested skull's 3D facial landmarks for a positive pair (BPE); None or without
-        them for a negative pair.
-    topology : EdgeTopology, optional
-        Of the skull mesh (cached by the caller).
-
-    Returns
-    -------
-    dict
-        ``bpe_mm``, ``skull_px``, ``outside_px``, ``percent_outside`` (None where not defined).
-    """
-    from ..evaluation import score
-
-    s = score(result, truth, skull, photo.face_mask, topology)
-    imp = s.implausible
-    return {
-        "bpe_mm": _finite(s.bpe_mm),
-        "skull_px": imp.skull_px if imp else None,
-        "outside_px": imp.outside_px if imp else None,
-        "percent_outside": imp.percent_outside if imp else None,
-    }
 
 
 def run_task(task):
@@ -339,52 +260,22 @@ def run_task(task):
         worker=f"{socket.gethostname()}:{os.getpid()}",
     )
     try:
-        skull = _skull(task.subject_dir, task.axes_file)
-        photo, truth = _photo(task.photo_dir)
+        skull = task_skull(task.subject_dir, task.axes_file)
+        photo, truth = task_photo(task.photo_dir)
         result = _run_method(task, skull, photo)
     except ValueError as exc:
         row.update(success=0, error=str(exc), task_seconds=time.perf_counter() - start)
         row["finished_at"] = time.time()
         return row
     if row["positive"]:
-        truth = replace(truth, facial_landmarks_mm=_facial_truth(task.subject_dir))
-    row.update(score_result(result, skull, photo, truth, _topology(task.subject_dir, skull)))
+        truth = replace(truth, facial_landmarks_mm=facial_truth(task.subject_dir))
+    row.update(score_result(result, skull, photo, truth, skull_topology(task.subject_dir, skull)))
     row.update(result_columns(result, result.fitness, result))
     from .calibrate import with_terms
 
     with_terms(row, skull, [photo], [result], result.facial_landmarks_mm, [row])
     row.update(task_seconds=time.perf_counter() - start, finished_at=time.time())
     return row
-
-
-def result_columns(single, score, run):
-    """The stored columns of one photo's SFO result.
-
-    Parameters
-    ----------
-    single : SfoResult
-        The photo's result (terms, camera, ``result.json``).
-    score : float or None
-        Its ranking score (a joint SFO's: the joint fitness).
-    run : SfoResult or JointSfoResult
-        The run that produced it (its time, generations and error).
-    """
-    data = single.to_dict()
-    for key in _DROPPED_RESULT_KEYS:
-        data.pop(key, None)
-    return dict(
-        success=int(bool(single)),
-        score=_finite(score),
-        mse_pix=_finite(single.terms.get("mse_pix")),
-        p_cam=_finite(single.terms.get("p_cam")),
-        p_skof=_finite(single.terms.get("p_skof")),
-        p_pll=_finite(single.terms.get("p_pll")),
-        focal_px=_finite(single.camera.focal_px) if single else None,
-        seconds=float(run.seconds),
-        generations=run.extra.get("generations"),
-        error=single.error or run.error or None,
-        result=json.dumps(data),
-    )
 
 
 # -- driver -------------------------------------------------------------------------------------
