@@ -15,7 +15,7 @@ import sqlite3
 import struct
 import zlib
 
-from probe_hostile import Probe, _write
+from probe_hostile_machinery import Probe, _write
 
 
 def _png_header(width, height):

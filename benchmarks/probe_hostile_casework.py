@@ -16,7 +16,7 @@ import json
 import shutil
 import sqlite3
 
-from probe_hostile import Probe, _write
+from probe_hostile_machinery import Probe, _write
 
 #: The Lilium budget of the joint probes (DE/rand/1 needs 4 members).
 TINY = ("--generations", "2", "--population", "5")

@@ -42,7 +42,6 @@ import shutil
 import sys
 from pathlib import Path
 
-from probe_hostile import Probe, Workspace, _then
 from probe_hostile_casework import _quiet_main
 from probe_hostile_detcampaign import (
     CONFIG,
@@ -72,6 +71,7 @@ from probe_hostile_detcompare import (
     _same_outputs,
     _same_rows,
 )
+from probe_hostile_machinery import Probe, Workspace, _then
 from probe_hostile_runs import _in
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -246,7 +246,7 @@ def _measured(probe, ws, verdict, verbose):
 
 def main(argv=None):
     """Run this group alone (the same verdicts as ``probe_hostile.py``)."""
-    from probe_hostile import run_group
+    from probe_hostile_machinery import run_group
 
     return run_group(
         determinism_probes,

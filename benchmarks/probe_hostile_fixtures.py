@@ -1,14 +1,17 @@
-"""The inputs and result readers the hostile probes of a generated case share (the semantic,
-geometry, metamorphic and report groups of ``probe_hostile.py``): ``_syn``, a copy of the
-campaign's generated dataset (two subjects, ``s01`` and ``s02``, with one frontal and one
-lateral photo each: experiment A, made once per campaign in ``WORK/semantic-dataset``, about
-5 s); paths into a probe's ``in/`` folder and the stand-in case; set-ups that edit a JSON file,
-a photo's landmarks or its image and mask; and readers of the ``result.json`` a probe's command
-wrote (the camera's rotation error, the warnings' codes).
+"""The inputs and result readers the hostile probes share. For the probes of a generated case
+(the semantic, geometry, metamorphic and report groups of ``probe_hostile.py``): ``_syn``, a
+copy of the campaign's generated dataset (two subjects, ``s01`` and ``s02``, with one frontal
+and one lateral photo each: experiment A, made once per campaign in ``WORK/semantic-dataset``,
+about 5 s); paths into a probe's ``in/`` folder and the stand-in case; set-ups that edit a JSON
+file, a photo's landmarks or its image and mask; and readers of the ``result.json`` a probe's
+command wrote (the camera's rotation error, the warnings' codes). For the resume probes and
+their scenarios: a run's outputs read for comparison with another's (``_results``,
+``_sfo_fields``, ``_png_ok``).
 """
 
 import json
 import shutil
+from pathlib import Path
 
 import numpy as np
 
@@ -128,3 +131,29 @@ def _result(ws, rel=None):
 
 def _codes(result):
     return [w["code"] for w in result.get("warnings", [])]
+
+
+# -- a run's outputs, compared with another's -------------------------------------------------
+
+#: The fields of a result.json an SFO computes (not its timing).
+SFO_FIELDS = ("method", "variant", "seed", "camera", "fitness", "terms", "generations")
+
+
+def _sfo_fields(path):
+    data = json.loads(Path(path).read_text())
+    return {k: data.get(k) for k in SFO_FIELDS}
+
+
+def _results(folder):
+    return {p.relative_to(folder).as_posix(): p for p in sorted(Path(folder).rglob("result.json"))}
+
+
+def _png_ok(path):
+    from PIL import Image
+
+    try:
+        with Image.open(path) as im:
+            im.load()
+    except Exception as exc:  # noqa: BLE001
+        return f"{Path(path).name} unreadable ({type(exc).__name__})"
+    return None

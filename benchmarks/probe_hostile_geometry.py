@@ -35,7 +35,6 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from probe_hostile import Probe, _then  # noqa: E402
 from probe_hostile_casework import TINY, _quiet_main  # noqa: E402
 from probe_hostile_fixtures import (  # noqa: E402
     _codes,
@@ -77,6 +76,7 @@ from probe_hostile_geometry_damage import (  # noqa: E402
     _stray_triangle,
     _unreferenced_vertex,
 )
+from probe_hostile_machinery import Probe, _then  # noqa: E402
 
 SEED = ("--seed", "1")
 #: Warnings of the clean inputs (see probe_hostile_semantic.CLEAN_CODES).
@@ -414,7 +414,7 @@ def geometry_probes():
 
 def main(argv=None):
     """Run this group alone (the same verdicts as ``probe_hostile.py``)."""
-    from probe_hostile import run_group
+    from probe_hostile_machinery import run_group
 
     return run_group(geometry_probes, "geometry", __doc__, argv)
 

@@ -20,8 +20,8 @@ to another.
 
 import numpy as np
 
-from probe_hostile import _then
 from probe_hostile_fixtures import _edit_json
+from probe_hostile_machinery import _then
 
 # -- set-ups: meshes --------------------------------------------------------------------------
 

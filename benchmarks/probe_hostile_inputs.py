@@ -14,7 +14,7 @@ from functools import cache
 
 import numpy as np
 
-from probe_hostile import Probe
+from probe_hostile_machinery import Probe
 
 # -- photos -----------------------------------------------------------------------------------
 

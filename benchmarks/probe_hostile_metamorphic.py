@@ -28,8 +28,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from probe_hostile import ROOT, Probe, Workspace, _then  # noqa: E402
 from probe_hostile_fixtures import _dump, _in, _json, _syn  # noqa: E402
+from probe_hostile_machinery import ROOT, Probe, Workspace, _then  # noqa: E402
 from probe_hostile_metamorphic_compare import (  # noqa: E402
     IDENTITY,
     LIL,
@@ -373,7 +373,7 @@ def _spread_first(args, base):
 def main(argv=None):
     """Run this group alone (the same verdicts as ``probe_hostile.py``); ``--spread`` prints
     the seed spread the tolerances come from and stops."""
-    from probe_hostile import run_group
+    from probe_hostile_machinery import run_group
 
     hooks = {
         "arguments": lambda p: p.add_argument(

@@ -47,8 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from probe_hostile import Probe, Workspace, _then
 from probe_hostile_fixtures import _dump, _json
+from probe_hostile_machinery import Probe, Workspace, _then
 
 #: Lilium's budget in these probes (about 0.3 s an SFO here).
 LIL = ("--generations", "100", "--population", "30")

@@ -24,8 +24,8 @@ import re
 import shutil
 from html.parser import HTMLParser
 
-from probe_hostile import Probe, _then
 from probe_hostile_casework import TINY, _inputs_kept, _quiet_main, _second_photo
+from probe_hostile_machinery import Probe, _then
 
 #: Runs in a browser it is loaded in: marks ``<body>`` (checked with Chromium's ``--dump-dom``).
 PWN = "<img src=x onerror=document.body.setAttribute('data-pwned',1)>"

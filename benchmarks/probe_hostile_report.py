@@ -32,9 +32,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from probe_hostile import Probe, _then  # noqa: E402
 from probe_hostile_casework import TINY, _calibration, _only_models, _quiet_main  # noqa: E402
 from probe_hostile_fixtures import _edit_json, _in, _json, _syn  # noqa: E402
+from probe_hostile_machinery import Probe, _then  # noqa: E402
 from probe_hostile_reportcheck import (  # noqa: E402
     _conclusion_problems,
     _console_problems,
@@ -420,7 +420,7 @@ def report_probes():
 
 def main(argv=None):
     """Run this group alone (the same verdicts as ``probe_hostile.py``)."""
-    from probe_hostile import run_group
+    from probe_hostile_machinery import run_group
 
     return run_group(report_probes, "report", __doc__, argv, limit_s=120)
 

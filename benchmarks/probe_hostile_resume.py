@@ -27,24 +27,12 @@ import sys
 import time
 from pathlib import Path
 
-from probe_hostile import Probe
 from probe_hostile_casework import TINY, _quiet_main, _second_photo
+from probe_hostile_fixtures import SFO_FIELDS, _png_ok, _results, _sfo_fields
+from probe_hostile_machinery import Probe
 from probe_hostile_runs import BASE, _config, _exp, _in, _prior_run, _stored, _then
 
 # -- comparing a resumed run with a fresh one ---------------------------------------------------
-
-#: The fields of a result.json an SFO computes (not its timing).
-SFO_FIELDS = ("method", "variant", "seed", "camera", "fitness", "terms", "generations")
-
-
-def _sfo_fields(path):
-    data = json.loads(Path(path).read_text())
-    return {k: data.get(k) for k in SFO_FIELDS}
-
-
-def _results(folder):
-    return {p.relative_to(folder).as_posix(): p for p in sorted(Path(folder).rglob("result.json"))}
-
 
 def _same_as_fresh(argv_at):
     """Check: the outputs of the resumed run equal those of the same command run afresh into
@@ -66,17 +54,6 @@ def _same_as_fresh(argv_at):
         return None
 
     return check
-
-
-def _png_ok(path):
-    from PIL import Image
-
-    try:
-        with Image.open(path) as im:
-            im.load()
-    except Exception as exc:  # noqa: BLE001
-        return f"{Path(path).name} unreadable ({type(exc).__name__})"
-    return None
 
 
 # -- lineup ---------------------------------------------------------------------------------

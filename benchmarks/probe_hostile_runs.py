@@ -13,7 +13,7 @@ import os
 import shutil
 import sqlite3
 
-from probe_hostile import Probe, _then, _write
+from probe_hostile_machinery import Probe, _then, _write
 
 #: One subject, a frontal and a lateral photo, POSEST-SFO, Exp. A: 2 SFOs, a few seconds.
 BASE = """name = "runs"

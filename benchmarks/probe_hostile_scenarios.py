@@ -21,7 +21,7 @@ import sys
 import time
 from pathlib import Path
 
-from probe_hostile_resume import _png_ok, _results, _sfo_fields
+from probe_hostile_fixtures import _png_ok, _results, _sfo_fields
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -23,7 +23,6 @@ import shutil
 
 import numpy as np
 
-from probe_hostile import Probe, _then
 from probe_hostile_casework import TINY, _quiet_main
 from probe_hostile_fixtures import (
     _codes,
@@ -42,6 +41,7 @@ from probe_hostile_fixtures import (
     _subject,
     _syn,
 )
+from probe_hostile_machinery import Probe, _then
 
 # -- checks -----------------------------------------------------------------------------------
 
