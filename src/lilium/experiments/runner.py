@@ -10,11 +10,11 @@ Tasks: every photo x every skull x every method, for each experiment:
 A joint method (``lilium-joint``, :mod:`lilium.experiments.joint_tasks`) runs once per
 subject's frontal + lateral photo pair and skull, and stores one row per photo.
 
-The worker (:func:`run_task`) reads the case (cached per process), runs the method and scores
-it: the ranking score, the BPE for positive pairs (photo of this skull's subject) and the
-projected-skull pixels outside the face mask (implausible SFOs). The parent writes each row to
-the :class:`~lilium.experiments.store.ResultStore` as it arrives, so a killed run loses only the
-SFOs in flight; a rerun skips the stored keys.
+The worker (:func:`run_task`) reads the case (cached per process, :mod:`.task_io`), runs the
+method and scores it: the ranking score, the BPE for positive pairs (photo of this skull's
+subject) and the projected-skull pixels outside the face mask (implausible SFOs). The parent
+writes each row to the :class:`~lilium.experiments.store.ResultStore` as it arrives, so a
+killed run loses only the SFOs in flight; a rerun skips the stored keys.
 
 Before the first SFO the run checks the dataset (:mod:`lilium.experiments.dataset`: the
 index, every file the tasks read, the fingerprint the database keeps) and takes the database's
