@@ -458,9 +458,9 @@ def _pair_sum(pairs, decision_pairs, validated, key):
 
 #: The decisions whose logistic regression is bi-Gaussianized
 #: (:func:`lilium.identification.calibration.bigaussian_warp`): none; ``bench_identification``
-#: compares the two on every decision, and on 92 and on 152 generated subjects the warp did
+#: compares the two on every decision, and on 92, 152 and 172 generated subjects the warp did
 #: not bring the frontal + lateral decision's misleading evidence to 5 % for both kinds of
-#: pair (152: 4.6 / 5.2 % against the logistic's 3.3 / 6.2 %, Cllr 0.204 against 0.195;
+#: pair (172: 5.2 / 5.1 % against the logistic's 2.9 / 5.8 %, Cllr 0.196 against 0.186;
 #: docs/method.md).
 WARPED = frozenset()
 
