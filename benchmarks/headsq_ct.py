@@ -129,7 +129,7 @@ def headsq_subjects(path=None, work_dir=None):
     from scipy.spatial import cKDTree
 
     from lilium.softtissue.landmarks import CORRESPONDENCES, MIDLINE_CRANIAL
-    from lilium.softtissue.normals import surface_normals_at
+    from lilium.softtissue.normals import landmark_normals
     from lilium.synthetic.subjects import MANDIBLE_LANDMARKS, SyntheticSubject
 
     key = str(data_dir(path))
@@ -161,14 +161,7 @@ def headsq_subjects(path=None, work_dir=None):
     pairs = [(c, f) for c, f in CORRESPONDENCES if c in cranial and f in facial]
     axes = {c: (facial[f] - cranial[c]) / np.linalg.norm(facial[f] - cranial[c]) for c, f in pairs}
     depths = {c: float(np.linalg.norm(facial[f] - cranial[c])) for c, f in pairs}
-    names = list(cranial)
-    normals = dict(
-        zip(
-            names,
-            surface_normals_at(skull, skull_f, np.array([cranial[n] for n in names])),
-            strict=True,
-        )
-    )
+    normals = landmark_normals(skull, skull_f, cranial)
     out = {
         "hq": SyntheticSubject(
             "hq", skull, skull_f, skin, skin_f, cranial, facial, axes, depths, normals

@@ -167,7 +167,7 @@ def place_landmarks(skull, skull_faces, skin, mandible_mask):
     -------
     cranial, facial : dict of str -> ndarray (3,)
     """
-    from lilium.softtissue.normals import surface_normals_at
+    from lilium.softtissue.normals import landmark_normals
 
     height, index, xy = _height_map(skull, skull_faces)
     labels, n = _deep_regions(height)
@@ -257,14 +257,7 @@ def place_landmarks(skull, skull_faces, skin, mandible_mask):
         cranial[f"zygion_{side}"] = c[np.argmax(sign * c[:, 0])]
 
     # facial
-    names = list(cranial)
-    normals = dict(
-        zip(
-            names,
-            surface_normals_at(skull, skull_faces, np.array([cranial[k] for k in names])),
-            strict=True,
-        )
-    )
+    normals = landmark_normals(skull, skull_faces, cranial)
     facial = {}
     z_axis = np.array([0.0, 0.0, 1.0])
     for name in ("nasion", "pogonion", "gnathion"):

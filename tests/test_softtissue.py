@@ -8,6 +8,7 @@ from lilium.softtissue import (
     DepthStats,
     check_depth_table,
     decode,
+    landmark_normals,
     make_cones,
     midsagittal_plane,
     surface_normals_at,
@@ -102,6 +103,11 @@ def test_surface_normals_of_a_sphere_point_outward():
     normals = surface_normals_at(sphere.vertices, sphere.faces[:, ::-1], points)  # inverted winding
     expected = points / np.linalg.norm(points, axis=1, keepdims=True)
     assert np.all(np.einsum("ij,ij->i", normals, expected) > 0.999)
+    faces = sphere.faces[:, ::-1]
+    named = landmark_normals(sphere.vertices, faces, {"c": points[2], "a": points[0]})
+    assert list(named) == ["c", "a"]  # the landmarks' own order, each its own normal
+    np.testing.assert_allclose(named["a"], normals[0], atol=1e-12)
+    np.testing.assert_allclose(named["c"], normals[2], atol=1e-12)
 
 
 def test_depth_table_checks():

@@ -21,7 +21,7 @@ from ..geometry.mesh import compact, parts_apart, point_surface_distance
 from ..inputs import CaseWarning, Photo, Priors, Skull
 from ..softtissue.depths import DepthStats, check_depth_table
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from ..softtissue.normals import surface_normals_at
+from ..softtissue.normals import landmark_normals
 from ..validation import check_prior, is_real
 from .curves import read_face_curve
 from .formats import find_landmark_file, points_from_object, read_landmarks
@@ -188,8 +188,7 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
             axes[name] = a / norm
     missing = [n for n in landmarks if n not in axes and n in CRANIAL_TO_FACIAL]
     if missing:
-        normals = surface_normals_at(vertices, faces, np.array([landmarks[n] for n in missing]))
-        axes.update(zip(missing, normals, strict=True))
+        axes.update(landmark_normals(vertices, faces, {n: landmarks[n] for n in missing}))
     return Skull(skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings))
 
 

@@ -13,7 +13,7 @@ from .landmarks import (
     bilateral_pairs,
     twin,
 )
-from .normals import surface_normals_at
+from .normals import landmark_normals, surface_normals_at
 
 __all__ = [
     "BUILTIN_DEPTHS",
@@ -32,6 +32,7 @@ __all__ = [
     "depth_stats",
     "encode_depth_only",
     "hybrid_genes",
+    "landmark_normals",
     "make_cones",
     "midsagittal_plane",
     "surface_normals_at",

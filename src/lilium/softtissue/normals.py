@@ -44,3 +44,12 @@ def surface_normals_at(vertices_mm, faces, points_mm, radius_mm=NORMAL_NEIGHBOUR
         norm = np.linalg.norm(n)
         normals[k] = n / norm if norm > 0 else (p - centre) / np.linalg.norm(p - centre)
     return normals
+
+
+def landmark_normals(vertices_mm, faces, landmarks_mm, radius_mm=NORMAL_NEIGHBOURHOOD_MM):
+    """:func:`surface_normals_at` of named points: ``{name: (3,) unit vector}`` for each of
+    ``landmarks_mm`` (``{name: (3,) mm}``), in its order."""
+    names = list(landmarks_mm)
+    points = np.array([landmarks_mm[n] for n in names], float).reshape(-1, 3)
+    normals = surface_normals_at(vertices_mm, faces, points, radius_mm)
+    return dict(zip(names, normals, strict=True))

@@ -43,7 +43,7 @@ import numpy as np
 from ..ct.mesh import volume_to_mesh
 from ..ct.volume import Volume
 from ..softtissue.landmarks import CORRESPONDENCES, FACIAL_NAMES
-from ..softtissue.normals import surface_normals_at
+from ..softtissue.normals import landmark_normals
 from .anatomy.bone import build_bone
 from .anatomy.landmarks import locate_cranial_landmarks, place_cheilia
 from .anatomy.shape import SubjectShape, draw_shape
@@ -185,14 +185,7 @@ def _skull(shape, rng):
     bone, design = build_bone(shape, rng)
     skull_v, skull_f = _mesh(bone, SKULL_FACES)
     cranial = locate_cranial_landmarks(bone, design)
-    names = list(cranial)
-    normals = dict(
-        zip(
-            names,
-            surface_normals_at(skull_v, skull_f, np.array([cranial[n] for n in names])),
-            strict=True,
-        )
-    )
+    normals = landmark_normals(skull_v, skull_f, cranial)
     return bone, design, skull_v, skull_f, cranial, normals
 
 
