@@ -17,6 +17,15 @@ from lilium import jit
 from lilium.geometry.rotations import rotvec_to_matrix
 
 
+def _cameras_some_behind(rng, S):
+    """``S`` random cameras (rotations, translations, focal lengths), some with the scene
+    behind them (depth from -100 to 1500 mm)."""
+    R = np.array([rotvec_to_matrix(v) for v in rng.normal(size=(S, 3))])
+    t = np.column_stack([rng.normal(scale=20.0, size=(S, 2)), rng.uniform(-100.0, 1500.0, S)])
+    f = rng.uniform(1000.0, 4000.0, S)
+    return R, t, f
+
+
 def _lm_problems(S=120, N=18, rng=7):
     from lilium.geometry.camera import project_points
 
@@ -63,9 +72,7 @@ def test_reprojection_errors_and_decoding_kernels_match_numpy():
 
     rng = np.random.default_rng(4)
     S = 200
-    R = np.array([rotvec_to_matrix(v) for v in rng.normal(size=(S, 3))])
-    t = np.column_stack([rng.normal(scale=20.0, size=(S, 2)), rng.uniform(-100.0, 1500.0, S)])
-    f = rng.uniform(1000.0, 4000.0, S)
+    R, t, f = _cameras_some_behind(rng, S)
     for X in (rng.normal(scale=60.0, size=(18, 3)), rng.normal(scale=60.0, size=(S, 18, 3))):
         uv = rng.normal(scale=300.0, size=(18, 2))
         compiled = reprojection_sq_errors(uv, X, R, t, f)
@@ -97,9 +104,7 @@ def test_projection_kernel_matches_numpy():
 
     rng = np.random.default_rng(5)
     S = 50
-    R = np.array([rotvec_to_matrix(v) for v in rng.normal(size=(S, 3))])
-    t = np.column_stack([rng.normal(scale=20.0, size=(S, 2)), rng.uniform(-100.0, 1500.0, S)])
-    f = rng.uniform(1000.0, 4000.0, S)
+    R, t, f = _cameras_some_behind(rng, S)
     for X in (rng.normal(scale=60.0, size=(40, 3)), rng.normal(scale=60.0, size=(S, 40, 3))):
         compiled = project_points(X, R, t, f, CENTRE)
         with jit.kernels("numpy"):
