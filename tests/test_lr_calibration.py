@@ -106,6 +106,8 @@ def test_two_views_that_repeat_each_other_are_not_counted_twice():
     model = models["m//pair_sum"]
     assert model.names == VIEWS_TERMS
     assert model.provenance["model"] == VIEWS_MODEL
+    # The sum is bi-Gaussianized (calibrate.WARPED), the single photos' models are not.
+    assert model.warp is not None and models["m//frontal"].warp is None
     assert model.provenance["ridge"] == VIEWS_RIDGE  # each model says its penalty
     terms_model = models["m//frontal"]
     assert terms_model.provenance["ridge"] == pytest.approx(ridge_for(terms_model.n_same))

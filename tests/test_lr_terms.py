@@ -14,6 +14,7 @@ from lilium.geometry.camera import Camera
 from lilium.identification.terms import (
     View,
     landmark_chi2,
+    landmark_worst,
     prior_excess,
     soft_tissue_covariance,
 )
@@ -47,6 +48,24 @@ def test_marginal_chi2_is_one_for_the_model_and_larger_for_another_skull():
     assert 0.8 < np.mean(true) < 1.2  # the residuals' own covariance: 1 per coordinate
     wrong = [landmark_chi2([_view(rng, scale=1.08)])[0] for _ in range(20)]
     assert np.mean(wrong) > 1.5 * np.mean(true)
+
+
+def test_worst_landmark_follows_the_model_and_finds_one_misfit():
+    """Under the model a landmark's misfit per coordinate in one photo is exponential (mean
+    1), so the largest of N is about the harmonic number H_N; one landmark moved by 6 of its
+    errors raises the worst landmark far more than the mean term, which spreads it over all
+    N (the landmark's error here: about 5 px per coordinate, 2D noise and soft tissue)."""
+    rng = np.random.default_rng(3)
+    views = [_view(rng) for _ in range(40)]
+    worst = [landmark_worst([v]) for v in views]
+    assert np.mean(worst) == pytest.approx(np.sum(1.0 / np.arange(1, 41)), rel=0.15)
+    view = views[0]
+    moved = replace(view, uv_px=view.uv_px + np.r_[[[40.0, 0.0]], np.zeros((39, 2))])
+    worst_ratio = landmark_worst([moved]) / landmark_worst([view])
+    chi2_ratio = landmark_chi2([moved])[0] / landmark_chi2([view])[0]
+    assert worst_ratio > 3 and chi2_ratio < 2 and worst_ratio > 2 * chi2_ratio
+    behind = View(view.camera, view.cranial_mm + [0, 0, 3000.0], *list(vars(view).values())[2:])
+    assert landmark_worst([behind]) == np.inf
 
 
 def test_shared_soft_tissue_couples_two_views():

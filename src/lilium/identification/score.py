@@ -21,6 +21,7 @@ from .terms import (
     TERM_NAMES,
     eye_corner_px,
     landmark_chi2,
+    landmark_worst,
     make_view,
     prior_excess,
     soft_tissue_z2,
@@ -168,6 +169,7 @@ def identification_terms(
         skull_sd=skull_sd,
         landmark_refit=refit,
         outside_refit=outside_refit,
+        landmark_worst=landmark_worst(views),
     )
     assert tuple(out) == TERM_NAMES
     out["nll"] = nll
@@ -177,14 +179,15 @@ def identification_terms(
 
 #: The terms added last, in the order they came: stored terms lacking only these are
 #: completed (:func:`with_late_terms`), not computed again.
-LATE_TERMS = ("skull_mean", "skull_sd", "landmark_refit", "outside_refit")
+LATE_TERMS = ("skull_mean", "skull_sd", "landmark_refit", "outside_refit", "landmark_worst")
 
 
 def with_late_terms(terms, skull, photos, cameras, depth_table=None, cohort=None):
     """Terms stored by an older version, completed: each of :data:`LATE_TERMS` they lack
     computed (``skull_mean`` and ``skull_sd`` by
     :func:`lilium.identification.cohort.skull_cohort_terms`, ``landmark_refit`` and
-    ``outside_refit`` by :func:`refit_terms`), every other term kept as stored
+    ``outside_refit`` by :func:`refit_terms`, ``landmark_worst`` by
+    :func:`lilium.identification.terms.landmark_worst`), every other term kept as stored
     (arguments as in :func:`identification_terms`)."""
     out = dict(terms)
     missing = [n for n in LATE_TERMS if n not in terms]
@@ -202,6 +205,8 @@ def with_late_terms(terms, skull, photos, cameras, depth_table=None, cohort=None
         out["skull_mean"], out["skull_sd"] = skull_cohort_terms(views, cohort)
     if {"landmark_refit", "outside_refit"} & set(missing):
         out["landmark_refit"], out["outside_refit"] = refit_terms(skull, photos, views)
+    if "landmark_worst" in missing:
+        out["landmark_worst"] = landmark_worst(views)
     return out
 
 

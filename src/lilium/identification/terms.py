@@ -47,6 +47,9 @@ The terms (all "lower is better", dimensionless):
 - ``outside_refit``: ``outside_fraction`` under those refitted cameras: where the landmarks
   alone would put this skull's outline. The true skull's lies inside its own face; a wrong
   skull that fits the landmarks often pokes out of the head.
+- ``landmark_worst``: the largest landmark's ``r_i^T S_i^{-1} r_i`` per coordinate
+  (:func:`landmark_worst`): whether the misfit that ``landmark_chi2`` averages is spread over
+  the landmarks (noise) or sits in one (a skull that differs there).
 
 A term whose input is missing (no mask, no curve, no prior) is None; the calibration
 (:mod:`lilium.identification.calibration`) reads a None as the term's typical value and says so.
@@ -88,6 +91,7 @@ TERM_NAMES = (
     "skull_sd",
     "landmark_refit",
     "outside_refit",
+    "landmark_worst",
 )
 
 #: The cohort terms: the photo(s) against other people's skulls, the skull against other
@@ -95,9 +99,10 @@ TERM_NAMES = (
 #: the calibration how to read ``landmark_chi2``.
 COHORT_TERMS = ("cohort_mean", "cohort_sd", "skull_mean", "skull_sd")
 
-#: The terms that say how to read ``landmark_chi2`` and are not evidence by themselves: the
-#: cohort terms and the landmarks' own best fit (left out of the unweighted score).
-REFERENCE_TERMS = (*COHORT_TERMS, "landmark_refit")
+#: The terms that say how to read ``landmark_chi2`` and are not evidence apart from it: the
+#: cohort terms, the landmarks' own best fit and the worst landmark (a second reading of the
+#: same residuals); left out of the unweighted score.
+REFERENCE_TERMS = (*COHORT_TERMS, "landmark_refit", "landmark_worst")
 
 #: The terms the calibration uses. ``soft_tissue_z2`` is reported but left out: measured on 20
 #: generated subjects (docs/method.md, Identification) it lowered Lilium's frontal per-photo
@@ -116,6 +121,7 @@ CALIBRATED_TERMS = (
     "landmark_snorm",
     "landmark_tension",
     "outside_refit",
+    "landmark_worst",
 )
 
 
@@ -259,8 +265,10 @@ def landmark_sigma_px(view):
     )
 
 
-def landmark_chi2(views):
-    """The marginal landmark term over one or several photos of one person.
+def landmark_blocks(views):
+    """Each landmark's share of the marginal landmark term over one or several photos of one
+    person: its stacked residual's squared Mahalanobis norm, log-determinant and number of
+    coordinates.
 
     Landmarks with the same cranial name in several views share their soft tissue: their
     residuals are stacked into one Gaussian whose covariance couples them through
@@ -272,33 +280,71 @@ def landmark_chi2(views):
 
     Returns
     -------
-    chi2 : float
-        ``sum_i r_i^T S_i^{-1} r_i`` over every landmark of every view divided by the number of
-        observed coordinates; ``inf`` when a landmark lies behind a camera.
-    nll : float
-        The negative log-likelihood of the landmarks (nats): ``0.5 sum_i (r^T S^-1 r +
-        log det(2 pi S_i))``.
+    quad, logdet, coords : ndarray of shape (L,)
+        Per landmark name (in order of first appearance): ``r^T S^-1 r``, ``log det(2 pi S)``
+        and the length of ``r`` (2 per photo it is seen in); None when a landmark lies behind
+        a camera.
     """
     by_name = {}
     for view in views:
         residual, jac, z = _mean_points_and_jacobians(view)
         if not np.all(z > 0) or not np.all(np.isfinite(residual)):
-            return np.inf, np.inf
+            return None
         sigma_px = landmark_sigma_px(view)
         cov = soft_tissue_covariance(view.axes, view.depth_mean_mm, view.depth_sd_mm)
         for k, name in enumerate(view.names):
             by_name.setdefault(name, []).append((residual[k], jac[k], sigma_px[k], cov[k]))
-    quad = logdet = 0.0
-    coords = 0
+    quad, logdet, coords = [], [], []
     for entries in by_name.values():
         r = np.concatenate([e[0] for e in entries])
         J = np.concatenate([e[1] for e in entries])
         noise = np.repeat([e[2] ** 2 for e in entries], 2)
         S = J @ entries[0][3] @ J.T + np.diag(noise)
-        quad += float(r @ np.linalg.solve(S, r))
-        logdet += float(np.linalg.slogdet(2 * np.pi * S)[1])
-        coords += len(r)
-    return quad / coords, 0.5 * (quad + logdet)
+        quad.append(float(r @ np.linalg.solve(S, r)))
+        logdet.append(float(np.linalg.slogdet(2 * np.pi * S)[1]))
+        coords.append(len(r))
+    return np.array(quad), np.array(logdet), np.array(coords)
+
+
+def landmark_chi2(views):
+    """The marginal landmark term over one or several photos of one person
+    (:func:`landmark_blocks`).
+
+    Parameters
+    ----------
+    views : sequence of View
+
+    Returns
+    -------
+    chi2 : float
+        ``sum_i r_i^T S_i^-1 r_i`` over every landmark of every view divided by the number of
+        observed coordinates; ``inf`` when a landmark lies behind a camera.
+    nll : float
+        The negative log-likelihood of the landmarks (nats): ``0.5 sum_i (r^T S^-1 r +
+        log det(2 pi S_i))``.
+    """
+    blocks = landmark_blocks(views)
+    if blocks is None:
+        return np.inf, np.inf
+    quad, logdet, coords = blocks
+    return float(quad.sum() / coords.sum()), float(0.5 * (quad.sum() + logdet.sum()))
+
+
+def landmark_worst(views):
+    """The worst landmark: the largest ``r_i^T S_i^-1 r_i`` per coordinate over the landmarks
+    (:func:`landmark_blocks`); ``inf`` when a landmark lies behind a camera (or none is seen).
+
+    ``landmark_chi2`` averages the misfit over the landmarks; a wrong skull that fits most of
+    them and misses one (a wider zygomatic arch, a longer chin) shows here. Under the model
+    a landmark's ``r^T S^-1 r`` per coordinate is 1 on average; in one photo (two
+    coordinates) it is exponential, so for the true skull the largest of ``N`` is about the
+    harmonic number ``H_N`` (3.5 for 18 landmarks).
+    """
+    blocks = landmark_blocks(views)
+    if blocks is None:
+        return np.inf
+    quad, _, coords = blocks
+    return float(np.max(quad / coords)) if len(quad) else np.inf
 
 
 def soft_tissue_z2(facial_mm, cranial_mm, axes, depth_mean_mm, depth_sd_mm):
