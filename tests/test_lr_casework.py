@@ -53,6 +53,38 @@ def test_sfo_writes_the_identification_and_prints_the_conclusion(case, tmp_path,
     assert f"identification: {ident['conclusion']}" in stdout
 
 
+def test_the_record_names_a_misplaced_landmark(case, tmp_path):
+    """One photo landmark moved far off (a misclick): the identification names it as the
+    worst-fitting landmark, with a larger misfit, and the report shows the name."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from lilium.casework.identify import Calibrations, identify
+    from lilium.inputs import correspondences
+    from lilium.io.case import read_photo, read_skull
+    from lilium.report.conclusion_html import conclusion_section
+
+    subject_dir, photo_dir = case
+    assert main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
+                 "--photo", str(photo_dir), "--out", str(tmp_path / "out")]) == 0
+    data = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert data["identification"]["worst_landmark"]["misfit"] > 0
+    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[],
+                             camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
+    skull, photo = read_skull(subject_dir), read_photo(photo_dir)
+    moved_name = correspondences(skull, photo).facial_names[2]
+    landmarks = dict(photo.landmarks_uv)
+    landmarks[moved_name] = np.asarray(landmarks[moved_name], float) + [60.0, -60.0]
+    calibrations = Calibrations()
+    before = identify(skull, [photo], [result], calibrations)["worst_landmark"]
+    after = identify(skull, [replace(photo, landmarks_uv=landmarks)], [result], calibrations)
+    assert after["worst_landmark"]["name"] == moved_name
+    assert after["worst_landmark"]["misfit"] > 3 * before["misfit"]
+    assert after["terms"]["landmark_worst"] == pytest.approx(after["worst_landmark"]["misfit"])
+    html = conclusion_section([("photo", "", after)])
+    assert f"worst-fitting landmark: {moved_name}" in html
+
+
 def test_case_without_a_calibrated_model_says_so(case, tmp_path, capsys):
     subject_dir, photo_dir = case
     calibration = tmp_path / "empty.json"

@@ -21,7 +21,7 @@ from dataclasses import replace
 
 from ..identification.calibration import VIEWS_LOG10_LR
 from ..identification.conclusion import conclude, material_caps
-from ..identification.score import identification_terms, nll_score
+from ..identification.score import identification_terms, nll_score, worst_landmark_of
 from ..inputs import correspondences
 from ..io.calibration import read_calibration, shipped_cohort, shipped_path
 from ..methods.prior_checks import perspective_conflict
@@ -118,7 +118,10 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
     -------
     dict
         ``score``, ``terms``, ``log10_lr``, ``conclusion``, ``conclusion_uncapped``, ``caps``,
-        ``inconsistent``, ``calibration`` (model key, file, provenance), ``note``.
+        ``inconsistent``, ``calibration`` (model key, file, provenance), ``worst_landmark``
+        (the photo landmark that fits worst and its misfit per coordinate: one misplaced
+        landmark lowers the LR, so the examiner is told which to check; absent for a failed
+        SFO), ``note``.
     """
     method, variant = results[0].method, results[0].variant
     key = decision_key(method, variant, photos, joint)
@@ -193,6 +196,7 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
             note = "calibrated on one frontal and one lateral photo; these photos differ"
     inconsistent = _inconsistent(photos, results, terms, facial)
     verdict = conclude(lr, caps, inconsistent)
+    worst, misfit = worst_landmark_of(skull, photos, [r.camera for r in results])
     return record | {
         "score": nll_score(terms),
         "terms": {k: (None if v is None else float(v)) for k, v in terms.items()},
@@ -201,6 +205,7 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
         "conclusion_uncapped": verdict.uncapped,
         "caps": caps,
         "inconsistent": inconsistent,
+        "worst_landmark": None if worst is None else {"name": worst, "misfit": misfit},
         "note": note,
     }
 

@@ -25,6 +25,7 @@ from .terms import (
     make_view,
     prior_excess,
     soft_tissue_z2,
+    worst_landmark,
 )
 
 
@@ -197,10 +198,7 @@ def with_late_terms(terms, skull, photos, cameras, depth_table=None, cohort=None
         out[name] = None
     if not np.isfinite(terms.get("landmark_chi2") or np.nan):
         return out
-    views = [
-        make_view(camera, correspondences(skull, photo), photo.landmark_sources, depth_table)
-        for photo, camera in zip(photos, cameras, strict=True)
-    ]
+    views = views_of(skull, photos, cameras, depth_table)
     if cohort is not None and {"skull_mean", "skull_sd"} & set(missing):
         out["skull_mean"], out["skull_sd"] = skull_cohort_terms(views, cohort)
     if {"landmark_refit", "outside_refit"} & set(missing):
@@ -208,6 +206,27 @@ def with_late_terms(terms, skull, photos, cameras, depth_table=None, cohort=None
     if "landmark_worst" in missing:
         out["landmark_worst"] = landmark_worst(views)
     return out
+
+
+def views_of(skull, photos, cameras, depth_table=None):
+    """The :class:`~lilium.identification.terms.View` of each photo under its camera."""
+    return [
+        make_view(camera, correspondences(skull, photo), photo.landmark_sources, depth_table)
+        for photo, camera in zip(photos, cameras, strict=True)
+    ]
+
+
+def worst_landmark_of(skull, photos, cameras):
+    """The photo landmark that fits worst under the cameras (its facial name, the photos'
+    landmarks taken together as in ``landmark_worst``) and its misfit per coordinate; ``(None,
+    inf)`` when a landmark lies behind a camera (:func:`lilium.identification.terms.
+    worst_landmark`). A case names it: one misplaced landmark lowers the LR."""
+    facial = {}
+    for photo in photos:
+        corr = correspondences(skull, photo)
+        facial.update(zip(corr.cranial_names, corr.facial_names, strict=True))
+    name, misfit = worst_landmark(views_of(skull, photos, cameras))
+    return facial.get(name), misfit
 
 
 def nll_score(terms):

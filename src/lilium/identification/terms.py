@@ -280,10 +280,13 @@ def landmark_blocks(views):
 
     Returns
     -------
+    names : list of str, length L
+        The cranial names, in order of first appearance.
     quad, logdet, coords : ndarray of shape (L,)
-        Per landmark name (in order of first appearance): ``r^T S^-1 r``, ``log det(2 pi S)``
-        and the length of ``r`` (2 per photo it is seen in); None when a landmark lies behind
-        a camera.
+        Per landmark name: ``r^T S^-1 r``, ``log det(2 pi S)`` and the length of ``r`` (2 per
+        photo it is seen in).
+
+    None when a landmark lies behind a camera.
     """
     by_name = {}
     for view in views:
@@ -303,7 +306,7 @@ def landmark_blocks(views):
         quad.append(float(r @ np.linalg.solve(S, r)))
         logdet.append(float(np.linalg.slogdet(2 * np.pi * S)[1]))
         coords.append(len(r))
-    return np.array(quad), np.array(logdet), np.array(coords)
+    return list(by_name), np.array(quad), np.array(logdet), np.array(coords)
 
 
 def landmark_chi2(views):
@@ -326,25 +329,33 @@ def landmark_chi2(views):
     blocks = landmark_blocks(views)
     if blocks is None:
         return np.inf, np.inf
-    quad, logdet, coords = blocks
+    _, quad, logdet, coords = blocks
     return float(quad.sum() / coords.sum()), float(0.5 * (quad.sum() + logdet.sum()))
 
 
-def landmark_worst(views):
-    """The worst landmark: the largest ``r_i^T S_i^-1 r_i`` per coordinate over the landmarks
-    (:func:`landmark_blocks`); ``inf`` when a landmark lies behind a camera (or none is seen).
+def worst_landmark(views):
+    """The worst landmark: the cranial name and the misfit (``r_i^T S_i^-1 r_i`` per
+    coordinate, :func:`landmark_blocks`) of the landmark that fits worst; ``(None, inf)`` when
+    a landmark lies behind a camera (or none is seen).
 
     ``landmark_chi2`` averages the misfit over the landmarks; a wrong skull that fits most of
-    them and misses one (a wider zygomatic arch, a longer chin) shows here. Under the model
-    a landmark's ``r^T S^-1 r`` per coordinate is 1 on average; in one photo (two
-    coordinates) it is exponential, so for the true skull the largest of ``N`` is about the
-    harmonic number ``H_N`` (3.5 for 18 landmarks).
+    them and misses one (a wider zygomatic arch, a longer chin) shows here, and so does one
+    misplaced 2D landmark (which is why a case names it). Under the model a landmark's misfit
+    is 1 on average; in one photo (two coordinates) it is exponential, so for the true skull
+    the largest of ``N`` is about the harmonic number ``H_N`` (3.5 for 18 landmarks).
     """
     blocks = landmark_blocks(views)
-    if blocks is None:
-        return np.inf
-    quad, _, coords = blocks
-    return float(np.max(quad / coords)) if len(quad) else np.inf
+    if blocks is None or not blocks[0]:
+        return None, np.inf
+    names, quad, _, coords = blocks
+    misfit = quad / coords
+    k = int(np.argmax(misfit))
+    return names[k], float(misfit[k])
+
+
+def landmark_worst(views):
+    """The term ``landmark_worst``: the misfit of :func:`worst_landmark`."""
+    return worst_landmark(views)[1]
 
 
 def soft_tissue_z2(facial_mm, cranial_mm, axes, depth_mean_mm, depth_sd_mm):

@@ -31,6 +31,12 @@ def _why(record):
     parts += [f"{escape(code)}: {escape(text)}" for code, text in caps]
     if record.get("note"):
         parts.append(f"<i>{escape(record['note'])}</i>")
+    worst = record.get("worst_landmark")
+    if worst:
+        parts.append(
+            f"<span class='muted'>worst-fitting landmark: {escape(str(worst['name']))} (misfit "
+            f"{worst['misfit']:.1f} per coordinate; a misplaced landmark lowers the LR)</span>"
+        )
     return "<br>".join(parts) or "&ndash;"
 
 
