@@ -52,9 +52,9 @@ def test_marginal_chi2_is_one_for_the_model_and_larger_for_another_skull():
 
 def test_worst_landmark_follows_the_model_and_finds_one_misfit():
     """Under the model a landmark's misfit per coordinate in one photo is exponential (mean
-    1), so the largest of N is about the harmonic number H_N; one landmark moved by 6 of its
-    errors raises the worst landmark far more than the mean term, which spreads it over all
-    N (the landmark's error here: about 5 px per coordinate, 2D noise and soft tissue)."""
+    1), so the largest of N is about the harmonic number H_N; one landmark moved by 40 px
+    (about 8 of its errors: some 5 px per coordinate, 2D noise and soft tissue) raises the
+    worst landmark far more than the mean term, which spreads it over all N."""
     rng = np.random.default_rng(3)
     views = [_view(rng) for _ in range(40)]
     worst = [landmark_worst([v]) for v in views]
