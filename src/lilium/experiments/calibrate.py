@@ -459,10 +459,10 @@ def _pair_sum(pairs, decision_pairs, validated, key):
 #: The decisions whose logistic regression is bi-Gaussianized
 #: (:func:`lilium.identification.calibration.bigaussian_warp`): the frontal + lateral sum
 #: (since 2026-12-05). The warp moves LR 1 to where the two kinds of pair are misled equally
-#: often; on 172 generated subjects (cross-validated, docs/method.md "The worst landmark") it
-#: took Lilium's sum from 2.9 / 5.5 % misleading same / different-person pairs to 4.7 / 4.8 %
-#: and its different-person wrong conclusions from 3.3 to 2.8 % (same-person ones 1.7 % both
-#: ways), for a Cllr of 0.184 against 0.179: fewer wrong persons supported, no more wrong
+#: often; on 232 generated subjects (cross-validated, docs/method.md "The worst landmark") it
+#: takes Lilium's sum from 3.0 / 5.6 % misleading same / different-person pairs to 4.7 / 4.5 %
+#: and its different-person wrong conclusions from 3.4 to 2.9 % (same-person ones 1.3 % both
+#: ways), for a Cllr of 0.187 against 0.179: fewer wrong persons supported, no more wrong
 #: exclusions. The single photos' models stay logistic (warped, their Cllr rose);
 #: ``bench_identification`` prints both calibrations for every decision.
 WARPED = frozenset({"pair_sum"})

@@ -286,7 +286,8 @@ def landmark_blocks(views):
         Per landmark name: ``r^T S^-1 r``, ``log det(2 pi S)`` and the length of ``r`` (2 per
         photo it is seen in).
 
-    None when a landmark lies behind a camera.
+    None when a landmark lies behind a camera, or the face's centroid does (a degenerate
+    camera, such as a cohort member's diverged refit: no face size, no 2D error).
     """
     by_name = {}
     for view in views:
@@ -294,6 +295,8 @@ def landmark_blocks(views):
         if not np.all(z > 0) or not np.all(np.isfinite(residual)):
             return None
         sigma_px = landmark_sigma_px(view)
+        if not np.all(np.isfinite(sigma_px)):  # the face's centroid at or behind the camera
+            return None
         cov = soft_tissue_covariance(view.axes, view.depth_mean_mm, view.depth_sd_mm)
         for k, name in enumerate(view.names):
             by_name.setdefault(name, []).append((residual[k], jac[k], sigma_px[k], cov[k]))
