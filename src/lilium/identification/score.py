@@ -121,18 +121,16 @@ def identification_terms(
         ``{name: float or None}`` for every name of :data:`TERM_NAMES`, plus ``"nll"`` (the
         landmarks' negative log-likelihood in nats) and ``"landmarks"`` (pairs used).
     """
-    views, outside, pll, excess = [], [], [], []
-    for k, (photo, camera) in enumerate(zip(photos, cameras, strict=True)):
-        corr = correspondences(skull, photo)
-        view = make_view(camera, corr, photo.landmark_sources, depth_table)
-        views.append(view)
+    views = views_of(skull, photos, cameras, depth_table)
+    outside, pll, excess = [], [], []
+    for k, (photo, camera, view) in enumerate(zip(photos, cameras, views, strict=True)):
         if image is not None and image[k] is not None:
             o, p = image[k]
         else:
             o, p = image_consistency(skull, photo, camera, eye_corner_px(camera, view.cranial_mm))
         outside.append(o)
         pll.append(p)
-        point = scd_point_mm(facial_landmarks_mm) if facial_landmarks_mm else corr.cranial_mm[0]
+        point = scd_point_mm(facial_landmarks_mm) if facial_landmarks_mm else view.cranial_mm[0]
         excess.append(prior_excess(camera, photo.priors, point))
     chi2, nll = landmark_chi2(views)
     cohort_mean = cohort_sd = None
@@ -221,12 +219,8 @@ def worst_landmark_of(skull, photos, cameras):
     landmarks taken together as in ``landmark_worst``) and its misfit per coordinate; ``(None,
     inf)`` when a landmark lies behind a camera (:func:`lilium.identification.terms.
     worst_landmark`). A case names it: one misplaced landmark lowers the LR."""
-    facial = {}
-    for photo in photos:
-        corr = correspondences(skull, photo)
-        facial.update(zip(corr.cranial_names, corr.facial_names, strict=True))
     name, misfit = worst_landmark(views_of(skull, photos, cameras))
-    return facial.get(name), misfit
+    return (None if name is None else CRANIAL_TO_FACIAL[name]), misfit
 
 
 def nll_score(terms):
