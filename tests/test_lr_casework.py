@@ -289,3 +289,124 @@ def test_two_photos_reuse_each_photos_own_decision(case, tmp_path, monkeypatch):
     calls.clear()
     identify(skull, [frontal, lateral], own, other)
     assert calls == [2, 1, 1]
+
+
+def _one_term_model(ranges):
+    """A calibration of POSEST-SFO's frontal photos that reads any case as strong support
+    (log10 LR 3, its upper bound), with ``ranges`` for its one feature."""
+    from lilium.identification.calibration import Calibration
+
+    n_same, n_diff = 1, 1000
+    return Calibration(
+        ("landmark_chi2",), {"landmark_chi2": 0.0}, {"landmark_chi2": 1.0},
+        {"landmark_chi2": 0.0}, {"landmark_chi2": 0.0},
+        3.0 * np.log(10.0) + np.log(n_same / n_diff), n_same, n_diff,
+        ranges=ranges,
+    )
+
+
+def test_a_case_outside_the_calibrations_range_gets_no_support(case, tmp_path, capsys):
+    """The same case and model, once with the feature's training range around the case's
+    value (moderate support: strong, capped one step for the single photo) and once with a
+    range that leaves it out: then ``outside_calibration`` names the feature, its value and
+    the range, the conclusion is undetermined, and the console and the report say so first."""
+    from lilium.io.calibration import write_calibration
+
+    subject_dir, photo_dir = case
+    conclusions = {}
+    for name, ranges in (("inside", {"landmark_chi2": (-50.0, 50.0)}),
+                         ("outside", {"landmark_chi2": (-50.0, -40.0)})):
+        calibration = tmp_path / f"{name}.json"
+        write_calibration(calibration, {"posest-sfo//frontal": _one_term_model(ranges)}, {})
+        out = tmp_path / name
+        code = main(["case", "--skull", str(subject_dir), "--photo", str(photo_dir),
+                     "--method", "posest-sfo", "--calibration", str(calibration),
+                     "--out", str(out)])
+        stdout = capsys.readouterr().out
+        assert code == 0
+        ident = json.loads((out / photo_dir.name / "posest-sfo" / "result.json").read_text())[
+            "identification"]
+        assert ident["log10_lr"] == pytest.approx(3.0)
+        conclusions[name] = ident["conclusion"]
+        if name == "outside":
+            assert list(ident["caps"])[0] == "outside_calibration"
+            text = ident["caps"]["outside_calibration"]
+            assert "landmark_chi2" in text and "[-50, -40]" in text
+            value = float(np.log(ident["terms"]["landmark_chi2"]))
+            assert f"{value:.3g}" in text
+            line = next(x for x in stdout.splitlines() if "identification:" in x)
+            assert line.index("capped: feature landmark_chi2") > 0
+            report = (out / "report.html").read_text()
+            why = report[report.index("<table class='conclusions'>"):]
+            assert why.index("outside_calibration") < why.index("single_photo")
+        else:
+            assert "outside_calibration" not in ident["caps"]
+    assert conclusions == {"inside": "moderate support", "outside": "undetermined"}
+
+
+def test_a_camera_far_outside_its_priors_is_no_conclusion():
+    """The head orientation 173 deg from its prior (a wrong skull's SFO on a real head) is a
+    consistency failure: neither support nor exclusion, named; 2.5 tolerances off is not."""
+    from types import SimpleNamespace
+
+    from lilium.geometry.rotations import rotvec_to_matrix
+    from lilium.inputs import Priors
+    from lilium.methods.prior_checks import prior_conflict
+
+    prior = np.eye(3)
+    priors = Priors(focal_px=(900.0, 1100.0), scd_mm=None, head_rotation_skull2cam=prior,
+                    head_tolerance_deg=10.0)
+    photo = SimpleNamespace(id="p", priors=priors, prior_sources={})
+    for angle_deg, focal, far in ((25.0, 1000.0, False), (173.0, 1000.0, True),
+                                  (0.0, 1600.0, False), (0.0, 1700.0, True),
+                                  (0.0, 590.0, True)):
+        R = rotvec_to_matrix(np.radians([0.0, angle_deg, 0.0]))
+        camera = Camera.from_rt(R, np.array([0.0, 0.0, 1000.0]), focal, np.array([500.0, 500.0]))
+        found = prior_conflict(photo, camera, None)
+        assert (found is not None) == far, (angle_deg, focal, found)
+    assert "173.0 deg" in prior_conflict(photo, Camera.from_rt(
+        rotvec_to_matrix(np.radians([0.0, 173.0, 0.0])), np.array([0.0, 0.0, 1000.0]), 1000.0,
+        np.array([500.0, 500.0])), None)
+    failed = conclude(-2.5, {}, {"camera_outside_priors": "173 deg"})
+    assert failed.label == conclude(2.5, {}, {"camera_outside_priors": "173 deg"}).label \
+        == "undetermined"
+
+
+def test_skull_outside_the_head_is_decided_beyond_the_edge_noise(case):
+    """The head mask is the skull's own raster grown, shrunk by one pixel (a pixel-wide ring
+    of the skull outside it: raster and mask-edge noise) or cut at the brow (the vault really
+    leaves the head): only the last is ``skull_outside_head``, though the ring already counts
+    in ``outside_fraction``."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from scipy import ndimage as ndi
+
+    from lilium.casework.identify import skull_outside_head
+    from lilium.identification.score import outside_fraction, skull_beyond_head
+    from lilium.imaging.raster import mesh_mask
+    from lilium.io.case import read_photo, read_skull
+    from lilium.io.truth import read_ground_truth
+
+    subject_dir, photo_dir = case
+    skull, photo = read_skull(subject_dir), read_photo(photo_dir)
+    camera = read_ground_truth(photo_dir).camera
+    height, width = np.asarray(photo.face_mask).shape
+    raster = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height)) != 0
+    rows = np.nonzero(raster.any(axis=1))[0]
+    cut = raster.copy()
+    cut[: rows[0] + (rows[-1] - rows[0]) // 4] = False
+    masks = {"grown": ndi.binary_dilation(raster, iterations=8),
+             "one pixel in": ndi.binary_erosion(raster), "cut at the brow": cut}
+    result = SimpleNamespace(camera=camera)
+    found = {}
+    for name, mask in masks.items():
+        masked = replace(photo, face_mask=mask.astype(np.uint8) * 255)
+        beyond, skull_px, band = skull_beyond_head(skull, masked, camera)
+        assert skull_px == raster.sum() and band >= 2.0
+        found[name] = beyond
+        sentence = skull_outside_head(skull, [masked], [result])
+        assert (sentence is not None) == (name == "cut at the brow"), (name, sentence)
+    assert found["grown"] == found["one pixel in"] == 0 < found["cut at the brow"]
+    ring = outside_fraction(skull, replace(photo, face_mask=masks["one pixel in"]), camera)
+    assert ring > 0

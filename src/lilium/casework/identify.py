@@ -20,11 +20,16 @@ naming the model missing and how to fit it.
 from dataclasses import replace
 
 from ..identification.calibration import VIEWS_LOG10_LR
-from ..identification.conclusion import conclude, material_caps
-from ..identification.score import identification_terms, nll_score, worst_landmark_of
+from ..identification.conclusion import NO_SUPPORT_CAPS, conclude, material_caps
+from ..identification.score import (
+    identification_terms,
+    nll_score,
+    skull_beyond_head,
+    worst_landmark_of,
+)
 from ..inputs import correspondences
 from ..io.calibration import read_calibration, shipped_cohort, shipped_path
-from ..methods.prior_checks import perspective_conflict
+from ..methods.prior_checks import perspective_conflict, prior_conflict
 
 #: Cranial landmarks on the mandible: a skull with none of them has no mandible.
 MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")
@@ -62,22 +67,56 @@ def decision_key(method, variant, photos, joint=False):
     return f"{method}/{variant or ''}/{_group(photos[0])}"
 
 
-def _inconsistent(photos, results, terms, facial_landmarks_mm):
-    out = {}
-    outside = terms.get("outside_fraction")
-    if outside:
-        out["skull_outside_head"] = (
-            f"{100 * outside:.2g} % of the skull's pixels lie outside the head mask"
+def outside_calibration(model, terms, key):
+    """``{"outside_calibration": sentence}`` when a feature of ``terms`` lies outside the range
+    the model ``key`` was fitted on (:meth:`Calibration.outside`), else ``{}``: the sentence
+    names the first such feature, its value and the range, and how many more there are."""
+    outside = model.outside(terms)
+    if not outside:
+        return {}
+    name, value, (lo, hi) = outside[0]
+    more = f" (and {len(outside) - 1} more feature(s))" if len(outside) > 1 else ""
+    return {"outside_calibration": (
+        f"feature {name} = {value:.3g} lies outside the range [{lo:.3g}, {hi:.3g}] the model "
+        f"{key} was fitted on{more}: its LR would be an extrapolation, so it gives no support"
+    )}
+
+
+def skull_outside_head(skull, photos, results):
+    """The sentence of ``skull_outside_head``, or None: the photos where skull pixels lie
+    beyond the head mask's edge band (:func:`~lilium.identification.score.skull_beyond_head`),
+    how many and how far."""
+    found = []
+    for photo, result in zip(photos, results, strict=True):
+        counts = skull_beyond_head(skull, photo, result.camera)
+        if counts is None or counts[0] == 0:
+            continue
+        beyond, skull_px, band = counts
+        found.append(
+            f"{photo.id}: {beyond} of the skull's {skull_px} pixels ({100 * beyond / skull_px:.2g}"
+            f" %) lie more than {band:.1f} px outside the head mask"
         )
-    conflicts = []
+    return "; ".join(found) or None
+
+
+def _inconsistent(skull, photos, results, facial_landmarks_mm):
+    out = {}
+    outside = skull_outside_head(skull, photos, results)
+    if outside:
+        out["skull_outside_head"] = outside
+    conflicts, far = [], []
     for photo, result in zip(photos, results, strict=True):
         for w in result.warnings:
             if w.code == "view_mismatch":
                 out["view_mismatch"] = w.message
         facial = result.facial_landmarks_mm or facial_landmarks_mm
         conflicts.append(perspective_conflict(photo, result.camera, facial))
+        far_off = prior_conflict(photo, result.camera, facial)
+        far.append(None if far_off is None else f"{photo.id}: {far_off}")
     if any(conflicts):
         out["perspective_mismatch"] = "; ".join(c for c in conflicts if c)
+    if any(far):
+        out["camera_outside_priors"] = "; ".join(c for c in far if c)
     return out
 
 
@@ -177,6 +216,16 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
         lr, note = _views_lr(
             lrs, [p.id for p in photos], calibrations, f"{method}/{variant or ''}/pair_sum", record
         )
+        outside = [f"{p.id}: {part['caps']['outside_calibration']}"
+                   for p, part in zip(photos, parts, strict=True)
+                   if "outside_calibration" in part["caps"]]
+        views_model = calibrations.get(f"{method}/{variant or ''}/pair_sum")
+        if views_model is not None and lr is not None:
+            outside += outside_calibration(
+                views_model, {VIEWS_LOG10_LR: float(sum(lrs))}, f"{method}/{variant or ''}/pair_sum"
+            ).values()
+        if outside:
+            caps = {"outside_calibration": "; ".join(outside)} | caps
         note = "; ".join([part["note"] for part in parts if part["note"]] + [note] * bool(note))
         record["views_log10_lr"] = lrs
         record["calibration"].setdefault(
@@ -191,10 +240,11 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
         )
     else:
         lr = float(model.log10_lr([terms])[0])
+        caps = outside_calibration(model, terms, key) | caps
         record["calibration"]["provenance"] = model.provenance
         if len(photos) > 1 and not joint:
             note = "calibrated on one frontal and one lateral photo; these photos differ"
-    inconsistent = _inconsistent(photos, results, terms, facial)
+    inconsistent = _inconsistent(skull, photos, results, facial)
     verdict = conclude(lr, caps, inconsistent)
     worst, misfit = worst_landmark_of(skull, photos, [r.camera for r in results])
     return record | {
@@ -236,9 +286,11 @@ def conclusion_line(record):
     """One console line: the conclusion, the LR, and what capped it."""
     lr = record.get("log10_lr")
     lr_text = "no LR" if lr is None else f"log10 LR {lr:+.2f} (LR {10**lr:.3g})"
-    why = list(record.get("inconsistent", {}).values())
+    caps = dict(record.get("caps") or {})
+    why = [caps.pop(k) for k in NO_SUPPORT_CAPS if k in caps]  # first: the LR extrapolates
+    why += list(record.get("inconsistent", {}).values())
     if record["conclusion"] != record["conclusion_uncapped"]:
-        why += list(record["caps"].values())
+        why += list(caps.values())
     extra = f"; capped: {'; '.join(why)}" if why else ""
     note = f"; {record['note']}" if record.get("note") else ""
     return f"identification: {record['conclusion']}, {lr_text}{extra}{note}"

@@ -157,6 +157,32 @@ def implausible_sfo(skull_mask, face_mask):
     return ImplausibleSFO(outside_px, skull_px, percent)
 
 
+def outside_depth_px(skull_mask, face_mask):
+    """How far outside the face mask each projected-skull pixel outside it lies.
+
+    Parameters
+    ----------
+    skull_mask, face_mask : array_like of shape (H, W)
+        Non-zero = skull / face (head) pixels.
+
+    Returns
+    -------
+    ndarray of shape (M,)
+        For each of the M skull pixels outside the mask, the Euclidean distance (pixels) from
+        its centre to the nearest mask pixel's (1 for a pixel touching the mask's edge).
+    """
+    from scipy import ndimage as ndi
+
+    s = np.asarray(skull_mask) != 0
+    f = np.asarray(face_mask) != 0
+    outside = s & ~f
+    if not outside.any():
+        return np.empty(0)
+    if not f.any():
+        return np.full(int(outside.sum()), np.inf)
+    return ndi.distance_transform_edt(~f)[outside]
+
+
 def outside_face(camera, vertices_mm, faces, face_mask, topology=None):
     """Skull pixels outside the face mask for a camera and a skull mesh (SPEC section 7).
 

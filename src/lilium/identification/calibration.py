@@ -21,6 +21,16 @@ clipped to ``[-log10(n_same), log10(n_diff)]`` (a different-person score rarer t
 bound idea of forensic LR validation. Small calibration sets make LRs vary (Ali et al. 2015):
 the shipped models are fitted on hundreds of pairs and cross-validated by subject.
 
+**Range.** A model is valid only where it was fitted: each keeps the range of every feature
+it saw (:attr:`Calibration.ranges`: per class, same- and different-person pairs apart, the
+0.5 % and 99.5 % quantiles of the feature; the range is the lowest of the two lower quantiles
+to the highest of the two upper ones, so the best-fitting true pairs, a few per cent of all
+pairs, are inside it). :meth:`Calibration.outside` names the features of a decision that lie
+beyond it: the logistic regression would extrapolate there, and the decision does not get
+support (:mod:`lilium.identification.conclusion`, ``outside_calibration``). Real photos once
+sat 3-8 SD outside the generated range on two photo-level terms, and every real skull, the
+wrong one included, got the largest LR.
+
 **Validation.** :func:`cross_validated` scores every pair with a model that never saw its
 subject (k folds of subjects; training leaves out every pair whose photo or skull belongs to
 the fold). :func:`performance` gives Cllr, Cllr_min (after the pool-adjacent-violators
@@ -90,6 +100,10 @@ VIEWS_RIDGE = 1e-4
 #: Default number of subject folds of the cross-validation.
 FOLDS = 5
 
+#: The quantiles of a feature, per class, that bound the range a model was fitted on
+#: (:attr:`Calibration.ranges`).
+RANGE_QUANTILES = (0.005, 0.995)
+
 
 def _column(terms_list, name):
     """The raw values ``(P,)`` of one term (stored, or :data:`DERIVED_TERMS`), NaN where
@@ -138,6 +152,9 @@ class Calibration:
         The bi-Gaussianized warp of the logistic regression's natural-log LR
         (:func:`bigaussian_warp`): ``knots`` and ``ln_lr``, increasing, interpolated linearly
         and held flat beyond the ends; None = the logistic regression's LR as it is.
+    ranges : dict of str -> (float, float) or None
+        Per feature, the range it was fitted on (:data:`RANGE_QUANTILES`, module docstring);
+        None for a model stored without one (nothing is then said to lie outside it).
     """
 
     names: tuple
@@ -150,6 +167,7 @@ class Calibration:
     n_diff: int
     provenance: dict = field(default_factory=dict)
     warp: dict | None = None
+    ranges: dict | None = None
 
     @property
     def bounds(self):
@@ -171,6 +189,26 @@ class Calibration:
         out[keep] = np.clip(ln_lr / np.log(10.0), *self.bounds)
         return out
 
+    def outside(self, terms):
+        """The features of one decision's term dictionary that lie outside
+        :attr:`ranges`: ``[(name, value, (lo, hi)), ...]`` in the model's order, empty when
+        every feature is inside (or the model has no ranges). A missing term takes the
+        training median and is never outside; one of ``inf`` (a landmark behind the camera)
+        is."""
+        if not self.ranges:
+            return []
+        out = []
+        for name in self.names:
+            value = _column([terms], name)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                value = float(FEATURES[name](value)[0])
+            lo, hi = self.ranges[name]
+            if np.isnan(value) or np.isneginf(value):
+                continue
+            if not lo <= value <= hi:
+                out.append((name, value, (lo, hi)))
+        return out
+
     def to_dict(self):
         return {
             "names": list(self.names),
@@ -182,7 +220,9 @@ class Calibration:
             "n_same": self.n_same,
             "n_diff": self.n_diff,
             "provenance": self.provenance,
-        } | ({} if self.warp is None else {"warp": self.warp})
+        } | ({} if self.warp is None else {"warp": self.warp}) | (
+            {} if self.ranges is None else {"ranges": {n: list(v) for n, v in self.ranges.items()}}
+        )
 
     @classmethod
     def from_dict(cls, data):
@@ -212,6 +252,7 @@ class Calibration:
             _count(data["n_diff"], "n_diff"),
             dict(data.get("provenance", {})),
             _read_warp(data.get("warp")),
+            _read_ranges(data.get("ranges"), names),
         )
 
 
@@ -227,6 +268,43 @@ def _count(value, name):
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise ValueError(f"{name} must be a whole number of at least 1, got {str(value)[:40]!r}")
     return value
+
+
+def _read_ranges(ranges, names):
+    """Stored :attr:`Calibration.ranges` checked: a ``[lo, hi]`` of finite numbers, ``lo <=
+    hi``, for every feature of the model (None stays None)."""
+    if ranges is None:
+        return None
+    out = {}
+    for name in names:
+        if name not in ranges:
+            raise ValueError(f"ranges.{name} is missing (every feature of the model needs one)")
+        value = ranges[name]
+        if not isinstance(value, (list, tuple)) or len(value) != 2:
+            raise ValueError(f"ranges.{name} must be [lo, hi], got {str(value)[:40]!r}")
+        lo, hi = (_finite(v, f"ranges.{name}") for v in value)
+        if lo > hi:
+            raise ValueError(f"ranges.{name} must have lo <= hi, got [{lo}, {hi}]")
+        out[name] = (lo, hi)
+    return out
+
+
+def feature_ranges(X, same):
+    """The range of each column of a feature matrix ``X`` ``(P, F)`` (module docstring):
+    ``(F, 2)``, per class the :data:`RANGE_QUANTILES` of the finite values, the lower of the
+    two lows to the higher of the two highs."""
+    same = np.asarray(same, bool)
+    out = np.empty((X.shape[1], 2))
+    for j in range(X.shape[1]):
+        quantiles = []
+        for group in (same, ~same):
+            col = X[group, j]
+            col = col[np.isfinite(col)]
+            if len(col):
+                quantiles.append(np.quantile(col, RANGE_QUANTILES))
+        quantiles = np.array(quantiles)
+        out[j] = quantiles[:, 0].min(), quantiles[:, 1].max()
+    return out
 
 
 def _read_warp(warp):
@@ -277,6 +355,8 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, w
     used = tuple(raw)
     fill = {n: float(np.nanmedian(np.where(np.isfinite(raw[n]), raw[n], np.nan))) for n in used}
     X = features(terms_list, used, fill)
+    # Measured on the terms as given (a missing term is not at its median for the range).
+    ranges = feature_ranges(np.column_stack([raw[n] for n in used]), same)
     centre = X.mean(axis=0)
     scale = X.std(axis=0)
     scale[scale == 0] = 1.0
@@ -310,6 +390,7 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, w
         int((~same).sum()),
         dict(provenance or {}),
         warped,
+        {n: (float(lo), float(hi)) for n, (lo, hi) in zip(used, ranges, strict=True)},
     )
 
 

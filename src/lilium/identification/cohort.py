@@ -249,8 +249,10 @@ def _log_stats(values):
     return float(values.mean()), float(max(values.std(), 1e-6))
 
 
-def cohort_chi2(views, cohort):
-    """``landmark_chi2`` of every cohort skull against the photos of ``views``.
+def cohort_views(views, cohort):
+    """Every cohort skull's views of the photos of ``views``, each camera refitted to the
+    photo's landmarks (:func:`refit_cameras`, from the candidate's camera moved onto the cohort
+    skull by the rigid fit of their common landmarks).
 
     Parameters
     ----------
@@ -260,15 +262,15 @@ def cohort_chi2(views, cohort):
 
     Returns
     -------
-    ndarray of shape (K',)
-        One value per cohort skull that has every landmark the views use (the others are
-        left out).
+    list of list of View
+        Per cohort skull that has every landmark the views use (the others are left out), one
+        view per photo: its own landmarks and axes under its refitted camera.
     """
     members, moves = _aligned(views, cohort)
     if not members:
-        return np.empty(0)
+        return []
     K = len(members)
-    cohort_views = [[] for _ in members]
+    member_views = [[] for _ in members]
     for view in views:
         cam = view.camera
         R0 = np.array([cam.R @ Ra for Ra, _ in moves])
@@ -279,11 +281,17 @@ def cohort_chi2(views, cohort):
             view.depth_mean_mm, view.depth_sd_mm, view.uv_px, landmark_sigma_px(view),
         )
         for j in range(K):
-            cohort_views[j].append(replace(
+            member_views[j].append(replace(
                 view, camera=Camera.from_rt(R[j], t[j], f[j], cam.principal_point_px),
                 cranial_mm=cranial[j], axes=axes[j],
             ))
-    return np.array([landmark_chi2(v)[0] for v in cohort_views])
+    return member_views
+
+
+def cohort_chi2(views, cohort):
+    """``landmark_chi2`` ``(K',)`` of every cohort skull against the photos of ``views``
+    (:func:`cohort_views`; several photos still share each skull's soft tissue)."""
+    return np.array([landmark_chi2(v)[0] for v in cohort_views(views, cohort)])
 
 
 def cohort_terms(views, cohort):

@@ -23,10 +23,19 @@ is named in the result: the skull has no mandible; a single photo; automatic lan
 nobody reviewed; fewer than 8 landmark pairs. Exclusion is not capped: a poor match is
 evidence against the same person whatever the material.
 
+**Outside the calibration.** A decision one of whose features lies beyond the range its
+calibration model was fitted on (``outside_calibration``,
+:meth:`lilium.identification.calibration.Calibration.outside`) gets no support: its LR is an
+extrapolation. It is a cap of its own, named first with the feature, its value and the range,
+and it takes the highest level straight to "undetermined"; exclusion stays possible (the LR
+is still given).
+
 **Consistency.** A consistency failure (skull pixels outside the head mask: an implausible
 SFO; the camera disagreeing with the declared view; a camera whose perspective contradicts the
 photo's distance prior, ``perspective_mismatch``) is never support: the conclusion is at
-most "undetermined" and says why. A camera that disagrees with the declared view is no
+most "undetermined" and says why. A camera that disagrees with the declared view, or one far
+outside the photo's priors (``camera_outside_priors``: the head orientation more than three
+tolerances from its prior, the focal length or the distance beyond 1.5 x its interval), is no
 exclusion either (an upside-down or mislabelled photo gave a camera 120 degrees off and
 "moderate support for exclusion"): the conclusion is "undetermined". A failed SFO (no camera)
 is "undetermined".
@@ -53,7 +62,10 @@ UNDETERMINED = 3
 #: Consistency failures that leave no camera to read any LR from: the conclusion is
 #: undetermined in both directions (the others only stop support: a skull that leaves the
 #: head is itself evidence against the person).
-CAMERA_FAILURES = ("view_mismatch",)
+CAMERA_FAILURES = ("view_mismatch", "camera_outside_priors")
+
+#: Caps that allow no support at all (not one step each): the LR is an extrapolation.
+NO_SUPPORT_CAPS = ("outside_calibration",)
 
 #: Fewest landmark pairs that do not cap the support.
 MIN_PAIRS_UNCAPPED = 8
@@ -135,7 +147,7 @@ def conclude(log10_lr, caps=None, inconsistent=None):
     log10_lr : float or None
         None or NaN: no LR (a failed SFO) -> undetermined.
     caps : dict of str -> str, optional
-        :func:`material_caps`.
+        :func:`material_caps`, and those of :data:`NO_SUPPORT_CAPS`.
     inconsistent : dict of str -> str, optional
         ``{warning code: sentence}`` of consistency failures: none is support; one of
         :data:`CAMERA_FAILURES` is no exclusion either.
@@ -150,7 +162,7 @@ def conclude(log10_lr, caps=None, inconsistent=None):
         return Conclusion(label, label, caps, inconsistent)
     raw = level(log10_lr)
     top = len(SCALE) - 1 - len(caps)
-    if inconsistent:
+    if inconsistent or any(code in caps for code in NO_SUPPORT_CAPS):
         top = UNDETERMINED
     capped = min(raw, max(top, UNDETERMINED))
     if any(code in inconsistent for code in CAMERA_FAILURES):

@@ -8,8 +8,9 @@ unweighted (the score before calibration); the calibrated log10 LR is
 
 import numpy as np
 
-from ..evaluation.metrics import outside_face
+from ..evaluation.metrics import outside_depth_px, outside_face
 from ..geometry.camera import Camera
+from ..imaging.raster import mesh_mask
 from ..inputs import correspondences
 from ..methods.lilium_terms import PllTerm, TermOff
 from ..methods.prior_checks import scd_point_mm
@@ -65,6 +66,43 @@ def outside_fraction(skull, photo, camera):
         return None
     counts = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
     return counts.outside_px / counts.skull_px if counts.skull_px else 1.0
+
+
+#: "Skull outside the head" counts the skull's pixels more than this share of the eye-corner
+#: distance (:data:`OUTSIDE_BAND_MIN_PX` at least) outside the head mask
+#: (:func:`skull_beyond_head`): a pixel or two at the mask's edge is raster and mask noise, not
+#: a skull that leaves the head. 1 % is about 0.9 mm at the face, a third of the thinnest soft
+#: tissue at the head's outline. Measured on true pairs of the headsq CT (docs/identification.md,
+#: "Skull outside the head"): Lilium's skulls lie wholly inside the head; POSEST-SFO's failed
+#: lateral cameras put 44-25,000 pixels beyond the band, 2-40 % of the eye-corner distance deep.
+OUTSIDE_BAND_EYE = 0.01
+
+#: The band's floor, pixels: the raster's and the mask edge's own noise.
+OUTSIDE_BAND_MIN_PX = 2.0
+
+
+def skull_beyond_head(skull, photo, camera):
+    """The skull's pixels beyond the head mask's edge band under one camera.
+
+    Returns
+    -------
+    beyond_px : int
+        Skull pixels more than ``band_px`` outside the mask.
+    skull_px : int
+    band_px : float
+        ``max(OUTSIDE_BAND_MIN_PX, OUTSIDE_BAND_EYE * eye-corner distance in pixels)``.
+
+    None when the photo has no mask.
+    """
+    if photo.face_mask is None:
+        return None
+    height, width = np.asarray(photo.face_mask).shape
+    skull_mask = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height))
+    eye_px = eye_corner_px(camera, np.array(list(skull.landmarks_mm.values()), float))
+    band = max(OUTSIDE_BAND_MIN_PX, OUTSIDE_BAND_EYE * eye_px) if np.isfinite(eye_px) else \
+        OUTSIDE_BAND_MIN_PX
+    depth = outside_depth_px(skull_mask, photo.face_mask)
+    return int(np.count_nonzero(depth > band)), int(np.count_nonzero(skull_mask)), float(band)
 
 
 def image_consistency(skull, photo, camera, eye_px):

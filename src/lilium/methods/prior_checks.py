@@ -1,8 +1,10 @@
 """The priors' checks of an SFO result (SPEC section 10): each prior's provenance
 (:func:`priors_record`, the ``"priors"`` of ``result.json``), the warnings about missing priors
-and about a camera outside one (:func:`prior_warnings`), and a camera whose perspective
+and about a camera outside one (:func:`prior_warnings`), a camera whose perspective
 contradicts the distance prior (:func:`perspective_conflict`, which keeps a conclusion from
-support). Pure functions; :func:`lilium.methods.checks.finish_result` attaches them to a result.
+support) and a camera far outside its priors (:func:`prior_conflict`, which keeps it
+undetermined). Pure functions; :func:`lilium.methods.checks.finish_result` attaches them to a
+result.
 """
 
 import numpy as np
@@ -111,6 +113,63 @@ def perspective_conflict(photo, camera, facial_landmarks_mm):
         f"distance prior {fmt_range(*bounds, 'mm')}: the perspective over the face's depth "
         f"differs by {apart:.0%} (more than {PERSPECTIVE_MISMATCH:.0%})"
     )
+
+
+#: A camera whose head orientation deviates from its prior by more than this many tolerances,
+#: or whose focal length or distance lies beyond this factor of its prior's interval
+#: (:data:`FAR_INTERVAL`), is far outside its priors (:func:`prior_conflict`).
+FAR_TOLERANCES = 3.0
+
+#: See :data:`FAR_TOLERANCES`: above ``FAR_INTERVAL * hi`` or below ``lo / FAR_INTERVAL``.
+FAR_INTERVAL = 1.5
+
+
+def prior_conflict(photo, camera, facial_landmarks_mm):
+    """Why a camera lies far outside the photo's priors, or None.
+
+    Far: the head orientation more than :data:`FAR_TOLERANCES` tolerances from its prior, the
+    focal length or the subject-to-camera distance beyond :data:`FAR_INTERVAL` times its
+    interval. Such a camera is not a view of this photo that the priors allow (a wrong skull
+    turned 173 deg from the photo's head orientation once got the largest LR): a consistency
+    failure, like a camera that contradicts the declared view.
+
+    Parameters
+    ----------
+    photo : Photo
+    camera : Camera
+    facial_landmarks_mm : dict or None
+        The estimated facial landmarks (the distance is measured to their nasion or centroid;
+        None: the distance is not checked).
+
+    Returns
+    -------
+    str or None
+        One sentence per prior exceeded, joined by "; ".
+    """
+    p = photo.priors
+    out = []
+    checks = [("focal length", camera.focal_px, p.focal_px, "px", "focal_px")]
+    if facial_landmarks_mm and p.scd_mm is not None:
+        scd = float(np.ravel(camera.distance_mm(scd_point_mm(facial_landmarks_mm)))[0])
+        checks.append(("subject-to-camera distance", scd, p.scd_mm, "mm", "scd_mm"))
+    for label, value, bounds, unit, key in checks:
+        if bounds is None:
+            continue
+        if not bounds[0] / FAR_INTERVAL <= value <= bounds[1] * FAR_INTERVAL:
+            out.append(
+                f"the {label} found, {_apart(value, bounds)} {unit}, lies beyond "
+                f"{FAR_INTERVAL:g} x its prior {fmt_range(*bounds, unit)} "
+                f"({_source(photo, key, bounds)})"
+            )
+    if p.uses_head:
+        dev = float(head_deviation_deg(camera.R[None], p.head_rotation_skull2cam)[0])
+        if dev > FAR_TOLERANCES * p.head_tolerance_deg:
+            out.append(
+                f"the head orientation found deviates {dev:.1f} deg from its prior, more than "
+                f"{FAR_TOLERANCES:g} x its tolerance of {p.head_tolerance_deg:g} deg "
+                f"({_source(photo, 'head_rotation', True)})"
+            )
+    return "; ".join(out) or None
 
 
 def _apart(value, bounds):

@@ -8,7 +8,7 @@ section as the paper's score.
 
 from html import escape
 
-from ..identification.conclusion import SCALE
+from ..identification.conclusion import NO_SUPPORT_CAPS, SCALE
 
 #: CSS class of a conclusion by its side of the scale.
 _SIDE = {label: ("support" if k > 3 else "exclusion" if k < 3 else "undetermined")
@@ -23,12 +23,14 @@ def _lr_text(record):
 
 
 def _why(record):
+    caps = dict(record.get("caps") or {})
+    # Outside the calibration first: the LR beside it is an extrapolation.
+    first = {k: caps.pop(k) for k in NO_SUPPORT_CAPS if k in caps}
     parts = [
         f"<b>{escape(code)}</b>: {escape(text)}"
-        for code, text in (record.get("inconsistent") or {}).items()
+        for code, text in (first | (record.get("inconsistent") or {})).items()
     ]
-    caps = (record.get("caps") or {}).items()
-    parts += [f"{escape(code)}: {escape(text)}" for code, text in caps]
+    parts += [f"{escape(code)}: {escape(text)}" for code, text in caps.items()]
     if record.get("note"):
         parts.append(f"<i>{escape(record['note'])}</i>")
     worst = record.get("worst_landmark")
@@ -93,7 +95,9 @@ def conclusion_section(decisions):
         "calibrated on generated subjects (docs/method.md, Identification). The conclusion "
         "follows a verbal scale, capped by the material; a skull outside the head, or a camera "
         "whose perspective contradicts the photo's distance prior, is never support, and a "
-        "camera that contradicts the declared view is neither support nor exclusion. The "
+        "camera that contradicts the declared view is neither support nor exclusion. A "
+        "decision whose features lie outside the range its calibration was fitted on "
+        "(<b>outside_calibration</b>) gets no support: its LR would be an extrapolation. The "
         "fitness in each SFO's "
         "section is the paper's alignment score, not an identification.</p>\n"
         f"<table class='conclusions'><thead>{head}</thead><tbody>{''.join(rows)}</tbody></table>\n"
