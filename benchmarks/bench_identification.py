@@ -54,10 +54,12 @@ from lilium.experiments.identification import (
     ranking_score,
 )
 from lilium.experiments.lr_report import calibrate_databases
+from lilium.experiments.lr_validation import roc_auc
 from lilium.experiments.report import load_rows
 from lilium.experiments.runner import run_experiment
 from lilium.experiments.store import COLUMNS, ResultStore
 from lilium.geometry.camera import Camera
+from lilium.identification.terms import COHORT_CALIBRATED_TERMS
 from lilium.inputs import correspondences
 from lilium.methods.posest_sfo import mean_depth_landmarks
 from lilium.optimisation.de import DEOptions
@@ -250,6 +252,8 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
     print(file=file)
     print_calibration_comparison(decision_pairs, validated, file)
     print(file=file)
+    print_terms_comparison(decision_pairs, validated, file)
+    print(file=file)
     print_lookalikes(dbs, decision_pairs, validated, file)
     print(file=file)
     print("| ranked by identification log10 LR | view | mean rank | rank-1 | AUC | photos |",
@@ -261,6 +265,27 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
             f"{_f(t['auc'], 3)} | {t['photo_runs']} |",
             file=file,
         )
+
+
+def print_terms_comparison(decision_pairs, validated, file=sys.stdout):
+    """What leaving the cohort terms out of the calibration costs on generated subjects (they
+    do not transfer to real photos, docs/identification.md): every decision's cross-validated
+    AUC, Cllr and misleading evidence with the shipped terms beside the same with the cohort
+    terms and ``landmark_snorm`` (the same folds; ``validated`` holds the first)."""
+    cohort = validate(decision_pairs, names=COHORT_CALIBRATED_TERMS)
+    print("| decision | method | shipped terms: AUC, Cllr, misleading same / different | "
+          "with the cohort terms |", file=file)
+    print("|---|---|---|---|", file=file)
+    for key in sorted(validated):
+        same = [p["same"] for p in decision_pairs[key]]
+        cells = [
+            f"{roc_auc(v['log10_lr'], same):.3f}, {v['performance']['cllr']:.3f}, "
+            f"{100 * v['performance']['misleading_same']:.1f} / "
+            f"{100 * v['performance']['misleading_diff']:.1f} %"
+            for v in (validated[key], cohort[key])
+        ]
+        print(f"| {key[2]} | {method_label(key[0], key[1])} | {cells[0]} | {cells[1]} |",
+              file=file)
 
 
 def print_calibration_comparison(decision_pairs, validated, file=sys.stdout):

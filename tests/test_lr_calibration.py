@@ -208,19 +208,26 @@ def test_shipped_calibration_states_its_error_rates():
 
 
 def test_landmark_snorm_is_derived_from_the_stored_terms():
-    from lilium.identification.terms import CALIBRATED_TERMS, landmark_snorm
+    """Derived from the stored terms, and a feature of a model fitted with the cohort terms
+    (the calibration before 2026-12-06); the shipped terms leave it out with them."""
+    from lilium.identification.terms import (
+        CALIBRATED_TERMS,
+        COHORT_CALIBRATED_TERMS,
+        landmark_snorm,
+    )
 
     terms = {"landmark_chi2": np.e, "cohort_mean": 0.5, "cohort_sd": 0.25, "skull_mean": 2.0,
              "skull_sd": 0.5}
     assert landmark_snorm(terms) == pytest.approx((1 - 0.5) / 0.25 + (1 - 2.0) / 0.5)
     assert landmark_snorm(dict(terms, skull_sd=None)) is None  # older terms: filled by the model
-    assert "landmark_snorm" in CALIBRATED_TERMS
+    assert "landmark_snorm" not in CALIBRATED_TERMS
     rng = np.random.default_rng(5)
     pairs = _synthetic_pairs(rng)
     for p in pairs:
         p["terms"].update(cohort_mean=0.0, cohort_sd=1.0, skull_mean=0.0, skull_sd=1.0)
-    model = fit([p["terms"] for p in pairs], [p["same"] for p in pairs])
-    assert "landmark_snorm" in model.names
+    terms = [p["terms"] for p in pairs]
+    assert "landmark_snorm" in fit(terms, [p["same"] for p in pairs], COHORT_CALIBRATED_TERMS).names
+    assert "landmark_snorm" not in fit(terms, [p["same"] for p in pairs]).names
 
 
 def test_the_ridge_is_a_prior_worth_a_fixed_number_of_same_person_pairs():

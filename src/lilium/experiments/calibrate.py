@@ -365,14 +365,15 @@ def decisions(rows, terms, inputs=None, cohort_cache=None):
     return dict(out)
 
 
-def validate(decision_pairs, folds=5, warped=None):
+def validate(decision_pairs, folds=5, warped=None, names=CALIBRATED_TERMS):
     """Cross-validated log10 LR of every decision and its performance.
 
     ``pair_sum`` decisions add their two photos' cross-validated single-photo log10 LRs
     (``added``, with its ``performance_added`` on the pairs the calibrated sum scores) and
     calibrate the sum, nested (:func:`_nested_views_lr`).
 
-    ``warped``: the decisions whose models are bi-Gaussianized (default :data:`WARPED`).
+    ``warped``: the decisions whose models are bi-Gaussianized (default :data:`WARPED`);
+    ``names``: the terms' models' candidate features.
 
     Returns
     -------
@@ -384,21 +385,21 @@ def validate(decision_pairs, folds=5, warped=None):
     for key, pairs in sorted(decision_pairs.items()):
         if key[2] == "pair_sum":
             continue
-        lr = cross_validated(pairs, folds, warp=key[2] in warped)
+        lr = cross_validated(pairs, folds, names, warp=key[2] in warped)
         out[key] = {"log10_lr": lr, "performance": performance(lr, [p["same"] for p in pairs])}
     for key, pairs in decision_pairs.items():
         if key[2] != "pair_sum":
             continue
         same = [p["same"] for p in pairs]
         added = _pair_sum(pairs, decision_pairs, out, key)
-        lr = _nested_views_lr(pairs, added, decision_pairs, key, folds, warped)
+        lr = _nested_views_lr(pairs, added, decision_pairs, key, folds, warped, names)
         scored = np.where(np.isfinite(lr), added, np.nan)
         out[key] = {"log10_lr": lr, "performance": performance(lr, same),
                     "added": added, "performance_added": performance(scored, same)}
     return out
 
 
-def _nested_views_lr(pairs, added, decision_pairs, key, folds, warped):
+def _nested_views_lr(pairs, added, decision_pairs, key, folds, warped, names):
     """Cross-validated calibrated sums of the ``pair_sum`` ``pairs``: for each subject fold
     ``k``, the views' model is fitted on sums of single-photo LRs that never saw fold ``k``
     (the two views' models cross-validated again within the other folds' pairs) and scores
@@ -411,7 +412,8 @@ def _nested_views_lr(pairs, added, decision_pairs, key, folds, warped):
             view_key = (key[0], key[1], view)
             inner_pairs[view_key] = training(decision_pairs.get(view_key, []))
             inner_lr[view_key] = {
-                "log10_lr": cross_validated(inner_pairs[view_key], folds, warp=view in warped)
+                "log10_lr": cross_validated(inner_pairs[view_key], folds, names,
+                                            warp=view in warped)
             }
         train = training(pairs)
         inner = views_pairs(train, _pair_sum(train, inner_pairs, inner_lr, key))
