@@ -344,32 +344,36 @@ def test_a_case_outside_the_calibrations_range_gets_no_support(case, tmp_path, c
     assert conclusions == {"inside": "moderate support", "outside": "undetermined"}
 
 
-def test_a_camera_far_outside_its_priors_is_no_conclusion():
-    """The head orientation 173 deg from its prior (a wrong skull's SFO on a real head) is a
-    consistency failure: neither support nor exclusion, named; 2.5 tolerances off is not."""
+def test_a_camera_far_outside_its_priors_is_no_support():
+    """The head orientation 173 deg from its prior (a wrong skull's SFO on a real head) reads
+    no LR either way; a focal length beyond 1.5 x its prior's interval is no support;
+    2.5 tolerances or 1.45 x off is neither."""
     from types import SimpleNamespace
 
     from lilium.geometry.rotations import rotvec_to_matrix
     from lilium.inputs import Priors
-    from lilium.methods.prior_checks import prior_conflict
+    from lilium.methods.prior_checks import prior_conflicts
 
-    prior = np.eye(3)
-    priors = Priors(focal_px=(900.0, 1100.0), scd_mm=None, head_rotation_skull2cam=prior,
+    priors = Priors(focal_px=(900.0, 1100.0), scd_mm=None, head_rotation_skull2cam=np.eye(3),
                     head_tolerance_deg=10.0)
     photo = SimpleNamespace(id="p", priors=priors, prior_sources={})
-    for angle_deg, focal, far in ((25.0, 1000.0, False), (173.0, 1000.0, True),
-                                  (0.0, 1600.0, False), (0.0, 1700.0, True),
-                                  (0.0, 590.0, True)):
+    expected = {(25.0, 1000.0): set(), (173.0, 1000.0): {"head_outside_prior"},
+                (0.0, 1595.0): set(), (0.0, 1700.0): {"camera_outside_priors"},
+                (0.0, 590.0): {"camera_outside_priors"},
+                (40.0, 1700.0): {"camera_outside_priors", "head_outside_prior"}}
+    found = {}
+    for (angle_deg, focal), codes in expected.items():
         R = rotvec_to_matrix(np.radians([0.0, angle_deg, 0.0]))
         camera = Camera.from_rt(R, np.array([0.0, 0.0, 1000.0]), focal, np.array([500.0, 500.0]))
-        found = prior_conflict(photo, camera, None)
-        assert (found is not None) == far, (angle_deg, focal, found)
-    assert "173.0 deg" in prior_conflict(photo, Camera.from_rt(
-        rotvec_to_matrix(np.radians([0.0, 173.0, 0.0])), np.array([0.0, 0.0, 1000.0]), 1000.0,
-        np.array([500.0, 500.0])), None)
-    failed = conclude(-2.5, {}, {"camera_outside_priors": "173 deg"})
-    assert failed.label == conclude(2.5, {}, {"camera_outside_priors": "173 deg"}).label \
-        == "undetermined"
+        found[(angle_deg, focal)] = prior_conflicts(photo, camera, None)
+        assert set(found[(angle_deg, focal)]) == codes, (angle_deg, focal)
+    assert "173.0 deg" in found[(173.0, 1000.0)]["head_outside_prior"]
+    assert "1700 px" in found[(0.0, 1700.0)]["camera_outside_priors"]
+    head = {"head_outside_prior": "173 deg"}
+    assert conclude(-2.5, {}, head).label == conclude(2.5, {}, head).label == "undetermined"
+    focal = {"camera_outside_priors": "1700 px"}
+    assert conclude(2.5, {}, focal).label == "undetermined"
+    assert conclude(-2.5, {}, focal).label == "strong support for exclusion"
 
 
 def test_skull_outside_the_head_is_decided_beyond_the_edge_noise(case):

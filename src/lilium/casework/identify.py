@@ -29,7 +29,7 @@ from ..identification.score import (
 )
 from ..inputs import correspondences
 from ..io.calibration import read_calibration, shipped_cohort, shipped_path
-from ..methods.prior_checks import perspective_conflict, prior_conflict
+from ..methods.prior_checks import perspective_conflict, prior_conflicts
 
 #: Cranial landmarks on the mandible: a skull with none of them has no mandible.
 MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")
@@ -104,19 +104,18 @@ def _inconsistent(skull, photos, results, facial_landmarks_mm):
     outside = skull_outside_head(skull, photos, results)
     if outside:
         out["skull_outside_head"] = outside
-    conflicts, far = [], []
+    conflicts, far = [], {}
     for photo, result in zip(photos, results, strict=True):
         for w in result.warnings:
             if w.code == "view_mismatch":
                 out["view_mismatch"] = w.message
         facial = result.facial_landmarks_mm or facial_landmarks_mm
         conflicts.append(perspective_conflict(photo, result.camera, facial))
-        far_off = prior_conflict(photo, result.camera, facial)
-        far.append(None if far_off is None else f"{photo.id}: {far_off}")
+        for code, sentence in prior_conflicts(photo, result.camera, facial).items():
+            far.setdefault(code, []).append(f"{photo.id}: {sentence}")
     if any(conflicts):
         out["perspective_mismatch"] = "; ".join(c for c in conflicts if c)
-    if any(far):
-        out["camera_outside_priors"] = "; ".join(c for c in far if c)
+    out.update({code: "; ".join(sentences) for code, sentences in far.items()})
     return out
 
 

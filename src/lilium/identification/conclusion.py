@@ -32,10 +32,10 @@ is still given).
 
 **Consistency.** A consistency failure (skull pixels outside the head mask: an implausible
 SFO; the camera disagreeing with the declared view; a camera whose perspective contradicts the
-photo's distance prior, ``perspective_mismatch``) is never support: the conclusion is at
-most "undetermined" and says why. A camera that disagrees with the declared view, or one far
-outside the photo's priors (``camera_outside_priors``: the head orientation more than three
-tolerances from its prior, the focal length or the distance beyond 1.5 x its interval), is no
+photo's distance prior, ``perspective_mismatch``; a focal length or distance beyond 1.5 x its
+prior's interval, ``camera_outside_priors``) is never support: the conclusion is at most
+"undetermined" and says why. A camera that disagrees with the declared view, or whose head
+orientation lies more than three tolerances from its prior (``head_outside_prior``), is no
 exclusion either (an upside-down or mislabelled photo gave a camera 120 degrees off and
 "moderate support for exclusion"): the conclusion is "undetermined". A failed SFO (no camera)
 is "undetermined".
@@ -62,7 +62,7 @@ UNDETERMINED = 3
 #: Consistency failures that leave no camera to read any LR from: the conclusion is
 #: undetermined in both directions (the others only stop support: a skull that leaves the
 #: head is itself evidence against the person).
-CAMERA_FAILURES = ("view_mismatch", "camera_outside_priors")
+CAMERA_FAILURES = ("view_mismatch", "head_outside_prior")
 
 #: Caps that allow no support at all (not one step each): the LR is an extrapolation.
 NO_SUPPORT_CAPS = ("outside_calibration",)
