@@ -104,15 +104,31 @@ def build_headsq_dataset(
         ``out_dir``; None when the CT is absent (nothing written).
     """
     from lilium.io.jsonio import write_json
-    from lilium.synthetic import noise, photos
-    from lilium.synthetic.photos import CameraRanges
 
     if data_dir(data) is None:
         return None
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     subjects, photo_entries = _write_subjects(out, n_photos, seed, experiments, variants, data)
-    index = {
+    index = dataset_index(seed, n_photos, experiments, subjects, photo_entries)
+    index["headsq"] = _index_note(variants)
+    if "hq_nm" in variants:
+        index["incomplete"] = {
+            "no_mandible_share": sum(not VARIANTS[v] for v in variants) / len(variants),
+            "subjects_without_mandible": [v for v in variants if not VARIANTS[v]],
+            "drop_landmark_rate": 0.0,
+        }
+    write_json(out / "dataset.json", index)
+    return out
+
+
+def dataset_index(seed, n_photos, experiments, subjects, photo_entries):
+    """The fields of a generated ``dataset.json`` for these subject and photo entries (the
+    generator's format; a real-anatomy case adds its own note)."""
+    from lilium.synthetic import noise, photos
+    from lilium.synthetic.photos import CameraRanges
+
+    return {
         "format": "lilium-synthetic-dataset",
         "version": 1,
         "seed": seed,
@@ -134,16 +150,7 @@ def build_headsq_dataset(
         },
         "subjects": subjects,
         "photos": photo_entries,
-        "headsq": _index_note(variants),
     }
-    if "hq_nm" in variants:
-        index["incomplete"] = {
-            "no_mandible_share": sum(not VARIANTS[v] for v in variants) / len(variants),
-            "subjects_without_mandible": [v for v in variants if not VARIANTS[v]],
-            "drop_landmark_rate": 0.0,
-        }
-    write_json(out / "dataset.json", index)
-    return out
 
 
 def _index_note(variants):
