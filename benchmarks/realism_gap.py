@@ -30,6 +30,7 @@ import numpy as np
 
 from lilium.geometry.camera import Camera
 from lilium.identification.cohort import (
+    centred_cohort_terms,
     cohort_terms,
     cohort_views,
     refit_views,
@@ -87,12 +88,16 @@ def measure(root, cohort, experiment="C"):
         c_mean, c_sd = cohort_terms(views, cohort)
         s_mean, s_sd = skull_cohort_terms(views, cohort)
         refit = refit_views(views)
+        n_mean, n_sd = centred_cohort_terms(views, cohort)
+        chi2 = landmark_chi2(views)[0]
         rows.append({
             "photo": photo_id,
             "view": view,
             "terms": {
                 "cohort_mean": c_mean, "cohort_sd": c_sd, "skull_mean": s_mean,
-                "skull_sd": s_sd, "landmark_chi2": landmark_chi2(views)[0],
+                "skull_sd": s_sd, "centred_mean": n_mean, "centred_sd": n_sd,
+                "centred_z": (np.log(chi2) - n_mean) / n_sd if n_mean is not None else None,
+                "landmark_chi2": chi2,
                 "landmark_refit": landmark_chi2(refit)[0],
             },
             "cohort_misfit": {n: float(np.median(v)) for n, v in per_member.items()},

@@ -238,3 +238,37 @@ def test_older_terms_are_completed_with_the_late_terms_only(case):
     assert done["pll_face"] == 123.0
     for name in LATE_TERMS:
         assert done[name] == pytest.approx(full[name], rel=1e-9)
+
+
+def test_the_centred_cohort_reads_a_skull_outside_the_population_as_one_inside():
+    """People who differ from a common shape by 2 mm per landmark; a candidate from among them,
+    and one whose ten first landmarks all sit 15 mm further out (a head unlike every cohort
+    skull, as a real head is unlike the generated ones), each with a noise-free photo of its
+    own face: the photo cohort's mean moves far (every cohort skull fits that photo badly), the
+    centred cohort's (the cohort's differences put on the candidate) stays near the
+    in-population candidate's."""
+    from lilium.identification.cohort import Cohort, centred_cohort_terms, cohort_terms
+
+    base = _view(np.random.default_rng(11), noise=False)
+    names = base.names
+    rng = np.random.default_rng(12)
+    landmarks = [dict(zip(names, base.cranial_mm + rng.normal(0, 2.0, base.cranial_mm.shape),
+                          strict=True)) for _ in range(10)]
+    cohort = Cohort(tuple(landmarks), tuple(dict(zip(names, base.axes, strict=True))
+                                            for _ in range(10)))
+
+    def photo_of(cranial_mm):
+        facial = cranial_mm + base.depth_mean_mm[:, None] * base.axes
+        return replace(base, cranial_mm=cranial_mm, uv_px=base.camera.project(facial))
+
+    inside_mm = base.cranial_mm + rng.normal(0, 2.0, base.cranial_mm.shape)
+    outside_mm = inside_mm.copy()
+    outside_mm[:10, 0] += 15.0 * np.sign(outside_mm[:10, 0] - inside_mm[:, 0].mean())
+    views = {"in": photo_of(inside_mm), "out": photo_of(outside_mm)}
+    photo = {k: cohort_terms([v], cohort)[0] for k, v in views.items()}
+    centred = {k: centred_cohort_terms([v], cohort) for k, v in views.items()}
+    assert photo["out"] - photo["in"] > 1.0
+    assert abs(centred["out"][0] - centred["in"][0]) < 0.3
+    assert centred["in"][1] > 0
+    few = Cohort(cohort.landmarks_mm[:4], cohort.axes[:4])
+    assert centred_cohort_terms([views["in"]], few) == (None, None)

@@ -68,6 +68,9 @@ FEATURES = {
     "landmark_tension": lambda v: np.log1p(np.maximum(v, 0.0)),
     "outside_refit": lambda v: np.log1p(100.0 * np.maximum(v, 0.0)),
     "landmark_worst": lambda v: np.log(np.maximum(v, 1e-6)),
+    "centred_mean": lambda v: v,
+    "centred_sd": lambda v: np.log(np.maximum(v, 1e-6)),
+    "landmark_cnorm": lambda v: v,
     # Not a term: the frontal and the lateral photo's log10 LRs added, the one feature of the
     # model that turns them into one decision's LR (:data:`VIEWS_TERMS`).
     VIEWS_LOG10_LR: lambda v: v,

@@ -294,6 +294,59 @@ def cohort_chi2(views, cohort):
     return np.array([landmark_chi2(v)[0] for v in cohort_views(views, cohort)])
 
 
+def centred_cohort_views(views, cohort):
+    """The cohort's variation around the candidate skull, each member refitted to the photos.
+
+    Member ``k``'s landmarks, moved onto the candidate (rigid fit of the common landmarks),
+    differ from the members' mean by ``D_k``; its stand-in is the candidate's own landmarks
+    plus ``D_k``, with the candidate's soft-tissue axes: another person's differences, on this
+    skull. Each stand-in's camera is refitted to each photo's landmarks (:func:`refit_cameras`,
+    from the candidate's camera). Unlike :func:`cohort_views` nothing here is compared with the
+    generated population's mean shape, only with its spread.
+
+    Parameters
+    ----------
+    views : sequence of View
+    cohort : Cohort
+
+    Returns
+    -------
+    list of list of View
+        Per member that has every landmark the views use, one view per photo.
+    """
+    members, moves = _aligned(views, cohort)
+    if len(members) < MIN_COHORT:
+        return []
+    names = sorted({n for v in views for n in v.names})
+    moved = np.array([[cohort.landmarks_mm[k][n] @ R.T + t for n in names]
+                      for k, (R, t) in zip(members, moves, strict=True)])
+    deltas = dict(zip(names, np.moveaxis(moved - moved.mean(axis=0), 1, 0), strict=True))
+    K = len(members)
+    member_views = [[] for _ in members]
+    for view in views:
+        cam = view.camera
+        cranial = view.cranial_mm[None] + np.stack([deltas[n] for n in view.names], axis=1)
+        axes = np.repeat(view.axes[None], K, axis=0)
+        R, t, f = refit_cameras(
+            np.repeat(cam.R[None], K, axis=0), np.repeat(cam.t[None], K, axis=0),
+            np.full(K, cam.focal_px), cam.principal_point_px, cranial, axes,
+            view.depth_mean_mm, view.depth_sd_mm, view.uv_px, landmark_sigma_px(view),
+        )
+        for j in range(K):
+            member_views[j].append(replace(
+                view, camera=Camera.from_rt(R[j], t[j], f[j], cam.principal_point_px),
+                cranial_mm=cranial[j], axes=axes[j],
+            ))
+    return member_views
+
+
+def centred_cohort_terms(views, cohort):
+    """Mean and SD of ``ln landmark_chi2`` over :func:`centred_cohort_views` (None, None when
+    fewer than :data:`MIN_COHORT` members have the views' landmarks)."""
+    chi2 = np.array([landmark_chi2(v)[0] for v in centred_cohort_views(views, cohort)])
+    return _log_stats(chi2)
+
+
 def cohort_terms(views, cohort):
     """The cohort's fit to the photo(s): mean and SD of ``ln landmark_chi2`` over the cohort
     skulls (None, None when fewer than :data:`MIN_COHORT` have the views' landmarks).

@@ -16,7 +16,7 @@ from ..methods.lilium_terms import PllTerm, TermOff
 from ..methods.prior_checks import scd_point_mm
 from ..softtissue.depths import depth_stats
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from .cohort import cohort_terms, refit_views, skull_cohort_terms
+from .cohort import centred_cohort_terms, cohort_terms, refit_views, skull_cohort_terms
 from .terms import (
     REFERENCE_TERMS,
     TERM_NAMES,
@@ -178,9 +178,10 @@ def identification_terms(
         if key not in cache:
             cache[key] = cohort_terms(views, cohort)
         cohort_mean, cohort_sd = cache[key]
-    skull_mean = skull_sd = None
+    skull_mean = skull_sd = centred_mean = centred_sd = None
     if cohort is not None and np.isfinite(chi2):
         skull_mean, skull_sd = skull_cohort_terms(views, cohort)
+        centred_mean, centred_sd = centred_cohort_terms(views, cohort)
     refit = outside_refit = None
     if np.isfinite(chi2):
         refit, outside_refit = refit_terms(skull, photos, views)
@@ -207,6 +208,8 @@ def identification_terms(
         landmark_refit=refit,
         outside_refit=outside_refit,
         landmark_worst=landmark_worst(views),
+        centred_mean=centred_mean,
+        centred_sd=centred_sd,
     )
     assert tuple(out) == TERM_NAMES
     out["nll"] = nll
@@ -216,7 +219,8 @@ def identification_terms(
 
 #: The terms added last, in the order they came: stored terms lacking only these are
 #: completed (:func:`with_late_terms`), not computed again.
-LATE_TERMS = ("skull_mean", "skull_sd", "landmark_refit", "outside_refit", "landmark_worst")
+LATE_TERMS = ("skull_mean", "skull_sd", "landmark_refit", "outside_refit", "landmark_worst",
+              "centred_mean", "centred_sd")
 
 
 def with_late_terms(terms, skull, photos, cameras, depth_table=None, cohort=None):
@@ -224,8 +228,9 @@ def with_late_terms(terms, skull, photos, cameras, depth_table=None, cohort=None
     computed (``skull_mean`` and ``skull_sd`` by
     :func:`lilium.identification.cohort.skull_cohort_terms`, ``landmark_refit`` and
     ``outside_refit`` by :func:`refit_terms`, ``landmark_worst`` by
-    :func:`lilium.identification.terms.landmark_worst`), every other term kept as stored
-    (arguments as in :func:`identification_terms`)."""
+    :func:`lilium.identification.terms.landmark_worst`, ``centred_mean`` and ``centred_sd``
+    by :func:`lilium.identification.cohort.centred_cohort_terms`), every other term kept as
+    stored (arguments as in :func:`identification_terms`)."""
     out = dict(terms)
     missing = [n for n in LATE_TERMS if n not in terms]
     if not missing:
@@ -241,6 +246,8 @@ def with_late_terms(terms, skull, photos, cameras, depth_table=None, cohort=None
         out["landmark_refit"], out["outside_refit"] = refit_terms(skull, photos, views)
     if "landmark_worst" in missing:
         out["landmark_worst"] = landmark_worst(views)
+    if cohort is not None and {"centred_mean", "centred_sd"} & set(missing):
+        out["centred_mean"], out["centred_sd"] = centred_cohort_terms(views, cohort)
     return out
 
 

@@ -50,6 +50,13 @@ The terms (all "lower is better", dimensionless):
 - ``landmark_worst``: the largest landmark's ``r_i^T S_i^{-1} r_i`` per coordinate
   (:func:`landmark_worst`): whether the misfit that ``landmark_chi2`` averages is spread over
   the landmarks (noise) or sits in one (a skull that differs there).
+- ``centred_mean``, ``centred_sd``: the mean and SD of ``ln landmark_chi2`` of the cohort's
+  variation put on the candidate skull (each cohort member's difference from the cohort's mean
+  shape added to the candidate's landmarks, its camera refitted:
+  :func:`lilium.identification.cohort.centred_cohort_terms`): how much another person's
+  differences cost this skull's fit to this photo. Unlike the cohort terms they do not compare
+  the photo with the generated population's mean face, so they read a real photo as they read
+  a generated one (docs/identification.md, "The realism gap").
 
 A term whose input is missing (no mask, no curve, no prior) is None; the calibration
 (:mod:`lilium.identification.calibration`) reads a None as the term's typical value and says so.
@@ -92,6 +99,8 @@ TERM_NAMES = (
     "landmark_refit",
     "outside_refit",
     "landmark_worst",
+    "centred_mean",
+    "centred_sd",
 )
 
 #: The cohort terms: the photo(s) against other people's skulls, the skull against other
@@ -102,7 +111,8 @@ COHORT_TERMS = ("cohort_mean", "cohort_sd", "skull_mean", "skull_sd")
 #: The terms that say how to read ``landmark_chi2`` and are not evidence apart from it: the
 #: cohort terms, the landmarks' own best fit and the worst landmark (a second reading of the
 #: same residuals); left out of the unweighted score.
-REFERENCE_TERMS = (*COHORT_TERMS, "landmark_refit", "landmark_worst")
+REFERENCE_TERMS = (*COHORT_TERMS, "landmark_refit", "landmark_worst", "centred_mean",
+                   "centred_sd")
 
 #: The terms the calibration uses. ``soft_tissue_z2`` is reported but left out: measured on 20
 #: generated subjects (docs/method.md, Identification) it lowered Lilium's frontal per-photo
@@ -123,12 +133,15 @@ CALIBRATED_TERMS = (
     "landmark_tension",
     "outside_refit",
     "landmark_worst",
+    "centred_mean",
+    "centred_sd",
+    "landmark_cnorm",
 )
 
 #: The terms calibrated before 2026-12-06, with the cohort's (for the comparison of
 #: ``benchmarks/bench_identification.py``).
 COHORT_CALIBRATED_TERMS = (
-    *CALIBRATED_TERMS[:4], *COHORT_TERMS, "landmark_snorm", *CALIBRATED_TERMS[4:]
+    *CALIBRATED_TERMS[:4], *COHORT_TERMS, "landmark_snorm", *CALIBRATED_TERMS[4:7]
 )
 
 
@@ -143,6 +156,17 @@ def landmark_snorm(terms):
     chi2, c_mean, c_sd, s_mean, s_sd = parts
     log_chi2 = np.log(max(chi2, 1e-6))
     return float((log_chi2 - c_mean) / c_sd + (log_chi2 - s_mean) / s_sd)
+
+
+def landmark_cnorm(terms):
+    """The landmark term in the units of the cohort's variation on the candidate skull:
+    ``(ln chi2 - centred_mean) / centred_sd``; None when a part is missing. Derived from stored
+    terms (:data:`DERIVED_TERMS`)."""
+    parts = [terms.get(n) for n in ("landmark_chi2", "centred_mean", "centred_sd")]
+    if any(v is None or not np.isfinite(v) for v in parts) or parts[2] <= 0:
+        return None
+    chi2, mean, sd = parts
+    return float((np.log(max(chi2, 1e-6)) - mean) / sd)
 
 
 def landmark_tension(terms):
@@ -162,7 +186,8 @@ def landmark_tension(terms):
 
 #: Calibration features computed from the terms rather than stored with them:
 #: ``{name: function(terms dict) -> float or None}``.
-DERIVED_TERMS = {"landmark_snorm": landmark_snorm, "landmark_tension": landmark_tension}
+DERIVED_TERMS = {"landmark_snorm": landmark_snorm, "landmark_tension": landmark_tension,
+                 "landmark_cnorm": landmark_cnorm}
 
 
 @dataclass(frozen=True)
@@ -293,8 +318,9 @@ def landmark_blocks(views):
         Per landmark name: ``r^T S^-1 r``, ``log det(2 pi S)`` and the length of ``r`` (2 per
         photo it is seen in).
 
-    None when a landmark lies behind a camera, or the face's centroid does (a degenerate
-    camera, such as a cohort member's diverged refit: no face size, no 2D error).
+    None when a landmark lies behind a camera, or the face's centroid does, or a covariance
+    is not finite or singular (a degenerate camera, such as a cohort member's diverged refit:
+    no face size, no 2D error).
     """
     by_name = {}
     for view in views:
@@ -313,7 +339,12 @@ def landmark_blocks(views):
         J = np.concatenate([e[1] for e in entries])
         noise = np.repeat([e[2] ** 2 for e in entries], 2)
         S = J @ entries[0][3] @ J.T + np.diag(noise)
-        quad.append(float(r @ np.linalg.solve(S, r)))
+        if not np.all(np.isfinite(S)):
+            return None
+        try:
+            quad.append(float(r @ np.linalg.solve(S, r)))
+        except np.linalg.LinAlgError:  # a diverged refit's camera: no usable covariance
+            return None
         logdet.append(float(np.linalg.slogdet(2 * np.pi * S)[1]))
         coords.append(len(r))
     return list(by_name), np.array(quad), np.array(logdet), np.array(coords)
