@@ -414,3 +414,50 @@ def test_skull_outside_the_head_is_decided_beyond_the_edge_noise(case):
     assert found["grown"] == found["one pixel in"] == 0 < found["cut at the brow"]
     ring = outside_fraction(skull, replace(photo, face_mask=masks["one pixel in"]), camera)
     assert ring > 0
+
+
+def test_a_frontal_and_lateral_decision_is_outside_when_a_photo_is(case, tmp_path):
+    """The frontal + lateral decision inherits a photo's ``outside_calibration`` (naming the
+    photo), and is outside by itself when the sum of its photos' LRs lies beyond the views
+    model's range; inside every range it is not capped so."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from lilium.casework.identify import Calibrations, identify
+    from lilium.identification.calibration import VIEWS_LOG10_LR, Calibration
+    from lilium.io.case import read_photo, read_skull
+
+    subject_dir, photo_dir = case
+    assert main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
+                 "--photo", str(photo_dir), "--out", str(tmp_path / "out")]) == 0
+    data = json.loads((tmp_path / "out" / "result.json").read_text())
+    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[],
+                             camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
+    skull, frontal = read_skull(subject_dir), read_photo(photo_dir)
+    lateral = replace(frontal, id="side", view="lateral_left")
+    wide = {"landmark_chi2": (-50.0, 50.0)}
+
+    def views(lo, hi):
+        one = {VIEWS_LOG10_LR: 0.0}
+        return Calibration((VIEWS_LOG10_LR,), one, {VIEWS_LOG10_LR: 1.0}, one,
+                           {VIEWS_LOG10_LR: 1.0}, 0.0, 1, 1000,
+                           ranges={VIEWS_LOG10_LR: (lo, hi)})
+
+    calibrations = Calibrations()
+    for ranges_lateral, views_range, expected in (
+        (wide, (-10.0, 10.0), None),
+        ({"landmark_chi2": (-50.0, -40.0)}, (-10.0, 10.0), "side: feature landmark_chi2"),
+        (wide, (-10.0, -9.0), "feature views_log10_lr"),
+    ):
+        calibrations.models = {
+            "posest-sfo//frontal": _one_term_model(wide),
+            "posest-sfo//lateral": _one_term_model(ranges_lateral),
+            "posest-sfo//pair_sum": views(*views_range),
+        }
+        record = identify(skull, [frontal, lateral], [result, result], calibrations)
+        if expected is None:
+            assert "outside_calibration" not in record["caps"]
+        else:
+            assert list(record["caps"])[0] == "outside_calibration"
+            assert record["caps"]["outside_calibration"].startswith(expected)
+            assert record["conclusion"] == "undetermined"
