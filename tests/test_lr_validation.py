@@ -32,7 +32,7 @@ def _pairs(rng, n_subjects=15, shift=2.0, view="frontal"):
 def test_the_range_is_each_class_bulk_and_round_trips():
     """The range of a feature runs from the lower of the two classes' 0.5 % quantiles to the
     higher of their 99.5 % ones; a value beyond it is named, a missing term never is, and the
-    range survives the file."""
+    range survives the file; the LR does not extrapolate beyond it."""
     rng = np.random.default_rng(0)
     pairs = _pairs(rng)
     model = fit([p["terms"] for p in pairs], [p["same"] for p in pairs])
@@ -45,6 +45,11 @@ def test_the_range_is_each_class_bulk_and_round_trips():
     name, value, bounds = model.outside({"landmark_chi2": np.exp(hi + 1.0)})[0]
     assert name == "landmark_chi2" and value == pytest.approx(hi + 1.0) and bounds == (lo, hi)
     assert model.outside({"landmark_chi2": None, "landmark_worst": None}) == []
+    # No extrapolation: beyond its range a feature reads as the range's edge.
+    worst = float(np.exp(model.ranges["landmark_worst"][0]) * 2.0)
+    edge, beyond = model.log10_lr([{"landmark_chi2": np.exp(v), "landmark_worst": worst}
+                                   for v in (lo, lo - 3.0)])
+    assert beyond == pytest.approx(edge)
     assert model.outside({"landmark_chi2": np.inf})[0][0] == "landmark_chi2"
     again = Calibration.from_dict(json.loads(json.dumps(model.to_dict())))
     assert again.ranges == model.ranges

@@ -27,7 +27,10 @@ it saw (:attr:`Calibration.ranges`: per class, same- and different-person pairs 
 to the highest of the two upper ones, so the best-fitting true pairs, a few per cent of all
 pairs, are inside it). :meth:`Calibration.outside` names the features of a decision that lie
 beyond it: the logistic regression would extrapolate there, and the decision does not get
-support (:mod:`lilium.identification.conclusion`, ``outside_calibration``). Real photos once
+support (:mod:`lilium.identification.conclusion`, ``outside_calibration``); its LR is computed
+with each such feature at the edge of its range, not extrapolated (a real skull that fitted its
+photo's landmarks better than any generated true pair did was otherwise read at the largest
+LR). Real photos once
 sat 3-8 SD outside the generated range on two photo-level terms, and every real skull, the
 wrong one included, got the largest LR.
 
@@ -178,12 +181,15 @@ class Calibration:
         return -float(np.log10(max(self.n_same, 1))), float(np.log10(max(self.n_diff, 1)))
 
     def log10_lr(self, terms_list):
-        """log10 LR ``(P,)`` of term dictionaries; NaN for a None entry (a failed SFO)."""
+        """log10 LR ``(P,)`` of term dictionaries; NaN for a None entry (a failed SFO). A
+        feature beyond :attr:`ranges` counts as the range's edge."""
         keep = [i for i, t in enumerate(terms_list) if t is not None]
         out = np.full(len(terms_list), np.nan)
         if not keep:
             return out
         X = features([terms_list[i] for i in keep], self.names, self.fill)
+        if self.ranges:  # no extrapolation: a feature beyond its range reads as its edge
+            X = np.clip(X, *np.array([self.ranges[n] for n in self.names]).T)
         z = (X - [self.centre[n] for n in self.names]) / [self.scale[n] for n in self.names]
         logit = z @ [self.weights[n] for n in self.names] + self.intercept
         ln_lr = logit - np.log(self.n_same / self.n_diff)
