@@ -5,7 +5,10 @@ and without ``hq_nm``; ``benchmarks/cranium_case.py``: InVesalius' Cranium ``cr`
 mandible), each photographed by the generator's cameras from its own skin (Exp. C: landmarks
 with noise, perturbed soft-tissue axes). Every photo pair (one frontal, one lateral) of a head
 runs through :func:`lilium.casework.case.run_case` against its own skull and against the other
-heads' skulls, with POSEST-SFO and Lilium at the full budget; each decision (single photo,
+heads' skulls, with POSEST-SFO and Lilium at the full budget and the skull's first set of
+Exp. C soft-tissue axes (``axes_C1.json``: the true directions turned by up to 30 degrees, as
+the calibration's SFOs had them; with the true axes a real skull fits its photo better than
+any calibration pair and is read as outside the calibration); each decision (single photo,
 frontal + lateral) is one row: same person or not, log10 LR, conclusion, caps and consistency
 failures. :func:`summary` gives the figures of the validation (:mod:`bench_validation`): own
 skull log10 LR > 0, at a bound, different person with support, ``outside_calibration``.
@@ -111,7 +114,7 @@ def run_pairs(datasets, out, n_photos, log=print):
             for sid, (skull_head, skull_dir) in skulls.items():
                 case_dir = Path(out) / "cases" / f"{main_subject}{k:02d}-{sid}"
                 entries = run_case(skull_dir, [frontal, lateral], case_dir, methods=METHODS,
-                                   log=lambda line: None)
+                                   axes=skull_dir / "axes_C1.json", log=lambda line: None)
                 for method in METHODS:
                     items = [e for e in entries if e.result.method == method]
                     pair = identify(items[0].skull, [e.photo for e in items],
