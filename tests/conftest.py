@@ -15,3 +15,20 @@ def _bugs_raise(monkeypatch):
 def case(tmp_path):
     """A stand-in subject folder and a frontal photo folder with known camera."""
     return make_standin_case(tmp_path / "case", seed=0)
+
+
+@pytest.fixture
+def calibration_without_ranges(tmp_path):
+    """The shipped calibration without its features' ranges: the stand-in case (a noise-free
+    ellipsoid "skull") fits its photo far better than any generated person, so the shipped
+    models read it as outside the calibration; tests of the other rules use this file."""
+    import json
+
+    from lilium.io.calibration import shipped_path
+
+    data = json.loads(shipped_path().read_text())
+    for model in data["models"].values():
+        model.pop("ranges", None)
+    path = tmp_path / "calibration-without-ranges.json"
+    path.write_text(json.dumps(data))
+    return path

@@ -239,10 +239,13 @@ def test_a_camera_just_outside_a_prior_reads_apart_from_its_bound():
     assert _apart(3000.0, (3555.2, 3929.0)) == "3000"
 
 
-def test_a_camera_whose_perspective_contradicts_its_prior_is_never_support(case, tmp_path, capsys):
+def test_a_camera_whose_perspective_contradicts_its_prior_is_never_support(
+    case, tmp_path, capsys, calibration_without_ranges
+):
     """POSEST-SFO (no priors in its fit) on the stand-in (about 900 mm away) with a distance
     prior of a quarter and of twice that: the first contradicts the camera's perspective (no
-    support), the second does not (focal length and distance trade; the same picture)."""
+    support); the second does not (focal length and distance trade; the same picture), but
+    lies beyond 1.5 x the prior, which is no support either, for that reason alone."""
     import json
 
     from cli_helpers import _run
@@ -260,7 +263,8 @@ def test_a_camera_whose_perspective_contradicts_its_prior_is_never_support(case,
         (folder / "photo.json").write_text(json.dumps(edited))
         out = tmp_path / f"out-{name}"
         argv = ["sfo", "--method", "posest-sfo", "--skull", subject_dir, "--photo", folder]
-        code, _, err = _run(argv + ["--out", out, "--no-overlay"], capsys)
+        code, _, err = _run(argv + ["--out", out, "--no-overlay", "--calibration",
+                                    calibration_without_ranges], capsys)
         assert code == 0, err
         runs[name] = json.loads((out / "result.json").read_text())["identification"]
     assert runs["kept"]["conclusion"].endswith("support") and not runs["kept"]["inconsistent"]
@@ -268,4 +272,6 @@ def test_a_camera_whose_perspective_contradicts_its_prior_is_never_support(case,
     assert near["log10_lr"] == pytest.approx(runs["kept"]["log10_lr"])  # the same camera
     assert near["conclusion"] == "undetermined"
     assert "the perspective over the face's depth" in near["inconsistent"]["perspective_mismatch"]
-    assert far["conclusion"] == runs["kept"]["conclusion"] and not far["inconsistent"]
+    assert far["log10_lr"] == pytest.approx(runs["kept"]["log10_lr"])
+    assert far["conclusion"] == "undetermined" and set(far["inconsistent"]) == {
+        "camera_outside_priors"}

@@ -214,14 +214,11 @@ def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joi
         lrs = [part["log10_lr"] for part in parts]
         views_key = f"{method}/{variant or ''}/pair_sum"
         lr, note = _views_lr(lrs, [p.id for p in photos], calibrations, views_key, record)
-        # Outside the calibration when a photo's features are, or their LRs' sum is.
+        # Outside the calibration when a photo's features are (the sum of two LRs is not
+        # range-checked: lilium.identification.calibration.fit, keep_ranges).
         outside = [f"{p.id}: {part['caps']['outside_calibration']}"
                    for p, part in zip(photos, parts, strict=True)
                    if "outside_calibration" in part["caps"]]
-        views_model = calibrations.get(views_key)
-        if views_model is not None and lr is not None:
-            added = {VIEWS_LOG10_LR: float(sum(lrs))}
-            outside += outside_calibration(views_model, added, views_key).values()
         if outside:
             caps = {"outside_calibration": "; ".join(outside)} | caps
         note = "; ".join([part["note"] for part in parts if part["note"]] + [note] * bool(note))

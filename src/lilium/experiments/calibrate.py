@@ -501,7 +501,7 @@ def fit_models(decision_pairs, provenance, log=print, validated=None):
         origin["ridge"] = ridge_for(sum(same)) if ridge is None else ridge
         models["/".join(key)] = fit(
             [p["terms"] for p in train], same, names, origin, origin["ridge"],
-            warp=key[2] in WARPED,
+            warp=key[2] in WARPED, keep_ranges=key[2] != "pair_sum",
         )
     return models
 

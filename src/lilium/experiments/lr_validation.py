@@ -49,7 +49,7 @@ def score_decisions(decision_pairs, models):
         ``{(method, variant, decision): {"log10_lr", "same", "outside", "at_bound",
         "database"}}``, arrays ``(P,)``; a frontal + lateral decision (``pair_sum``) adds its
         photos' LRs and calibrates the sum with its views' model, and is outside the
-        calibration when either photo's features or the sum are.
+        calibration when either photo's features are.
     """
     out = {}
     singles = {}
@@ -78,8 +78,8 @@ def score_decisions(decision_pairs, models):
             added.append(f[0] + lat[0])
             outside.append(bool(f[1] or lat[1]))
         terms = [{VIEWS_LOG10_LR: float(a)} if np.isfinite(a) else None for a in added]
-        lr, views_outside = _score(model, terms)
-        out[key] = _entry(pairs, lr, np.array(outside) | views_outside, model.bounds)
+        lr, _ = _score(model, terms)
+        out[key] = _entry(pairs, lr, np.array(outside), model.bounds)
     return out
 
 

@@ -331,7 +331,8 @@ def _read_warp(warp):
     return {"knots": knots.tolist(), "ln_lr": ln_lr.tolist()}
 
 
-def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, warp=False):
+def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, warp=False,
+        keep_ranges=True):
     """Fit a :class:`Calibration` on term dictionaries and their labels.
 
     Parameters
@@ -349,6 +350,11 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, w
     warp : bool
         Warp the logistic regression's LRs by :func:`bigaussian_warp` (fitted on the same
         pairs).
+    keep_ranges : bool
+        Record the features' ranges (:attr:`Calibration.ranges`). The views' model
+        (:data:`VIEWS_TERMS`) keeps none: its one feature is a sum of LRs whose terms their own
+        models range-check, and two photos at their models' bounds add up beyond any sum its
+        out-of-fold training LRs reached.
     """
     same = np.asarray(same, bool)
     if same.all() or not same.any():
@@ -399,7 +405,8 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, w
         int((~same).sum()),
         dict(provenance or {}),
         warped,
-        {n: (float(lo), float(hi)) for n, (lo, hi) in zip(used, ranges, strict=True)},
+        {n: (float(lo), float(hi)) for n, (lo, hi) in zip(used, ranges, strict=True)}
+        if keep_ranges else None,
     )
 
 
