@@ -416,15 +416,11 @@ def test_skull_outside_the_head_is_decided_beyond_the_edge_noise(case):
     assert ring > 0
 
 
-def test_a_frontal_and_lateral_decision_is_outside_when_a_photo_is(case, tmp_path):
-    """The frontal + lateral decision inherits a photo's ``outside_calibration`` (naming the
-    photo); inside every photo's range it is not capped so, whatever the views model (which
-    keeps no range: two photos at their bounds add up beyond its training sums)."""
-    from dataclasses import replace
+def _posest_sfo(case, tmp_path):
+    """``lilium sfo --method posest-sfo`` on the stand-in case: a result with its camera, the
+    skull and the photo."""
     from types import SimpleNamespace
 
-    from lilium.casework.identify import Calibrations, identify
-    from lilium.identification.calibration import VIEWS_LOG10_LR, Calibration
     from lilium.io.case import read_photo, read_skull
 
     subject_dir, photo_dir = case
@@ -433,7 +429,19 @@ def test_a_frontal_and_lateral_decision_is_outside_when_a_photo_is(case, tmp_pat
     data = json.loads((tmp_path / "out" / "result.json").read_text())
     result = SimpleNamespace(method="posest-sfo", variant="", warnings=[],
                              camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
-    skull, frontal = read_skull(subject_dir), read_photo(photo_dir)
+    return result, read_skull(subject_dir), read_photo(photo_dir)
+
+
+def test_a_frontal_and_lateral_decision_is_outside_when_a_photo_is(case, tmp_path):
+    """The frontal + lateral decision inherits a photo's ``outside_calibration`` (naming the
+    photo); inside every photo's range it is not capped so, whatever the views model (which
+    keeps no range: two photos at their bounds add up beyond its training sums)."""
+    from dataclasses import replace
+
+    from lilium.casework.identify import Calibrations, identify
+    from lilium.identification.calibration import VIEWS_LOG10_LR, Calibration
+
+    result, skull, frontal = _posest_sfo(case, tmp_path)
     lateral = replace(frontal, id="side", view="lateral_left")
     wide = {"landmark_chi2": (-50.0, 50.0)}
 
