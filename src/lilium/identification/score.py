@@ -74,7 +74,7 @@ def outside_fraction(skull, photo, camera):
 #: a skull that leaves the head. 1 % is about 0.9 mm at the face, a third of the thinnest soft
 #: tissue at the head's outline. Measured on true pairs of the headsq CT (docs/identification.md,
 #: "Skull outside the head"): Lilium's skulls lie wholly inside the head; POSEST-SFO's failed
-#: lateral cameras put 44-25,000 pixels beyond the band, 2-40 % of the eye-corner distance deep.
+#: lateral cameras put 44-25,000 pixels beyond the band, 2-185 % of the eye-corner distance deep.
 OUTSIDE_BAND_EYE = 0.01
 
 #: The band's floor, pixels: the raster's and the mask edge's own noise.
