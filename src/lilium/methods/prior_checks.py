@@ -116,11 +116,33 @@ def perspective_conflict(photo, camera, facial_landmarks_mm):
 
 #: A camera whose head orientation deviates from its prior by more than this many tolerances,
 #: or whose focal length or distance lies beyond this factor of its prior's interval
-#: (:data:`FAR_INTERVAL`), is far outside its priors (:func:`prior_conflict`).
+#: (:data:`FAR_INTERVAL`), is far outside its priors (:func:`prior_conflicts`).
 FAR_TOLERANCES = 3.0
 
 #: See :data:`FAR_TOLERANCES`: above ``FAR_INTERVAL * hi`` or below ``lo / FAR_INTERVAL``.
 FAR_INTERVAL = 1.5
+
+
+def _measured(photo, camera, facial_landmarks_mm):
+    """``(label, value, prior, unit, key)`` of the camera's focal length and, given the facial
+    landmarks, its subject-to-camera distance, for each of the two the photo has a prior of."""
+    p = photo.priors
+    out = []
+    if p.focal_px is not None:
+        out.append(("focal length", camera.focal_px, p.focal_px, "px", "focal_px"))
+    if facial_landmarks_mm and p.scd_mm is not None:
+        scd = float(np.ravel(camera.distance_mm(scd_point_mm(facial_landmarks_mm)))[0])
+        out.append(("subject-to-camera distance", scd, p.scd_mm, "mm", "scd_mm"))
+    return out
+
+
+def _head_deviation_deg(photo, camera):
+    """The camera's head orientation's deviation (deg) from the photo's prior; None without
+    one."""
+    p = photo.priors
+    if not p.uses_head:
+        return None
+    return float(head_deviation_deg(camera.R[None], p.head_rotation_skull2cam)[0])
 
 
 def prior_conflicts(photo, camera, facial_landmarks_mm):
@@ -151,12 +173,8 @@ def prior_conflicts(photo, camera, facial_landmarks_mm):
     """
     p = photo.priors
     out, far = {}, []
-    checks = [("focal length", camera.focal_px, p.focal_px, "px", "focal_px")]
-    if facial_landmarks_mm and p.scd_mm is not None:
-        scd = float(np.ravel(camera.distance_mm(scd_point_mm(facial_landmarks_mm)))[0])
-        checks.append(("subject-to-camera distance", scd, p.scd_mm, "mm", "scd_mm"))
-    for label, value, bounds, unit, key in checks:
-        if bounds is not None and not bounds[0] / FAR_INTERVAL <= value <= bounds[1] * FAR_INTERVAL:
+    for label, value, bounds, unit, key in _measured(photo, camera, facial_landmarks_mm):
+        if not bounds[0] / FAR_INTERVAL <= value <= bounds[1] * FAR_INTERVAL:
             far.append(
                 f"the {label} found, {_apart(value, bounds)} {unit}, lies beyond "
                 f"{FAR_INTERVAL:g} x its prior {fmt_range(*bounds, unit)} "
@@ -164,14 +182,13 @@ def prior_conflicts(photo, camera, facial_landmarks_mm):
             )
     if far:
         out["camera_outside_priors"] = "; ".join(far)
-    if p.uses_head:
-        dev = float(head_deviation_deg(camera.R[None], p.head_rotation_skull2cam)[0])
-        if dev > FAR_TOLERANCES * p.head_tolerance_deg:
-            out["head_outside_prior"] = (
-                f"the head orientation found deviates {dev:.1f} deg from its prior, more than "
-                f"{FAR_TOLERANCES:g} x its tolerance of {p.head_tolerance_deg:g} deg "
-                f"({_source(photo, 'head_rotation', True)})"
-            )
+    dev = _head_deviation_deg(photo, camera)
+    if dev is not None and dev > FAR_TOLERANCES * p.head_tolerance_deg:
+        out["head_outside_prior"] = (
+            f"the head orientation found deviates {dev:.1f} deg from its prior, more than "
+            f"{FAR_TOLERANCES:g} x its tolerance of {p.head_tolerance_deg:g} deg "
+            f"({_source(photo, 'head_rotation', True)})"
+        )
     return out
 
 
@@ -222,14 +239,8 @@ def prior_warnings(photo, camera=None, facial_landmarks_mm=None):
         )
     if camera is None:
         return out
-    checks = [("focal length", camera.focal_px, p.focal_px, "px", "focal_px")]
-    if facial_landmarks_mm:
-        scd = camera.distance_mm(scd_point_mm(facial_landmarks_mm))
-        checks.append(
-            ("subject-to-camera distance", float(np.ravel(scd)[0]), p.scd_mm, "mm", "scd_mm")
-        )
-    for label, value, bounds, unit, key in checks:
-        if bounds is not None and not bounds[0] <= value <= bounds[1]:
+    for label, value, bounds, unit, key in _measured(photo, camera, facial_landmarks_mm):
+        if not bounds[0] <= value <= bounds[1]:
             out.append(
                 CaseWarning(
                     "outside_prior",
@@ -238,15 +249,14 @@ def prior_warnings(photo, camera=None, facial_landmarks_mm=None):
                     "check the prior and the landmarks",
                 )
             )
-    if p.uses_head:
-        dev = float(head_deviation_deg(camera.R[None], p.head_rotation_skull2cam)[0])
-        if dev > p.head_tolerance_deg:
-            out.append(
-                CaseWarning(
-                    "outside_prior",
-                    f"the head orientation found deviates {dev:.1f} deg from its prior "
-                    f"(tolerance {p.head_tolerance_deg:g} deg, "
-                    f"{_source(photo, 'head_rotation', True)}); check the prior and the landmarks",
-                )
+    dev = _head_deviation_deg(photo, camera)
+    if dev is not None and dev > p.head_tolerance_deg:
+        out.append(
+            CaseWarning(
+                "outside_prior",
+                f"the head orientation found deviates {dev:.1f} deg from its prior "
+                f"(tolerance {p.head_tolerance_deg:g} deg, "
+                f"{_source(photo, 'head_rotation', True)}); check the prior and the landmarks",
             )
+        )
     return out
