@@ -249,6 +249,19 @@ def _log_stats(values):
     return float(values.mean()), float(max(values.std(), 1e-6))
 
 
+def _refitted(view, R0, t0, cranial, axes):
+    """K skulls' views of one photo (``cranial``, ``axes`` ``(K, N, 3)``), each camera
+    refitted to the photo's landmarks by :func:`refit_cameras` from ``R0`` ``(K, 3, 3)``,
+    ``t0`` ``(K, 3)`` and the view's focal length."""
+    cam = view.camera
+    R, t, f = refit_cameras(
+        R0, t0, np.full(len(R0), cam.focal_px), cam.principal_point_px, cranial, axes,
+        view.depth_mean_mm, view.depth_sd_mm, view.uv_px, landmark_sigma_px(view),
+    )
+    return [replace(view, camera=Camera.from_rt(R[j], t[j], f[j], cam.principal_point_px),
+                    cranial_mm=cranial[j], axes=axes[j]) for j in range(len(R0))]
+
+
 def cohort_views(views, cohort):
     """Every cohort skull's views of the photos of ``views``, each camera refitted to the
     photo's landmarks (:func:`refit_cameras`, from the candidate's camera moved onto the cohort
@@ -269,22 +282,14 @@ def cohort_views(views, cohort):
     members, moves = _aligned(views, cohort)
     if not members:
         return []
-    K = len(members)
     member_views = [[] for _ in members]
     for view in views:
         cam = view.camera
         R0 = np.array([cam.R @ Ra for Ra, _ in moves])
         t0 = np.array([cam.R @ ta + cam.t for _, ta in moves])
         cranial, axes = _landmarks(cohort, members, view.names)
-        R, t, f = refit_cameras(
-            R0, t0, np.full(K, cam.focal_px), cam.principal_point_px, cranial, axes,
-            view.depth_mean_mm, view.depth_sd_mm, view.uv_px, landmark_sigma_px(view),
-        )
-        for j in range(K):
-            member_views[j].append(replace(
-                view, camera=Camera.from_rt(R[j], t[j], f[j], cam.principal_point_px),
-                cranial_mm=cranial[j], axes=axes[j],
-            ))
+        for j, refitted in enumerate(_refitted(view, R0, t0, cranial, axes)):
+            member_views[j].append(refitted)
     return member_views
 
 
@@ -327,16 +332,9 @@ def centred_cohort_views(views, cohort):
         cam = view.camera
         cranial = view.cranial_mm[None] + np.stack([deltas[n] for n in view.names], axis=1)
         axes = np.repeat(view.axes[None], K, axis=0)
-        R, t, f = refit_cameras(
-            np.repeat(cam.R[None], K, axis=0), np.repeat(cam.t[None], K, axis=0),
-            np.full(K, cam.focal_px), cam.principal_point_px, cranial, axes,
-            view.depth_mean_mm, view.depth_sd_mm, view.uv_px, landmark_sigma_px(view),
-        )
-        for j in range(K):
-            member_views[j].append(replace(
-                view, camera=Camera.from_rt(R[j], t[j], f[j], cam.principal_point_px),
-                cranial_mm=cranial[j], axes=axes[j],
-            ))
+        R0, t0 = np.repeat(cam.R[None], K, axis=0), np.repeat(cam.t[None], K, axis=0)
+        for j, refitted in enumerate(_refitted(view, R0, t0, cranial, axes)):
+            member_views[j].append(refitted)
     return member_views
 
 
