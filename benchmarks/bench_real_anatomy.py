@@ -15,7 +15,7 @@ skull log10 LR > 0, at a bound, different person with support, ``outside_calibra
 
 It also measures the tolerance of "skull outside the head" on the true pairs: for each SFO of a
 photo with its own skull, the skull's pixels outside the head mask and how far outside
-(:func:`outside_depths`), in pixels and in eye-corner units.
+(:func:`lilium.identification.score.outside_depths`), in pixels and in eye-corner units.
 
 Run::
 
@@ -64,31 +64,6 @@ def photo_pairs(root, subject, n_photos):
     ]
 
 
-def outside_depths(skull, photo, camera):
-    """The skull's pixels outside the head mask under ``camera`` and how far outside each is.
-
-    Returns
-    -------
-    skull_px : int
-    depth_px : ndarray of shape (M,)
-        For each of the M skull pixels outside the mask, its distance (pixels) to the nearest
-        mask pixel.
-    eye_px : float
-        The eye-corner distance in pixels (the face-size unit).
-    """
-    from scipy import ndimage as ndi
-
-    from lilium.identification.terms import eye_corner_px
-    from lilium.imaging.raster import mesh_mask
-
-    mask = np.asarray(photo.face_mask) != 0
-    height, width = mask.shape
-    skull_mask = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height)) != 0
-    depth = ndi.distance_transform_edt(~mask)
-    points = np.array(list(skull.landmarks_mm.values()))
-    return int(skull_mask.sum()), depth[skull_mask & ~mask], eye_corner_px(camera, points)
-
-
 def run_pairs(datasets, out, n_photos, log=print):
     """Every real photo pair against every real skull (module docstring).
 
@@ -99,10 +74,11 @@ def run_pairs(datasets, out, n_photos, log=print):
         ``method``, ``decision`` (``frontal``, ``lateral``, ``frontal + lateral``), ``photo``,
         ``log10_lr``, ``conclusion``, ``caps`` (codes), ``inconsistent`` (codes), ``bound``
         (the LR sits at its model's bound), ``terms``, and for single photos of the true
-        skull ``outside`` (:func:`outside_depths`).
+        skull ``outside`` (:func:`lilium.identification.score.outside_depths`).
     """
     from lilium.casework.case import run_case
     from lilium.casework.identify import Calibrations, identify
+    from lilium.identification.score import outside_depths
 
     calibrations = Calibrations()
     skulls = {sid: (head, datasets[head] / "subjects" / sid)

@@ -81,6 +81,28 @@ OUTSIDE_BAND_EYE = 0.01
 OUTSIDE_BAND_MIN_PX = 2.0
 
 
+def outside_depths(skull, photo, camera):
+    """How far outside the head mask each of the skull's pixels outside it lies, under one
+    camera (None when the photo has no mask).
+
+    Returns
+    -------
+    depth_px : ndarray of shape (M,)
+        Per skull pixel outside the mask, its distance (pixels) to the nearest mask pixel
+        (:func:`lilium.evaluation.metrics.outside_depth_px`).
+    skull_px : int
+    eye_px : float
+        The eye-corner distance in pixels (the face-size unit; NaN for a degenerate camera).
+    """
+    if photo.face_mask is None:
+        return None
+    height, width = np.asarray(photo.face_mask).shape
+    skull_mask = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height))
+    eye_px = eye_corner_px(camera, np.array(list(skull.landmarks_mm.values()), float))
+    return (outside_depth_px(skull_mask, photo.face_mask), int(np.count_nonzero(skull_mask)),
+            float(eye_px))
+
+
 def skull_beyond_head(skull, photo, camera):
     """The skull's pixels beyond the head mask's edge band under one camera.
 
@@ -94,15 +116,13 @@ def skull_beyond_head(skull, photo, camera):
 
     None when the photo has no mask.
     """
-    if photo.face_mask is None:
+    found = outside_depths(skull, photo, camera)
+    if found is None:
         return None
-    height, width = np.asarray(photo.face_mask).shape
-    skull_mask = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height))
-    eye_px = eye_corner_px(camera, np.array(list(skull.landmarks_mm.values()), float))
+    depth, skull_px, eye_px = found
     band = max(OUTSIDE_BAND_MIN_PX, OUTSIDE_BAND_EYE * eye_px) if np.isfinite(eye_px) else \
         OUTSIDE_BAND_MIN_PX
-    depth = outside_depth_px(skull_mask, photo.face_mask)
-    return int(np.count_nonzero(depth > band)), int(np.count_nonzero(skull_mask)), float(band)
+    return int(np.count_nonzero(depth > band)), skull_px, float(band)
 
 
 def image_consistency(skull, photo, camera, eye_px):
