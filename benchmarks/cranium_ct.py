@@ -85,6 +85,7 @@ from pathlib import Path
 import numpy as np
 
 from cranium_landmarks import place_landmarks, sanity_figures
+from headsq_ct import true_soft_tissue
 
 #: The CT beside the repository; ``LILIUM_CRANIUM`` (a file or its folder) overrides it.
 FILE_NAME = "Cranium.inv3"
@@ -277,8 +278,6 @@ def cranium_subject(path=None, work_dir=None):
         craniometric figures of :func:`cranium_landmarks.sanity_figures`.
     """
     from lilium.ct import import_ct
-    from lilium.softtissue.landmarks import CORRESPONDENCES, MIDLINE_CRANIAL
-    from lilium.softtissue.normals import landmark_normals
     from lilium.synthetic.subjects import SyntheticSubject
 
     key = str(data_path(path))
@@ -300,13 +299,7 @@ def cranium_subject(path=None, work_dir=None):
     skull, skin, origin = skull - shift, skin - shift, origin + shift
     cranial = {k: v - shift for k, v in cranial.items()}
     facial = {k: v - shift for k, v in facial.items()}
-    for name in MIDLINE_CRANIAL:
-        if name in cranial:
-            assert abs(cranial[name][0]) < 3.0, name
-    pairs = [(c, f) for c, f in CORRESPONDENCES if c in cranial and f in facial]
-    axes = {c: (facial[f] - cranial[c]) / np.linalg.norm(facial[f] - cranial[c]) for c, f in pairs}
-    depths = {c: float(np.linalg.norm(facial[f] - cranial[c])) for c, f in pairs}
-    normals = landmark_normals(skull, skull_f, cranial)
+    axes, depths, normals = true_soft_tissue(skull, skull_f, cranial, facial)
     subject = SyntheticSubject(
         "cr",
         skull,

@@ -117,6 +117,27 @@ def _import(volume, folder):
 
 
 # -- subjects ---------------------------------------------------------------------------------
+def true_soft_tissue(skull, skull_f, cranial, facial):
+    """A CT subject's true soft tissue from its placed landmarks (skull frame, the midline at
+    x = 0, checked): per correspondence the direction ``F - C`` (unit) and the depth
+    ``|F - C|`` (mm), and the bone normal at every cranial landmark.
+
+    Returns
+    -------
+    axes, depths, normals : dict
+    """
+    from lilium.softtissue.landmarks import CORRESPONDENCES, MIDLINE_CRANIAL
+    from lilium.softtissue.normals import landmark_normals
+
+    for name in MIDLINE_CRANIAL:
+        if name in cranial:
+            assert abs(cranial[name][0]) < 3.0, name
+    pairs = [(c, f) for c, f in CORRESPONDENCES if c in cranial and f in facial]
+    axes = {c: (facial[f] - cranial[c]) / np.linalg.norm(facial[f] - cranial[c]) for c, f in pairs}
+    depths = {c: float(np.linalg.norm(facial[f] - cranial[c])) for c, f in pairs}
+    return axes, depths, landmark_normals(skull, skull_f, cranial)
+
+
 _CACHE = {}
 
 
@@ -128,8 +149,6 @@ def headsq_subjects(path=None, work_dir=None):
     """
     from scipy.spatial import cKDTree
 
-    from lilium.softtissue.landmarks import CORRESPONDENCES, MIDLINE_CRANIAL
-    from lilium.softtissue.normals import landmark_normals
     from lilium.synthetic.subjects import MANDIBLE_LANDMARKS, SyntheticSubject
 
     key = str(data_dir(path))
@@ -155,13 +174,7 @@ def headsq_subjects(path=None, work_dir=None):
     cranial = {k: v - shift for k, v in cranial.items()}
     facial = {k: v - shift for k, v in facial.items()}
     origin = origin + shift
-    for name in MIDLINE_CRANIAL:
-        if name in cranial:
-            assert abs(cranial[name][0]) < 3.0, name
-    pairs = [(c, f) for c, f in CORRESPONDENCES if c in cranial and f in facial]
-    axes = {c: (facial[f] - cranial[c]) / np.linalg.norm(facial[f] - cranial[c]) for c, f in pairs}
-    depths = {c: float(np.linalg.norm(facial[f] - cranial[c])) for c, f in pairs}
-    normals = landmark_normals(skull, skull_f, cranial)
+    axes, depths, normals = true_soft_tissue(skull, skull_f, cranial, facial)
     out = {
         "hq": SyntheticSubject(
             "hq", skull, skull_f, skin, skin_f, cranial, facial, axes, depths, normals
