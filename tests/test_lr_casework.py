@@ -185,14 +185,11 @@ def test_lineup_refuses_a_name_given_twice(case, tmp_path, capsys):
     assert code == 2 and "given twice" in capsys.readouterr().err
 
 
-def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeypatch):
-    """Separate SFOs of one frontal and one lateral photo: the decision's log10 LR is the sum
-    of the two photos' own (each from its view's model) calibrated by the method's
-    ``pair_sum`` model, or the plain sum without one; other sets use the pair model."""
-    from dataclasses import replace
+def _posest_sfo(case, tmp_path):
+    """``lilium sfo --method posest-sfo`` on the stand-in case: a result with its camera, the
+    skull, the photo and the ``result.json`` written."""
     from types import SimpleNamespace
 
-    from lilium.casework.identify import Calibrations, identify
     from lilium.io.case import read_photo, read_skull
 
     subject_dir, photo_dir = case
@@ -201,7 +198,19 @@ def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeyp
     data = json.loads((tmp_path / "out" / "result.json").read_text())
     result = SimpleNamespace(method="posest-sfo", variant="", warnings=[],
                              camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
-    skull, frontal = read_skull(subject_dir), read_photo(photo_dir)
+    return result, read_skull(subject_dir), read_photo(photo_dir), data
+
+
+def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeypatch):
+    """Separate SFOs of one frontal and one lateral photo: the decision's log10 LR is the sum
+    of the two photos' own (each from its view's model) calibrated by the method's
+    ``pair_sum`` model, or the plain sum without one; other sets use the pair model."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from lilium.casework.identify import Calibrations, identify
+
+    result, skull, frontal, data = _posest_sfo(case, tmp_path)
     lateral = replace(frontal, view="lateral_left")  # the same landmarks, scored as lateral
     calibrations = Calibrations()
     one = [identify(skull, [p], [result], calibrations) for p in (frontal, lateral)]
@@ -416,22 +425,6 @@ def test_skull_outside_the_head_is_decided_beyond_the_edge_noise(case):
     assert ring > 0
 
 
-def _posest_sfo(case, tmp_path):
-    """``lilium sfo --method posest-sfo`` on the stand-in case: a result with its camera, the
-    skull and the photo."""
-    from types import SimpleNamespace
-
-    from lilium.io.case import read_photo, read_skull
-
-    subject_dir, photo_dir = case
-    assert main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
-                 "--photo", str(photo_dir), "--out", str(tmp_path / "out")]) == 0
-    data = json.loads((tmp_path / "out" / "result.json").read_text())
-    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[],
-                             camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
-    return result, read_skull(subject_dir), read_photo(photo_dir)
-
-
 def test_a_frontal_and_lateral_decision_is_outside_when_a_photo_is(case, tmp_path):
     """The frontal + lateral decision inherits a photo's ``outside_calibration`` (naming the
     photo); inside every photo's range it is not capped so, whatever the views model (which
@@ -441,7 +434,7 @@ def test_a_frontal_and_lateral_decision_is_outside_when_a_photo_is(case, tmp_pat
     from lilium.casework.identify import Calibrations, identify
     from lilium.identification.calibration import VIEWS_LOG10_LR, Calibration
 
-    result, skull, frontal = _posest_sfo(case, tmp_path)
+    result, skull, frontal, _ = _posest_sfo(case, tmp_path)
     lateral = replace(frontal, id="side", view="lateral_left")
     wide = {"landmark_chi2": (-50.0, 50.0)}
 

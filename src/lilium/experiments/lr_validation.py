@@ -17,9 +17,6 @@ import numpy as np
 
 from ..identification.calibration import VIEWS_LOG10_LR, performance
 
-#: The decisions of a case (keys of a calibration, ``<method>/<variant>/<decision>``).
-DECISIONS = ("frontal", "lateral", "pair_sum", "joint")
-
 
 def _key(method, variant, decision):
     return f"{method}/{variant or ''}/{decision}"

@@ -30,9 +30,8 @@ beyond it: the logistic regression would extrapolate there, and the decision doe
 support (:mod:`lilium.identification.conclusion`, ``outside_calibration``); its LR is computed
 with each such feature at the edge of its range, not extrapolated (a real skull that fitted its
 photo's landmarks better than any generated true pair did was otherwise read at the largest
-LR). Real photos once
-sat 3-8 SD outside the generated range on two photo-level terms, and every real skull, the
-wrong one included, got the largest LR.
+LR). Real photos once sat 3-8 SD outside the generated range on two photo-level terms, and
+every real skull, the wrong one included, got the largest LR.
 
 **Validation.** :func:`cross_validated` scores every pair with a model that never saw its
 subject (k folds of subjects; training leaves out every pair whose photo or skull belongs to
