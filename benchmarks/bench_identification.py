@@ -315,7 +315,7 @@ def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):
     conclusion. Skipped without the CT."""
     from headsq_case import build_headsq_dataset
     from lilium.casework.case import run_case
-    from lilium.casework.identify import Calibrations, identify
+    from lilium.casework.identify import Calibrations, decide
 
     root = build_headsq_dataset(Path(out_dir) / "dataset", 1, 0, variants=("hq", "hq_nm"))
     if root is None:
@@ -339,8 +339,8 @@ def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):
             by_method[e.result.method].append(e)
         for method, items in by_method.items():
             decisions = [(e.photo.id, e.result.extra["identification"]) for e in items]
-            pair = identify(items[0].skull, [e.photo for e in items], [e.result for e in items],
-                            calibrations)
+            pair = decide(items[0].skull, [e.photo for e in items], [e.result for e in items],
+                          calibrations).to_dict()
             for what, record in decisions + [("frontal + lateral", pair)]:
                 lr = record["log10_lr"]
                 print(

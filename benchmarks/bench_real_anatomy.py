@@ -77,7 +77,7 @@ def run_pairs(datasets, out, n_photos, log=print):
         skull ``outside`` (:func:`lilium.identification.score.outside_depths`).
     """
     from lilium.casework.case import run_case
-    from lilium.casework.identify import Calibrations, identify
+    from lilium.casework.identify import Calibrations, decide
     from lilium.identification.score import outside_depths
 
     calibrations = Calibrations()
@@ -93,8 +93,8 @@ def run_pairs(datasets, out, n_photos, log=print):
                                    axes=skull_dir / "axes_C1.json", log=lambda line: None)
                 for method in METHODS:
                     items = [e for e in entries if e.result.method == method]
-                    pair = identify(items[0].skull, [e.photo for e in items],
-                                    [e.result for e in items], calibrations)
+                    pair = decide(items[0].skull, [e.photo for e in items],
+                                  [e.result for e in items], calibrations).to_dict()
                     decisions = [(e.photo.view, e.photo.id, e.result.extra["identification"], e)
                                  for e in items]
                     for view, photo_id, record, entry in decisions + [

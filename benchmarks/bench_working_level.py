@@ -122,7 +122,7 @@ def main(argv=None):
 
 def identify_paths(root, paths, seed):
     """Each path's identification: every photo against every skull, ranked by log10 LR."""
-    from lilium.casework.identify import Calibrations, identify
+    from lilium.casework.identify import Calibrations, decide
 
     calibrations = Calibrations()
     photos = [(label, photo, truth) for label, _, photo, truth, _ in cases(root, 0, 0.0)]
@@ -139,7 +139,7 @@ def identify_paths(root, paths, seed):
             lrs = {}
             for sid, skull in skulls.items():
                 result = run_sfo("lilium", skull, photo, options, seed)
-                record = identify(skull, [photo], [result], calibrations) if result else {}
+                record = decide(skull, [photo], [result], calibrations).to_dict() if result else {}
                 lr = record.get("log10_lr")
                 lrs[sid] = -np.inf if lr is None else lr
             true = lrs[subject_of[label]]

@@ -8,11 +8,16 @@ import json
 import numpy as np
 import pytest
 
-from lilium.casework.identify import conclusion_line
+from lilium.casework.identify import Calibrations, conclusion_line, decide
 from lilium.cli.main import main
 from lilium.geometry.camera import Camera
 from lilium.identification.conclusion import conclude, level, material_caps
 from standin_case import scaled_photo
+
+
+def identify(skull, photos, results, calibrations):
+    """The decision's record, as ``result.json``'s ``"identification"`` holds it."""
+    return decide(skull, photos, results, calibrations).to_dict()
 
 
 def test_conclusion_scale_caps_and_consistency():
@@ -59,7 +64,6 @@ def test_the_record_names_a_misplaced_landmark(case, tmp_path):
     from dataclasses import replace
     from types import SimpleNamespace
 
-    from lilium.casework.identify import Calibrations, identify
     from lilium.inputs import correspondences
     from lilium.io.case import read_photo, read_skull
     from lilium.report.conclusion_html import conclusion_section
@@ -208,7 +212,6 @@ def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeyp
     from dataclasses import replace
     from types import SimpleNamespace
 
-    from lilium.casework.identify import Calibrations, identify
 
     result, skull, frontal, data = _posest_sfo(case, tmp_path)
     lateral = replace(frontal, view="lateral_left")  # the same landmarks, scored as lateral
@@ -232,7 +235,7 @@ def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeyp
     assert plain["calibration"]["model"] == "posest-sfo//frontal + posest-sfo//lateral"
     assert "single_photo" not in both["caps"]
     # Each photo's LR comes from its own SFO's soft tissue, not the first photo's.
-    import lilium.casework.identify as identify_module
+    import lilium.identification.decision as identify_module
 
     own = {k: np.asarray(v, float) for k, v in data["facial_landmarks_3d"].items()}
     moved = {k: v + np.array([4.0, -3.0, 8.0]) for k, v in own.items()}
@@ -267,8 +270,7 @@ def test_two_photos_reuse_each_photos_own_decision(case, tmp_path, monkeypatch):
     from pathlib import Path
     from types import SimpleNamespace
 
-    import lilium.casework.identify as identify_module
-    from lilium.casework.identify import Calibrations, identify
+    import lilium.identification.decision as identify_module
     from lilium.io.case import read_photo, read_skull
 
     subject_dir, photo_dir = case
@@ -395,7 +397,7 @@ def test_skull_outside_the_head_is_decided_beyond_the_edge_noise(case):
 
     from scipy import ndimage as ndi
 
-    from lilium.casework.identify import skull_outside_head
+    from lilium.identification.decision import skull_outside_head
     from lilium.identification.score import outside_fraction, skull_beyond_head
     from lilium.imaging.raster import mesh_mask
     from lilium.io.case import read_photo, read_skull
@@ -431,7 +433,6 @@ def test_a_frontal_and_lateral_decision_is_outside_when_a_photo_is(case, tmp_pat
     keeps no range: two photos at their bounds add up beyond its training sums)."""
     from dataclasses import replace
 
-    from lilium.casework.identify import Calibrations, identify
     from lilium.identification.calibration import VIEWS_LOG10_LR, Calibration
 
     result, skull, frontal, _ = _posest_sfo(case, tmp_path)

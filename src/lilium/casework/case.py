@@ -17,7 +17,7 @@ from .folders import (
     sfo_outputs,
     with_depth_table,
 )
-from .identify import Calibrations, conclusion_line, identify
+from .identify import Calibrations, conclusion_line, decide
 from .inputs import check_runnable, load_photos, load_skull
 from .joint_case import check_joint_case, joint_entry, run_joint_methods
 from .prepared import check_photo_extra
@@ -242,7 +242,8 @@ class _CaseRun:
             if len(done) < 2:
                 continue
             photos_m, results_m = zip(*done, strict=True)
-            record = identify(self.skull, list(photos_m), list(results_m), self.calibrations)
+            decision = decide(self.skull, list(photos_m), list(results_m), self.calibrations)
+            record = decision.to_dict()
             tag = method_tag(method, self.options.variant)
             label = f"photos {', '.join(p.id for p in photos_m)} together, {tag}"
             self.log(f"{label}: {conclusion_line(record)}")

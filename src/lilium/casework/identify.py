@@ -1,284 +1,44 @@
-"""The identification of a case's SFO results (SPEC section 12): terms, calibrated log10 LR and
-the conclusion, for one photo, a joint SFO, or a person's photos taken together.
+"""The identification in a case's workflow: the calibration file read once, each result's
+``"identification"`` record, and its console line.
 
-Which calibration model a decision uses (``lilium/data/calibration.json`` unless the user
-gives another): ``<method>/<variant>/frontal`` or ``/lateral`` for one photo,
-``lilium-joint/<variant>/joint`` for a joint SFO. Separate SFOs of one frontal and one lateral
-photo add the two photos' log10 LRs (each from its own view's model) and calibrate the sum
-with ``<method>/<variant>/pair_sum`` (a slope and an offset fitted on same- and
-different-person pairs instead of assuming the photos independent, which they are not: they
-share the soft tissue; Lilium's slope came out above 1, each photo's own model being
-conservative; without that model, the plain sum, and the note says so).
-Measured on 52 generated subjects (docs/method.md): Cllr 0.242 against 0.265 for the plain
-sum and 0.417 for one model of both photos with their soft tissue shared. Any other two or
-more photos use ``<method>/<variant>/pair``
-(that shared-soft-tissue model, fitted on a frontal and a lateral photo; the result says so).
-Without a model for the decision the LR is not given and the conclusion is "undetermined",
-naming the model missing and how to fit it.
+The decision itself (which model, the terms, the caps) is
+:func:`lilium.identification.decision.identify`; here it gets the calibration file the user
+gave (``lilium/data/calibration.json`` unless another) and the shipped cohort.
 """
 
 from dataclasses import replace
 
-from ..identification.calibration import VIEWS_LOG10_LR
-from ..identification.conclusion import NO_SUPPORT_CAPS, conclude, material_caps
-from ..identification.score import (
-    identification_terms,
-    nll_score,
-    skull_beyond_head,
-    worst_landmark_of,
-)
-from ..inputs import correspondences
+from ..identification.conclusion import NO_SUPPORT_CAPS
+from ..identification.decision import identify
 from ..io.calibration import read_calibration, shipped_cohort, shipped_path
-from ..methods.prior_checks import perspective_conflict, prior_conflicts
-
-#: Cranial landmarks on the mandible: a skull with none of them has no mandible.
-MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")
 
 
 class Calibrations:
-    """The calibration models of a file, read once (the shipped file by default)."""
+    """The calibration models of a file, read once (the shipped file by default), and the
+    cohort they were fitted with (the shipped one)."""
 
     def __init__(self, path=None):
         self.path = shipped_path() if path is None else path
         self.models, self.provenance = read_calibration(path)
+        self.cohort = shipped_cohort()
 
     def get(self, key):
         return self.models.get(key)
 
 
-def _group(photo):
-    return "frontal" if photo.view == "frontal" else "lateral"
-
-
-def adds_views(photos, joint=False):
-    """Whether the decision adds a frontal and a lateral photo's LRs (module docstring)."""
-    return not joint and sorted(_group(p) for p in photos) == ["frontal", "lateral"]
-
-
-def decision_key(method, variant, photos, joint=False):
-    """The calibration key of a decision (module docstring); for a frontal and a lateral
-    photo taken separately, the two keys joined by ``+``."""
-    if joint:
-        return f"lilium-joint/{variant or ''}/joint"
-    if adds_views(photos):
-        return " + ".join(f"{method}/{variant or ''}/{_group(p)}" for p in photos)
-    if len(photos) > 1:
-        return f"{method}/{variant or ''}/pair"
-    return f"{method}/{variant or ''}/{_group(photos[0])}"
-
-
-def outside_calibration(model, terms, key):
-    """``{"outside_calibration": sentence}`` when a feature of ``terms`` lies outside the range
-    the model ``key`` was fitted on (:meth:`Calibration.outside`), else ``{}``: the sentence
-    names the first such feature, its value and the range, and how many more there are."""
-    outside = model.outside(terms)
-    if not outside:
-        return {}
-    name, value, (lo, hi) = outside[0]
-    more = f" (and {len(outside) - 1} more feature(s))" if len(outside) > 1 else ""
-    return {"outside_calibration": (
-        f"feature {name} = {value:.3g} lies outside the range [{lo:.3g}, {hi:.3g}] the model "
-        f"{key} was fitted on{more}: its LR would be an extrapolation, so it gives no support"
-    )}
-
-
-def skull_outside_head(skull, photos, results):
-    """The sentence of ``skull_outside_head``, or None: the photos where skull pixels lie
-    beyond the head mask's edge band (:func:`~lilium.identification.score.skull_beyond_head`),
-    how many and how far."""
-    found = []
-    for photo, result in zip(photos, results, strict=True):
-        counts = skull_beyond_head(skull, photo, result.camera)
-        if counts is None or counts[0] == 0:
-            continue
-        beyond, skull_px, band = counts
-        found.append(
-            f"{photo.id}: {beyond} of the skull's {skull_px} pixels ({100 * beyond / skull_px:.2g}"
-            f" %) lie more than {band:.1f} px outside the head mask"
-        )
-    return "; ".join(found) or None
-
-
-def _inconsistent(skull, photos, results, facial_landmarks_mm):
-    out = {}
-    outside = skull_outside_head(skull, photos, results)
-    if outside:
-        out["skull_outside_head"] = outside
-    conflicts, far = [], {}
-    for photo, result in zip(photos, results, strict=True):
-        for w in result.warnings:
-            if w.code == "view_mismatch":
-                out["view_mismatch"] = w.message
-        facial = result.facial_landmarks_mm or facial_landmarks_mm
-        conflicts.append(perspective_conflict(photo, result.camera, facial))
-        for code, sentence in prior_conflicts(photo, result.camera, facial).items():
-            far.setdefault(code, []).append(f"{photo.id}: {sentence}")
-    if any(conflicts):
-        out["perspective_mismatch"] = "; ".join(c for c in conflicts if c)
-    out.update({code: "; ".join(sentences) for code, sentences in far.items()})
-    return out
-
-
-def _own_record(photo, result, calibrations):
-    """The photo's own decision already in its result (``extra["identification"]``, written by
-    :func:`with_identification` with the same calibration file and the photo's single-photo
-    model), or None: what ``identify(skull, [photo], [result], calibrations)`` would give,
-    not computed a second time."""
-    record = (getattr(result, "extra", None) or {}).get("identification")
-    if not record:
-        return None
-    calibration = record.get("calibration") or {}
-    same_file = calibration.get("file") == str(calibrations.path)
-    same_model = calibration.get("model") == decision_key(
-        result.method, result.variant, [photo], False
+def decide(skull, photos, results, calibrations, facial_landmarks_mm=None, joint=False):
+    """:func:`~lilium.identification.decision.identify` with the case's calibration file and
+    its cohort; returns the :class:`~lilium.identification.decision.Identification`."""
+    return identify(
+        skull, photos, results, calibrations, calibrations.cohort, facial_landmarks_mm, joint
     )
-    return record if same_file and same_model else None
-
-
-def identify(skull, photos, results, calibrations, facial_landmarks_mm=None, joint=False):
-    """The ``"identification"`` record of one decision.
-
-    Parameters
-    ----------
-    skull : Skull
-    photos : sequence of Photo
-    results : sequence of SfoResult
-        One per photo (a joint SFO's per-photo results, or separate SFOs).
-    calibrations : Calibrations
-    facial_landmarks_mm : dict, optional
-        The soft tissue of the decision's terms (default: the first frontal photo's result's,
-        else the first result's). A frontal and a lateral photo's separate SFOs each give their
-        LR from their own result's soft tissue.
-    joint : bool
-        The results are one joint SFO's.
-
-    Returns
-    -------
-    dict
-        ``score``, ``terms``, ``log10_lr``, ``conclusion``, ``conclusion_uncapped``, ``caps``,
-        ``inconsistent``, ``calibration`` (model key, file, provenance), ``worst_landmark``
-        (the photo landmark that fits worst and its misfit per coordinate: one misplaced
-        landmark lowers the LR, so the examiner is told which to check; absent for a failed
-        SFO), ``note``.
-    """
-    method, variant = results[0].method, results[0].variant
-    key = decision_key(method, variant, photos, joint)
-    pairs = []
-    for photo in photos:
-        try:
-            pairs.append(len(correspondences(skull, photo).cranial_names))
-        except ValueError:
-            pairs.append(0)
-    used = [
-        f for photo in photos for f in photo.landmarks_uv
-        if photo.landmark_sources.get(f, "manual") != "manual"
-    ]
-    caps = material_caps(
-        has_mandible=any(n in skull.landmarks_mm for n in MANDIBLE_LANDMARKS),
-        photos=len(photos),
-        unreviewed_automatic=bool(used),
-        pairs=min(pairs),
-    )
-    record = {"calibration": {"model": key, "file": str(calibrations.path)}}
-    if not all(results):
-        verdict = conclude(None, caps)
-        return record | {
-            "score": None,
-            "terms": None,
-            "log10_lr": None,
-            "conclusion": verdict.label,
-            "conclusion_uncapped": verdict.uncapped,
-            "caps": caps,
-            "inconsistent": {},
-            "note": "no camera: the SFO failed, so nothing can be concluded",
-        }
-    # Several photos' terms share one soft tissue: the first frontal photo's SFO's, as the
-    # calibration's pairs take it (lilium.experiments.calibrate), whatever the photos' order.
-    frontal = next(
-        (r for p, r in zip(photos, results, strict=True) if _group(p) == "frontal"), results[0]
-    )
-    facial = facial_landmarks_mm or frontal.facial_landmarks_mm
-    # The built-in depth table, whatever the SFO used: the calibration was fitted on terms
-    # computed with it, and a user's table would move the terms off that calibration.
-    terms = identification_terms(
-        skull, photos, [r.camera for r in results], facial, cohort=shipped_cohort()
-    )
-    model = calibrations.get(key)
-    note = ""
-    if adds_views(photos, joint):
-        # Each photo's LR from its own SFO's soft tissue, as the views' models were fitted.
-        parts = [
-            _own_record(p, r, calibrations) or identify(skull, [p], [r], calibrations)
-            for p, r in zip(photos, results, strict=True)
-        ]
-        lrs = [part["log10_lr"] for part in parts]
-        views_key = f"{method}/{variant or ''}/pair_sum"
-        lr, note = _views_lr(lrs, [p.id for p in photos], calibrations, views_key, record)
-        # Outside the calibration when a photo's features are (the sum of two LRs is not
-        # range-checked: lilium.identification.calibration.fit, keep_ranges).
-        outside = [f"{p.id}: {part['caps']['outside_calibration']}"
-                   for p, part in zip(photos, parts, strict=True)
-                   if "outside_calibration" in part["caps"]]
-        if outside:
-            caps = {"outside_calibration": "; ".join(outside)} | caps
-        note = "; ".join([part["note"] for part in parts if part["note"]] + [note] * bool(note))
-        record["views_log10_lr"] = lrs
-        record["calibration"].setdefault(
-            "provenance", parts[0]["calibration"].get("provenance")
-        )
-    elif model is None:
-        lr = None
-        note = (
-            f"no calibration for {key} in {calibrations.path}: fit one with lilium calibrate "
-            "DB on an experiment that ran this method and variant, and give it with "
-            "--calibration"
-        )
-    else:
-        lr = float(model.log10_lr([terms])[0])
-        caps = outside_calibration(model, terms, key) | caps
-        record["calibration"]["provenance"] = model.provenance
-        if len(photos) > 1 and not joint:
-            note = "calibrated on one frontal and one lateral photo; these photos differ"
-    inconsistent = _inconsistent(skull, photos, results, facial)
-    verdict = conclude(lr, caps, inconsistent)
-    worst, misfit = worst_landmark_of(skull, photos, [r.camera for r in results])
-    return record | {
-        "score": nll_score(terms),
-        "terms": {k: (None if v is None else float(v)) for k, v in terms.items()},
-        "log10_lr": lr,
-        "conclusion": verdict.label,
-        "conclusion_uncapped": verdict.uncapped,
-        "caps": caps,
-        "inconsistent": inconsistent,
-        "worst_landmark": None if worst is None else {"name": worst, "misfit": misfit},
-        "note": note,
-    }
-
-
-def _views_lr(lrs, photo_ids, calibrations, key, record):
-    """The log10 LR of a frontal and a lateral photo's log10 LRs ``lrs`` (None if either is
-    missing; ``photo_ids`` in the same order): their sum calibrated by the model ``key``, or
-    the plain sum without one; and the note that says which. Names the model in
-    ``record["calibration"]``."""
-    model = calibrations.get(key)
-    record["calibration"]["views_model"] = None if model is None else key
-    if None in lrs:
-        return None, ""
-    added = float(sum(lrs))
-    if model is None:
-        return added, (
-            f"the frontal and the lateral photo's log10 LRs added, as if independent (no {key} "
-            f"model in {calibrations.path}; lilium calibrate DB fits one)"
-        )
-    record["calibration"]["provenance"] = model.provenance
-    record["calibration"]["model"] += f" -> {key}"
-    lr = float(model.log10_lr([{VIEWS_LOG10_LR: added}])[0])
-    parts = ", ".join(f"{i} {v:+.2f}" for i, v in zip(photo_ids, lrs, strict=True))
-    return lr, f"the photos' log10 LRs ({parts}) added and calibrated as one decision ({key})"
 
 
 def conclusion_line(record):
-    """One console line: the conclusion, the LR, and what capped it."""
+    """One console line: the conclusion, the LR, and what capped it (``record``: an
+    :class:`~lilium.identification.decision.Identification` or its dict)."""
+    if hasattr(record, "to_dict"):
+        record = record.to_dict()
     lr = record.get("log10_lr")
     lr_text = "no LR" if lr is None else f"log10 LR {lr:+.2f} (LR {10**lr:.3g})"
     caps = dict(record.get("caps") or {})
@@ -296,7 +56,5 @@ def with_identification(result, skull, photos, calibrations):
     ``"identification"`` record in ``extra`` (so in ``result.json``)."""
     joint = hasattr(result, "photos")
     singles = list(result.photos) if joint else [result]
-    record = identify(
-        skull, photos, singles, calibrations, result.facial_landmarks_mm, joint=joint
-    )
-    return replace(result, extra={**result.extra, "identification": record})
+    decision = decide(skull, photos, singles, calibrations, result.facial_landmarks_mm, joint)
+    return replace(result, extra={**result.extra, "identification": decision.to_dict()})

@@ -34,7 +34,7 @@ from .folders import (
     sfo_fingerprint,
     sfo_outputs,
 )
-from .identify import Calibrations, conclusion_line, identify
+from .identify import Calibrations, conclusion_line, decide
 from .inputs import load_photos, load_skull
 
 #: The lineup's own files in its output folder: no candidate's folder may take their names.
@@ -240,7 +240,7 @@ class _LineupRun:
         if len(results) == 1:
             record = results[0].extra["identification"]
         else:
-            record = identify(self.skull, photos, results, self.calibrations)
+            record = decide(self.skull, photos, results, self.calibrations).to_dict()
         return dict(
             candidate=name,
             photos=[p.id for p in photos],

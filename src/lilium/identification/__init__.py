@@ -6,5 +6,11 @@
 - :mod:`~lilium.identification.calibration`: terms -> log10 LR (logistic regression,
   cross-validated by subject), Cllr, Cllr_min, rates of misleading evidence;
 - :mod:`~lilium.identification.conclusion`: log10 LR -> the verbal scale, capped by the
-  material.
+  material;
+- :mod:`~lilium.identification.decision`: one decision, :func:`identify` ->
+  :class:`Identification` (the models and the cohort passed in).
 """
+
+from .decision import Identification, identify
+
+__all__ = ["Identification", "identify"]
