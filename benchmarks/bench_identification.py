@@ -316,6 +316,7 @@ def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):
     from headsq_case import build_headsq_dataset
     from lilium.casework.case import run_case
     from lilium.casework.identify import Calibrations, decide
+    from lilium.casework.request import CaseRequest, PhotoSource, SkullSource
 
     root = build_headsq_dataset(Path(out_dir) / "dataset", 1, 0, variants=("hq", "hq_nm"))
     if root is None:
@@ -331,9 +332,12 @@ def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):
         ("generated", "generated", other_skull),
     )
     for name, folder, skull_dir in skulls:
-        entries = run_case(skull_dir, photos, Path(out_dir) / folder,
-                           methods=("lilium", "posest-sfo"), calibration=calibration,
-                           log=lambda line: None)
+        request = CaseRequest(
+            SkullSource(skull_dir), Path(out_dir) / folder,
+            photos=tuple(PhotoSource(p) for p in photos), methods=("lilium", "posest-sfo"),
+            calibration=calibration,
+        )
+        entries = run_case(request, log=lambda line: None)
         by_method = defaultdict(list)
         for e in entries:
             by_method[e.result.method].append(e)

@@ -78,6 +78,7 @@ def run_pairs(datasets, out, n_photos, log=print):
     """
     from lilium.casework.case import run_case
     from lilium.casework.identify import Calibrations, decide
+    from lilium.casework.request import CaseRequest, PhotoSource, SkullSource
     from lilium.identification.score import outside_depths
 
     calibrations = Calibrations()
@@ -89,8 +90,11 @@ def run_pairs(datasets, out, n_photos, log=print):
         for k, (frontal, lateral) in enumerate(photo_pairs(root, main_subject, n_photos)):
             for sid, (skull_head, skull_dir) in skulls.items():
                 case_dir = Path(out) / "cases" / f"{main_subject}{k:02d}-{sid}"
-                entries = run_case(skull_dir, [frontal, lateral], case_dir, methods=METHODS,
-                                   axes=skull_dir / "axes_C1.json", log=lambda line: None)
+                request = CaseRequest(
+                    SkullSource(skull_dir, axes=skull_dir / "axes_C1.json"), case_dir,
+                    photos=(PhotoSource(frontal), PhotoSource(lateral)), methods=tuple(METHODS),
+                )
+                entries = run_case(request, log=lambda line: None)
                 for method in METHODS:
                     items = [e for e in entries if e.result.method == method]
                     pair = decide(items[0].skull, [e.photo for e in items],

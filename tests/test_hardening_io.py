@@ -147,9 +147,11 @@ def test_missing_axes_file_is_an_error(case, tmp_path, capsys):
     with pytest.raises(ValueError, match="gone_axes.json: soft-tissue axes file not found"):
         read_skull(subject_dir, axes_path=gone)
     from lilium.casework.inputs import load_skull
+    from lilium.casework.request import SkullSource
 
     with pytest.raises(ValueError, match="gone_axes.json"):
-        load_skull(subject_dir / "skull.ply", subject_dir / "cranial_landmarks.json", gone)
+        load_skull(SkullSource(subject_dir / "skull.ply", subject_dir / "cranial_landmarks.json",
+                               gone))
 
 
 def test_landmarks_at_one_place_or_on_a_line(case, tmp_path, capsys):
@@ -353,7 +355,7 @@ def test_last_resort_handler(case, tmp_path, capsys, monkeypatch):
     def broken(*args, **kwargs):
         raise KeyError("camera")
 
-    monkeypatch.setattr(sfo_cli, "sfo_on_folders", broken)
+    monkeypatch.setattr(sfo_cli, "single_sfo", broken)
     with pytest.raises(KeyError):  # LILIUM_DEBUG=1 (conftest): a bug fails its test
         main([str(a) for a in _sfo(case, tmp_path)])
     monkeypatch.delenv("LILIUM_DEBUG")
@@ -363,13 +365,13 @@ def test_last_resort_handler(case, tmp_path, capsys, monkeypatch):
     def refused(*args, **kwargs):
         raise PermissionError(13, "Permission denied", str(tmp_path / "result.json"))
 
-    monkeypatch.setattr(sfo_cli, "sfo_on_folders", refused)
+    monkeypatch.setattr(sfo_cli, "single_sfo", refused)
     _one_line_error(capsys, _sfo(case, tmp_path), "result.json: permission denied", "permissions")
 
     def out_of_memory(*args, **kwargs):
         raise MemoryError
 
-    monkeypatch.setattr(sfo_cli, "sfo_on_folders", out_of_memory)
+    monkeypatch.setattr(sfo_cli, "single_sfo", out_of_memory)
     _one_line_error(capsys, _sfo(case, tmp_path), "out of memory", "downscale")
 
 

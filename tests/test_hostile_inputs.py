@@ -303,7 +303,7 @@ def test_terms_off_csv_has_its_header_when_nothing_was_off(report_db, tmp_path, 
     [
         (["--subjects", "100000000"], "argument --subjects: must be an integer from 1 to 1000"),
         (["--photos", "0"], "argument --photos: must be an integer from 1 to 1000"),
-        (["--workers", "-3"], "argument --workers: must be an integer from 1 to 256"),
+        (["--workers", "-3"], "argument --workers: must be an integer from 0 to 256"),
         (["--seed", "-1"], "argument --seed"),
     ],
 )

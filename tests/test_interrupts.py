@@ -55,7 +55,7 @@ def test_ctrl_c_inside_a_compiled_kernel_is_one_line(case, tmp_path, monkeypatch
             KeyboardInterrupt()
         )
 
-    monkeypatch.setattr(sfo_cli, "sfo_on_folders", kernel_interrupted)
+    monkeypatch.setattr(sfo_cli, "single_sfo", kernel_interrupted)
     assert cli_main.main([str(a) for a in _sfo(case, tmp_path / "out")]) == 130
     assert capsys.readouterr().err == "lilium sfo: interrupted\n"
 

@@ -102,4 +102,4 @@ def test_cli_bad_input_is_one_line_error(case, tmp_path, capsys):
         ]
     )
     err = capsys.readouterr().err
-    assert code == 2 and err.count("\n") == 1 and "photo folder not found" in err
+    assert code == 2 and err.count("\n") == 1 and "missing: --photo not found" in err

@@ -16,6 +16,7 @@ import lilium.casework.lineup as lineup_module
 from cli_helpers import _edit_json, _one_line_error, _run
 from lilium.casework.folders import FINGERPRINT_KEY, output_lock, sfo_fingerprint
 from lilium.casework.inputs import load_photos, load_skull
+from lilium.casework.request import PhotoSource, PriorOverrides, SkullSource
 from lilium.io.results import png_readable, write_png, write_result
 from lilium.methods.options import SfoOptions
 from lilium.methods.registry import run_sfo
@@ -51,10 +52,10 @@ def _count_sfos(monkeypatch):
 # -- D1: the input fingerprint -------------------------------------------------------------------
 
 
-def _fingerprint(case, options=SfoOptions(), seed=0, **photo_options):
+def _fingerprint(case, options=SfoOptions(), seed=0, **priors):
     subject_dir, photo_dir = case
-    skull, skull_inputs = load_skull(subject_dir)
-    (record,) = load_photos([photo_dir], **photo_options)
+    skull, skull_inputs = load_skull(SkullSource(subject_dir))
+    (record,) = load_photos([PhotoSource(photo_dir)], PriorOverrides(**priors))
     return sfo_fingerprint(
         "lilium", options, seed, skull, skull_inputs, [record.photo], [record.inputs]
     )

@@ -5,7 +5,6 @@ from pathlib import Path
 
 from ..io.paths import safe_id
 from ..methods.checks import check_inputs
-from ..methods.options import SfoOptions
 from ..methods.registry import check_method, method_tag, run_sfo
 from .console import log_warnings, status_text
 from .folders import (
@@ -50,65 +49,37 @@ def _landmark_info(origin, out):
     }
 
 
-def run_case(
-    skull_path,
-    photos,
-    out,
-    landmarks=None,
-    axes=None,
-    methods=("lilium",),
-    options=SfoOptions(),
-    seed=0,
-    depth_table=None,
-    title=None,
-    command=None,
-    log=print,
-    auto_landmarks=False,
-    joint=False,
-    calibration=None,
-    **photo_options,
-):
+def run_case(request, log=print):
     """Read and check every input, run every SFO, write each result and the report.
 
     Parameters
     ----------
-    skull_path : path
-        Subject folder or skull mesh (:func:`~lilium.casework.inputs.load_skull`).
-    photos : list of path
-        Photo folders or images; ``photo_options`` go to
-        :func:`~lilium.casework.inputs.load_photos`.
-    out : path
-        Output folder: ``report.html`` and, per photo and method, one folder
+    request : CaseRequest
+        The skull, the photos (:class:`~lilium.casework.request.PhotoSource`: folders or
+        images), the methods, their options and seed, the priors given, the depth table and
+        calibration files, ``auto_landmarks``, ``joint``, the title and the output folder
+        ``request.out``: ``report.html`` and, per photo and method, one folder
         ``<photo>/<method tag>/`` (:func:`~lilium.methods.method_tag`: ``posest-sfo``,
         ``lilium-skof+pll``, ...) with ``result.json`` and ``overlay.png``, however many
         methods run: one layout for scripts to read.
-    landmarks, axes : path, optional
-    methods : sequence of str
-    options : SfoOptions
-    seed : int
-    depth_table : path, optional
-    title, command : str, optional
-        Report title and the equivalent command line (provenance).
+
+        With ``auto_landmarks``, each image without a landmark file is prepared with ``lilium
+        photo`` into ``out/<photo>/prepared/`` (:func:`~lilium.casework.inputs.load_photos`);
+        the case fails at once, before reading anything, when ``lilium[photo]`` is not
+        installed. With ``joint``, each method that has a joint form (Lilium) runs as one joint
+        SFO of all the photos (one soft tissue shared by the photos, one camera each), written
+        to ``<out>/joint/<method tag>/`` (``result.json`` with ``"joint": true`` and
+        ``overlay_<photo id>.png`` per photo); the other methods run per photo as usual. The
+        report shows every photo's overlay and terms from the shared soft tissue, and its 3D
+        facial landmarks. Needs two or more distinct photos.
+
+        Every result gets its ``"identification"`` (docs/identification.md); with several
+        photos, each method's separate SFOs are also taken together as one decision (shared
+        soft tissue), shown first in the report and logged.
     log : callable
         Receives one line per sidecar file found beside a mesh or an image, one per photo
         prepared automatically, one per photo with automatic, unreviewed landmarks, one per
         SFO and one per warning of that SFO.
-    auto_landmarks : bool
-        Prepare each image without a landmark file with ``lilium photo`` into
-        ``out/<photo>/prepared/`` (:func:`~lilium.casework.inputs.load_photos`); fails at once,
-        before reading anything, when ``lilium[photo]`` is not installed.
-    joint : bool
-        Run each method that has a joint form (Lilium) as one joint SFO of all the photos
-        (SPEC section 9: one soft tissue shared by the photos, one camera each), written to
-        ``<out>/joint/<method tag>/`` (``result.json`` with ``"joint": true`` and
-        ``overlay_<photo id>.png`` per photo); the other methods run per photo as usual. The
-        report shows every photo's overlay and terms from the shared soft tissue, and its 3D
-        facial landmarks. Needs two or more distinct photos.
-    calibration : path, optional
-        Identification calibration file (default: the shipped one). Every result gets its
-        ``"identification"`` (SPEC section 12); with several photos, each method's separate
-        SFOs are also taken together as one decision (shared soft tissue), shown first in the
-        report and logged.
 
     Returns
     -------
@@ -134,28 +105,32 @@ def run_case(
     """
     from ..report.html import write_report
 
-    methods = list(dict.fromkeys(methods)) or ["lilium"]
+    methods, options, seed = list(request.methods), request.options, request.seed
     for method in methods:
         check_method(method, options.variant)
-    if auto_landmarks:
+    if request.auto_landmarks:
         check_photo_extra()
-    check_distinct_photos(photos)
-    if joint:
-        check_joint_case(photos, methods)
-    skull, skull_inputs = load_skull(skull_path, landmarks, axes, log=log)
+    paths = [source.path for source in request.photos]
+    check_distinct_photos(paths)
+    if request.joint:
+        check_joint_case(paths, methods)
+    skull, skull_inputs = load_skull(request.skull, log=log)
     skull = labelled_skull(skull, skull_inputs)
-    out = Path(out)
+    out = Path(request.out)
     with output_lock(out):
         records = load_photos(
-            photos, log=log, skull=skull, auto_landmarks=auto_landmarks, out=out, **photo_options
+            request.photos, request.priors, log=log, skull=skull,
+            auto_landmarks=request.auto_landmarks, out=out,
         )
-        if depth_table:
-            options, photos_in = with_depth_table(options, depth_table, [r.photo for r in records])
+        if request.depth_table:
+            options, photos_in = with_depth_table(
+                options, request.depth_table, [r.photo for r in records]
+            )
             records = [r._replace(photo=p) for r, p in zip(records, photos_in, strict=True)]
-        calibrations = Calibrations(calibration)
+        calibrations = Calibrations(request.calibration)
         _check_records(skull, skull_inputs, records, methods, options.variant, log)
         joints = {}  # method -> (JointSfoResult, folder), for the joint methods
-        if joint:
+        if request.joint:
             joints = run_joint_methods(
                 skull, skull_inputs, records, methods, options, seed, out, log, calibrations
             )
@@ -163,7 +138,8 @@ def run_case(
         entries = run.entries(records, methods, joints)
         decisions = run.decisions(methods)
         report = write_report(
-            out / "report.html", entries, title=title, command=command, decisions=decisions
+            out / "report.html", entries, title=request.title, command=request.command,
+            decisions=decisions, request=request.to_dict(),
         )
     log(f"report: {report}")
     return entries

@@ -15,14 +15,13 @@ import numpy as np
 
 from .. import __version__
 from ..inputs import CaseWarning
-from ..io.case import IMAGE_NAMES, read_depth_table, read_photo, read_skull
+from ..io.case import IMAGE_NAMES, read_depth_table
 from ..io.jsonio import write_json
 from ..io.locks import RunLock
 from ..io.paths import printable, safe_id
 from ..io.provenance import input_files
 from ..io.results import png_readable, read_result, remove_overlays, write_png, write_result
 from ..methods.checks import check_inputs
-from ..methods.options import SfoOptions
 from ..methods.overlay import result_overlay
 from ..methods.registry import (
     check_joint_method,
@@ -61,42 +60,21 @@ def labelled_skull(skull, inputs):
     return skull if path is None else replace(skull, landmarks_file=str(path))
 
 
-def sfo_on_folders(
-    skull_dir,
-    photo_dir,
-    out_dir,
-    method="posest-sfo",
-    options=SfoOptions(),
-    seed=0,
-    axes=None,
-    depth_table=None,
-    overlay=True,
-    calibration=None,
-):
-    """Read a subject and a photo folder, check them, run the method, write ``out_dir``.
+def single_sfo(request):
+    """One SFO: read the skull and the photo, check them, run the method, write ``request.out``.
 
-    The photo's priors come from ``photo.json``, or its focal prior from the image's EXIF
-    (:func:`~lilium.casework.inputs.with_priors`), those of a ``lilium photo`` folder with
-    ``"source": "automatic"`` and its head orientation converted through the skull's frame
-    (:func:`~lilium.casework.prepared.with_automatic_priors`); the left/right checks of SPEC
-    section 10 run before the SFO (:func:`~lilium.methods.checks.check_inputs`).
+    The photo's priors come from the request, ``photo.json``, or its focal prior from the
+    image's EXIF (:func:`~lilium.casework.inputs.with_priors`), those of a ``lilium photo``
+    folder with ``"source": "automatic"`` and its head orientation converted through the skull's
+    frame (:func:`~lilium.casework.prepared.with_automatic_priors`); the left/right checks run
+    before the SFO (:func:`~lilium.methods.checks.check_inputs`).
 
     Parameters
     ----------
-    skull_dir, photo_dir, out_dir : path
-    method : str
-        A key of :data:`lilium.methods.METHODS`.
-    options : SfoOptions
-    seed : int
-    axes : path, optional
-        Soft-tissue axes file to use instead of the subject's own.
-    depth_table : path, optional
-        CSV depth table (replaces ``options.depth_table``).
-    overlay : bool
-        Write ``overlay.png`` too.
-    calibration : path, optional
-        Identification calibration file (default: the shipped one;
-        :mod:`lilium.casework.identify`).
+    request : CaseRequest
+        One photo and one method (``request.methods[0]``); its axes, depth table (replaces
+        ``options.depth_table``), calibration (default: the shipped one,
+        :mod:`lilium.casework.identify`) and ``overlay`` (write ``overlay.png`` too).
 
     Returns
     -------
@@ -108,23 +86,31 @@ def sfo_on_folders(
     ValueError
         An invalid input (naming the file), including mirrored skull or photo labels.
     """
+    (method,) = request.methods
+    options = request.options
     check_method(method, options.variant)
-    for folder, read in ((skull_dir, read_skull), (photo_dir, read_photo)):
-        if not Path(folder).is_dir():
-            read(folder)  # raises its "not a folder" message
-    skull, skull_inputs = load_skull(skull_dir, axes=axes)
+    skull, photos = _checked_inputs(request)
+    if request.depth_table is not None:
+        options, photos = with_depth_table(options, request.depth_table, photos)
+    calibrations = Calibrations(request.calibration)
+    (photo,) = photos
+    result = run_sfo(method, skull, photo, options, request.seed)
+    result = with_identification(result, skull, [photo], calibrations)
+    overlay = result_overlay(result, skull, photo) if request.overlay else None
+    write_result(request.out, result, overlay)
+    return result
+
+
+def _checked_inputs(request):
+    """The request's skull and photos, read and checked (left/right)."""
+    skull, skull_inputs = load_skull(request.skull)
     skull = labelled_skull(skull, skull_inputs)
     # A lilium photo folder's automatic head orientation is paired with this skull's frame.
-    (record,) = load_photos([photo_dir], skull=skull)
-    photo = record.photo
-    check_inputs(skull, photo)
-    if depth_table is not None:
-        options, (photo,) = with_depth_table(options, depth_table, [photo])
-    calibrations = Calibrations(calibration)
-    result = run_sfo(method, skull, photo, options, seed)
-    result = with_identification(result, skull, [photo], calibrations)
-    write_result(out_dir, result, result_overlay(result, skull, photo) if overlay else None)
-    return result
+    records = load_photos(request.photos, request.priors, skull=skull)
+    photos = [record.photo for record in records]
+    for photo in photos:
+        check_inputs(skull, photo)
+    return skull, photos
 
 
 def joint_overlay_name(photo_id):
@@ -213,23 +199,12 @@ def check_distinct_photos(paths):
         )
 
 
-def joint_sfo_on_folders(
-    skull_dir,
-    photo_dirs,
-    out_dir,
-    method="lilium",
-    options=SfoOptions(),
-    seed=0,
-    axes=None,
-    depth_table=None,
-    overlay=True,
-    calibration=None,
-):
-    """One joint SFO (SPEC section 9) of a subject folder and two or more photo folders of the
-    same person: read, check, run, write ``out_dir``.
+def joint_sfo(request):
+    """One joint SFO of the request's two or more photos of the same person (one soft tissue
+    shared by the photos, one camera each): read, check, run, write ``request.out``.
 
-    As :func:`sfo_on_folders`, with ``photo_dirs`` a list; writes ``result.json`` with
-    ``"joint": true`` and ``overlay_<photo id>.png`` per photo (:func:`write_joint_result`).
+    As :func:`single_sfo`; writes ``result.json`` with ``"joint": true`` and
+    ``overlay_<photo id>.png`` per photo (:func:`write_joint_result`).
 
     Returns
     -------
@@ -241,25 +216,19 @@ def joint_sfo_on_folders(
         An invalid input (naming the file), a method without a joint form, fewer than two
         photos, or a photo given twice.
     """
+    (method,) = request.methods
+    options = request.options
     check_joint_method(method, options.variant)
-    photo_dirs = [Path(d) for d in photo_dirs]
-    if len(photo_dirs) < 2:
+    if len(request.photos) < 2:
         raise ValueError("a joint SFO needs two or more --photo folders")
-    check_distinct_photos(photo_dirs)
-    for folder, read in ((skull_dir, read_skull), *((d, read_photo) for d in photo_dirs)):
-        if not Path(folder).is_dir():
-            read(folder)  # raises its "not a folder" message
-    skull, skull_inputs = load_skull(skull_dir, axes=axes)
-    skull = labelled_skull(skull, skull_inputs)
-    photos = [record.photo for record in load_photos(photo_dirs, skull=skull)]
-    for photo in photos:
-        check_inputs(skull, photo)
-    if depth_table is not None:
-        options, photos = with_depth_table(options, depth_table, photos)
-    calibrations = Calibrations(calibration)
-    result = run_joint_sfo(method, skull, photos, options, seed)
+    check_distinct_photos([source.path for source in request.photos])
+    skull, photos = _checked_inputs(request)
+    if request.depth_table is not None:
+        options, photos = with_depth_table(options, request.depth_table, photos)
+    calibrations = Calibrations(request.calibration)
+    result = run_joint_sfo(method, skull, photos, options, request.seed)
     result = with_identification(result, skull, photos, calibrations)
-    write_joint_result(out_dir, result, skull, photos, overlay=overlay)
+    write_joint_result(request.out, result, skull, photos, overlay=request.overlay)
     return result
 
 

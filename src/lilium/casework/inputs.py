@@ -34,6 +34,7 @@ from ..io.prepared import read_prepared
 from ..methods.photo_checks import check_distinct_photos, check_landmarks_in_mask
 from ..validation import check_prior, fmt_range
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
+from .request import PriorOverrides
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
@@ -52,10 +53,15 @@ def first_file(folder, names):
     return next((folder / n for n in names if (folder / n).is_file()), None)
 
 
-def load_skull(skull_path, landmarks=None, axes=None, log=None):
+def load_skull(source, log=None):
     """Read the skull from a subject folder or a mesh file.
 
-    ``log`` (a callable, optional) receives one line for a landmark file found beside a mesh.
+    Parameters
+    ----------
+    source : SkullSource
+        The skull as given (:class:`~lilium.casework.request.SkullSource`).
+    log : callable, optional
+        Receives one line for a landmark file found beside a mesh.
 
     Returns
     -------
@@ -66,9 +72,10 @@ def load_skull(skull_path, landmarks=None, axes=None, log=None):
     Raises
     ------
     ValueError
-        Also when ``axes`` is given but is not a file (it is never ignored).
+        Also when ``source.axes`` is given but is not a file (it is never ignored).
     """
-    skull_path = Path(skull_path)
+    landmarks, axes = source.landmarks, source.axes
+    skull_path = Path(source.path)
     if axes is not None:
         check_axes_file(axes)
     if skull_path.is_dir():
@@ -104,19 +111,6 @@ def load_skull(skull_path, landmarks=None, axes=None, log=None):
     return skull, inputs
 
 
-def _per_photo(values, n, option, allow_one=False):
-    if not values:
-        return [None] * n
-    if allow_one and len(values) == 1:
-        return values * n
-    if len(values) != n:
-        raise ValueError(
-            f"command line: {option} given {len(values)} times for {n} photo image(s); give it "
-            "once per --photo image (not folder), in the same order"
-        )
-    return list(values)
-
-
 def _sibling(image_path, stems, suffixes):
     for stem in stems:
         for suffix in suffixes:
@@ -135,38 +129,21 @@ def _check_interval(values, option, key):
     return None if values is None else check_prior(values, key, f"command line: {option}")
 
 
-def load_photos(
-    photos,
-    photo_landmarks=(),
-    masks=(),
-    views=(),
-    focal_px=None,
-    scd_mm=None,
-    use_exif=True,
-    sensor_width_mm=None,
-    face_curves=(),
-    log=None,
-    skull=None,
-    auto_landmarks=False,
-    out=None,
-):
+def load_photos(sources, priors=PriorOverrides(), log=None, skull=None, auto_landmarks=False,
+                out=None):
     """Read every photo (folders and image files) with its priors.
 
     Parameters
     ----------
-    photos : list of path
-        Photo folders (SPEC section 8) or PNG/JPEG images.
-    photo_landmarks, masks, face_curves : list of path
-        Per image file (not folder), in order; landmark files default to a sibling
-        ``<stem>.csv``/``.json``/``<stem>_landmarks.*``, masks to ``<stem>_mask.png``, facial
-        curves (``face_curve.json`` format) to ``<stem>_face_curve.json``.
-    views : list of str
-        Once for all images, or once per image (default frontal).
-    focal_px, scd_mm : (lo, hi), optional
-        Priors from the command line: they win over ``photo.json``; without a focal prior the
-        photo's EXIF gives one when ``use_exif``.
-    sensor_width_mm : float, optional
-        For the EXIF focal prior.
+    sources : sequence of PhotoSource
+        Photo folders or PNG/JPEG images, each with the files named for it
+        (:class:`~lilium.casework.request.PhotoSource`): an image's landmark file defaults to a
+        sibling ``<stem>.csv``/``.json``/``<stem>_landmarks.*``, its mask to
+        ``<stem>_mask.png``, its facial curve (``face_curve.json`` format) to
+        ``<stem>_face_curve.json``, its view to frontal.
+    priors : PriorOverrides
+        Priors given for every photo: they win over ``photo.json``; without a focal prior the
+        photo's EXIF gives one when ``priors.use_exif``.
     log : callable, optional
         Receives one line per sidecar file found beside an image (not named on the command
         line), e.g. ``"front: using mask front_mask.png (found beside the photo)"``, one per
@@ -191,24 +168,19 @@ def load_photos(
         landmarks (None for landmarks placed by hand). Each photo carries its priors' sources
         (``prior_sources``), its ``landmarks_file`` and its input warnings (:func:`with_priors`).
     """
-    photos = [Path(p) for p in photos]
-    image_files = [p for p in photos if not p.is_dir()]
-    lm_files = _per_photo(list(photo_landmarks), len(image_files), "--photo-landmarks")
-    masks = _per_photo(list(masks), len(image_files), "--mask")
-    curves = _per_photo(list(face_curves), len(image_files), "--face-curve")
-    view_for_all = views[0] if len(views or ()) == 1 else None
-    views = _per_photo(list(views), len(image_files), "--view", allow_one=True)
-    focal_cli = _check_interval(focal_px, "--focal-px", "focal_px")
-    scd_cli = _check_interval(scd_mm, "--scd-mm", "scd_mm")
-    records, k_file = [], 0
-    for path in photos:
+    focal_cli = _check_interval(priors.focal_px, "--focal-px", "focal_px")
+    scd_cli = _check_interval(priors.scd_mm, "--scd-mm", "scd_mm")
+    use_exif, sensor_width_mm = priors.use_exif, priors.sensor_width_mm
+    records = []
+    for source in sources:
+        path = Path(source.path)
         inputs, notes, facts, origin = {}, {}, None, None
         if path.is_dir():
             photo = read_photo(path)
-            if view_for_all is not None and view_for_all != photo.view:
+            if source.view is not None and source.view != photo.view:
                 raise ValueError(
                     f"{path / 'photo.json'}: view is {photo.view!r} but --view says "
-                    f"{view_for_all!r}; --view sets the view of image files, a photo folder's is "
+                    f"{source.view!r}; --view sets the view of image files, a photo folder's is "
                     "its photo.json's: edit it there (or leave --view out)"
                 )
             image = first_file(path, IMAGE_NAMES)
@@ -229,7 +201,7 @@ def load_photos(
             if path.suffix.lower() not in IMAGE_SUFFIXES:
                 raise ValueError(f"{path}: --photo must be a folder or a PNG/JPEG image")
             image = path
-            lm_file = lm_files[k_file] or _sibling(
+            lm_file = source.landmarks or _sibling(
                 path,
                 [path.stem, f"{path.stem}_landmarks", f"{path.stem}.landmarks"],
                 (".csv", ".json", ".tsv", ".txt"),
@@ -240,20 +212,20 @@ def load_photos(
                     "--photo-landmarks FILE (CSV name,u,v or JSON), once per --photo image, or "
                     "let --auto-landmarks find them (pip install 'lilium[photo]')"
                 )
-            if lm_file is not None and lm_files[k_file] is None:
+            if lm_file is not None and source.landmarks is None:
                 _found(log, path.stem, "facial landmarks", lm_file, "the photo")
-            mask = masks[k_file] or _sibling(
+            mask = source.mask or _sibling(
                 path, [f"{path.stem}_mask", f"{path.stem}.mask"], (".png",)
             )
-            if mask is not None and masks[k_file] is None:
+            if mask is not None and source.mask is None:
                 _found(log, path.stem, "mask", mask, "the photo")
-            curve = curves[k_file] or _sibling(path, [f"{path.stem}_face_curve"], (".json",))
-            if curve is not None and curves[k_file] is None:
+            curve = source.face_curve or _sibling(path, [f"{path.stem}_face_curve"], (".json",))
+            if curve is not None and source.face_curve is None:
                 _found(log, path.stem, "face curve", curve, "the photo")
-            view = views[k_file] or "frontal"
+            view = source.view or "frontal"
             if lm_file is None:  # --auto-landmarks: lilium photo into OUT/<photo>/prepared/
                 photo, inputs, facts = _prepared_image(
-                    path, _taken(records), out, views[k_file], mask, sensor_width_mm, log
+                    path, _taken(records), out, source.view, mask, sensor_width_mm, log
                 )
                 origin = landmark_origin(photo, facts)
                 view = photo.view
@@ -261,7 +233,6 @@ def load_photos(
                 photo = photo_from_files(path, lm_file, view, mask)
                 inputs["photo"] = path
                 inputs["facial landmarks"] = lm_file
-            k_file += 1
             if mask is not None:
                 inputs["face mask"] = mask
             if curve is not None:

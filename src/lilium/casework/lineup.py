@@ -24,7 +24,6 @@ from pathlib import Path
 from ..io.jsonio import write_json
 from ..io.paths import printable, safe_id
 from ..methods.checks import check_inputs
-from ..methods.options import SfoOptions
 from ..methods.registry import check_method, method_tag, run_sfo
 from .folders import (
     labelled_skull,
@@ -94,40 +93,17 @@ def rank_key(entry, first_method):
     )
 
 
-def run_lineup(
-    skull_path,
-    candidates,
-    out,
-    methods=("lilium",),
-    options=SfoOptions(),
-    seed=0,
-    calibration=None,
-    landmarks=None,
-    title=None,
-    command=None,
-    log=print,
-    progress=True,
-):
+def run_lineup(request, log=print):
     """Run every candidate's SFOs (or read them back), rank the candidates, write the report.
 
     Parameters
     ----------
-    skull_path : path
-        Subject folder or skull mesh.
-    candidates : list of (str, list of path)
-        Each candidate's name and photo folders (SPEC section 8) or images.
-    out : path
-    methods : sequence of str
-        The first one ranks the candidates; the others are shown beside it.
-    options : SfoOptions
-    seed : int
-    calibration : path, optional
-    landmarks : path, optional
-        Cranial landmark file (when ``skull_path`` is a mesh).
-    title, command : str, optional
+    request : CaseRequest
+        The skull, the ``candidates`` (each a name and photo folders or images), the methods
+        (the first one ranks the candidates; the others are shown beside it), their options and
+        seed, the calibration file, the title, ``progress`` (a progress bar over the SFOs) and
+        the output folder.
     log : callable
-    progress : bool
-        Show a progress bar over the SFOs.
 
     Returns
     -------
@@ -142,24 +118,25 @@ def run_lineup(
     """
     from ..report.html import write_report
 
+    candidates = [(c.name, [source.path for source in c.photos]) for c in request.candidates]
     check_candidates(candidates)
-    methods = list(dict.fromkeys(methods)) or ["lilium"]
+    methods, options, seed = list(request.methods), request.options, request.seed
     for method in methods:
         check_method(method, options.variant)
-    out = Path(out)
-    calibrations = Calibrations(calibration)
-    skull, skull_inputs = load_skull(skull_path, landmarks, log=log)
+    out = Path(request.out)
+    calibrations = Calibrations(request.calibration)
+    skull, skull_inputs = load_skull(request.skull, log=log)
     skull = labelled_skull(skull, skull_inputs)
     loaded = []
-    for name, photos in candidates:  # every input checked before the first SFO
-        records = load_photos(photos, log=log, skull=skull)
+    for candidate in request.candidates:  # every input checked before the first SFO
+        records = load_photos(candidate.photos, log=log, skull=skull)
         for record in records:
             check_inputs(skull, record.photo)
-        loaded.append((name, records))
+        loaded.append((candidate.name, records))
 
     with output_lock(out):
         run = _LineupRun(skull, skull_inputs, out, methods, options, seed, calibrations, log)
-        entries, ranking = run.all(loaded, progress)
+        entries, ranking = run.all(loaded, request.progress)
         first = method_tag(methods[0], options.variant)
         ranking.sort(key=lambda entry: rank_key(entry, first))
         for k, entry in enumerate(ranking, start=1):
@@ -172,9 +149,10 @@ def run_lineup(
              f"{e['method']}", e["identification"])
             for e in ranking
         ]
-        title = title or f"Lineup: skull {skull.id} against {len(candidates)} candidates"
+        title = request.title or f"Lineup: skull {skull.id} against {len(candidates)} candidates"
         report = write_report(
-            out / "report.html", entries, title=title, command=command, decisions=decisions
+            out / "report.html", entries, title=title, command=request.command,
+            decisions=decisions, request=request.to_dict(),
         )
     log(f"report: {report}")
     return ranking

@@ -3,7 +3,8 @@
 import time
 from pathlib import Path
 
-from .argtypes import dataset_folder, output_folder
+from .argtypes import dataset_folder
+from .options import add_options
 
 
 def register(subparsers):
@@ -20,7 +21,7 @@ def register(subparsers):
         ),
     )
     p.add_argument("db", type=Path, nargs="+", help="results databases of lilium experiment")
-    p.add_argument("--out", type=output_folder, required=True, help="output folder")
+    add_options(p, "out", required=("out",))
     p.add_argument(
         "--dataset",
         type=dataset_folder,

@@ -18,20 +18,9 @@ number of methods.
 """
 
 import argparse
-import shlex
-from pathlib import Path
 
 from ..casework.case import run_case
-from ..constants import VIEWS
-from ..methods import METHODS
-from .argtypes import output_folder, positive_float
-from .sfo import (
-    AXES_FILE,
-    DEPTH_TABLE_FILE,
-    add_calibration_option,
-    add_lilium_options,
-    options_from,
-)
+from .options import PHOTO_FILES, PRIORS, SFO, add_options, case_request
 
 #: What ``lilium case --help`` says after the options: the face mask, the sidecar files and
 #: the output layout (docs/conventions.md says the same, with a picture).
@@ -81,167 +70,24 @@ def register(subparsers):
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument(
-        "--skull",
-        required=True,
-        type=Path,
-        help="subject folder (SPEC section 8) or a skull mesh (PLY/OBJ/STL, mm)",
-    )
-    p.add_argument(
-        "--landmarks",
-        type=Path,
-        help="cranial landmarks: .mrk.json/.fcsv (3D Slicer), .pp (MeshLab), .csv, .json",
-    )
-    p.add_argument(
-        "--axes", type=AXES_FILE, help="soft-tissue axes JSON (default: the skull's own)"
-    )
-    p.add_argument(
-        "--photo",
-        required=True,
-        action="append",
-        type=Path,
-        help="photo folder or image (PNG/JPEG); repeat for several photos of the person",
-    )
-    p.add_argument(
-        "--auto-landmarks",
-        action="store_true",
-        help=(
-            "prepare each --photo image that has no landmark file (none given, none beside it) "
-            "with lilium photo into OUT/<photo>/prepared/ and use its tracked landmarks, head "
-            "mask and priors; the report says they are automatic and unreviewed (needs "
-            "pip install 'lilium[photo]')"
-        ),
-    )
-    p.add_argument(
-        "--photo-landmarks",
-        action="append",
-        type=Path,
-        default=[],
-        help="facial landmarks (CSV name,u,v or JSON) of each photo image, in --photo order",
-    )
-    p.add_argument(
-        "--mask",
-        action="append",
-        type=Path,
-        default=[],
-        help=(
-            "face mask PNG of each photo image, in --photo order: the head as seen (face, "
-            "forehead, hair, ears, down to the upper neck), see below"
-        ),
-    )
-    p.add_argument(
-        "--face-curve",
-        action="append",
-        type=Path,
-        default=[],
-        help=(
-            "facial curve JSON (face_curve.json format) of each photo image, in --photo order; "
-            "default NAME_face_curve.json beside the image, else derived from the mask"
-        ),
-    )
-    p.add_argument(
-        "--view",
-        action="append",
-        choices=VIEWS,
-        default=[],
-        help=(
-            "view of each photo image (once for all images, or once per image; default "
-            "frontal); photo folders take theirs from photo.json"
-        ),
-    )
-    p.add_argument("--out", required=True, type=output_folder, help="output folder")
-    p.add_argument(
-        "--method",
-        action="append",
-        choices=list(METHODS),
-        default=[],
-        help="method; repeat to run several (default lilium)",
-    )
-    add_lilium_options(p, de_defaults=False)
-    p.add_argument("--focal-px", type=float, nargs=2, metavar=("LO", "HI"), help="focal prior")
-    p.add_argument("--scd-mm", type=float, nargs=2, metavar=("LO", "HI"), help="SCD prior (mm)")
-    p.add_argument(
-        "--sensor-width-mm",
-        type=positive_float(),
-        help="camera sensor width, for the EXIF focal prior",
-    )
-    p.add_argument("--no-exif", action="store_true", help="do not take a focal prior from EXIF")
-    p.add_argument(
-        "--depth-table", type=DEPTH_TABLE_FILE, help="CSV: landmark,mean,sd,min,max (mm)"
-    )
+    add_options(p, "skull", "landmarks", "axes", "photo", "auto_landmarks", *PHOTO_FILES, "out",
+                *SFO, *PRIORS, "depth_table", required=("skull", "photo", "out"),
+                shown={"method": "lilium"})
     p.add_argument(
         "--joint",
         action="store_true",
         help=(
             "run Lilium as one joint SFO of all the photos (two or more of the same person): "
             "one soft tissue shared by the photos, one camera each; outputs in "
-            "DIR/joint/lilium-<variant>/ (SPEC section 9). Measured: 0.87-0.98 x the separate "
-            "SFOs' BPE on generated subjects, level on a real CT head, where more of its "
-            "overlays leave the face (docs/method.md)"
+            "DIR/joint/lilium-<variant>/. Measured: 0.87-0.98 x the separate SFOs' BPE on "
+            "generated subjects, level on a real CT head, where more of its overlays leave the "
+            "face (docs/method.md)"
         ),
     )
-    add_calibration_option(p)
-    p.add_argument("--title", help="report title")
+    add_options(p, "calibration", "title")
     p.set_defaults(func=run)
 
 
-def command_line(args, methods):
-    """The ``lilium case`` command line equivalent to ``args`` (for the provenance)."""
-    parts = ["lilium", "case", "--skull", str(args.skull)]
-    for option in ("landmarks", "axes", "depth_table", "calibration"):
-        if getattr(args, option) is not None:
-            parts += [f"--{option.replace('_', '-')}", str(getattr(args, option))]
-    for photo in args.photo:
-        parts += ["--photo", str(photo)]
-    if args.auto_landmarks:
-        parts.append("--auto-landmarks")
-    for option in ("photo_landmarks", "mask", "face_curve", "view"):
-        for value in getattr(args, option):
-            parts += [f"--{option.replace('_', '-')}", str(value)]
-    for method in methods:
-        parts += ["--method", method]
-    if "lilium" in methods:
-        parts += ["--variant", args.variant, "--seed", str(args.seed)]
-        for option in ("generations", "population", "max_seconds"):
-            if getattr(args, option) is not None:
-                parts += [f"--{option.replace('_', '-')}", f"{getattr(args, option):g}"]
-    for option in ("focal_px", "scd_mm"):
-        if getattr(args, option) is not None:
-            parts += [f"--{option.replace('_', '-')}", *(f"{x:g}" for x in getattr(args, option))]
-    if args.sensor_width_mm is not None:
-        parts += ["--sensor-width-mm", f"{args.sensor_width_mm:g}"]
-    if args.no_exif:
-        parts.append("--no-exif")
-    if getattr(args, "joint", False):
-        parts.append("--joint")
-    parts += ["--out", str(args.out)]
-    return " ".join(shlex.quote(p) for p in parts)
-
-
 def run(args):
-    methods = list(dict.fromkeys(args.method)) or ["lilium"]
-    entries = run_case(
-        args.skull,
-        args.photo,
-        args.out,
-        landmarks=args.landmarks,
-        axes=args.axes,
-        methods=methods,
-        options=options_from(args),
-        seed=args.seed,
-        depth_table=args.depth_table,
-        title=args.title,
-        command=command_line(args, methods),
-        photo_landmarks=args.photo_landmarks,
-        masks=args.mask,
-        face_curves=args.face_curve,
-        views=args.view,
-        focal_px=args.focal_px,
-        scd_mm=args.scd_mm,
-        use_exif=not args.no_exif,
-        sensor_width_mm=args.sensor_width_mm,
-        auto_landmarks=args.auto_landmarks,
-        joint=args.joint,
-        calibration=args.calibration,
-    )
+    entries = run_case(case_request(args))
     return 0 if all(e.result for e in entries) else 1

@@ -3,14 +3,12 @@
 import time
 from pathlib import Path
 
-from .argtypes import output_folder, seed
+from .options import add_options
 
 
 def register(subparsers):
     p = subparsers.add_parser("demo", help="run a demo SFO on built-in data", description=__doc__)
-    p.add_argument("--out", type=output_folder, default=Path("lilium-demo"), help="output folder")
-    p.add_argument("--seed", type=seed, default=0)
-    p.add_argument("--variant", default="skof+pll", help="Lilium variant (default skof+pll)")
+    add_options(p, "out", "seed", "variant", out=Path("lilium-demo"))
     p.set_defaults(func=run)
 
 

@@ -3,6 +3,7 @@
 from pathlib import Path
 
 from ..experiments.config import PRESETS
+from .options import add_options
 
 
 def register(subparsers):
@@ -22,20 +23,16 @@ def register(subparsers):
         metavar="ADDRESS",
         help="run on this Dask distributed scheduler (e.g. tcp://host:8786) instead of locally",
     )
-    p.add_argument(
-        "--workers", type=int, help="local worker processes (default: the config's; 0 = all cores)"
-    )
+    add_options(p, "workers", shown={"workers": "the config's"})
     p.add_argument("--db", type=Path, help="results database (default: the config's)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_options(p, "no_progress")
     p.set_defaults(func=run)
 
 
 def run(args):
-    from ..experiments.config import check_int, load_config
+    from ..experiments.config import load_config
     from ..experiments.runner import run_experiment
 
-    if args.workers is not None:
-        check_int("--workers (0 = all cores)", args.workers, "workers")
     cfg = load_config(args.config)
     summary = run_experiment(
         cfg,

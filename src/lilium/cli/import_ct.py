@@ -1,6 +1,7 @@
 """``lilium import-ct``: a CT volume to a subject folder (skull.ply, face.ply, landmarks)."""
 
 from .argtypes import int_in
+from .options import add_options
 
 
 def _numbers(text, n, kind, name):
@@ -39,7 +40,7 @@ def register(subparsers):
         ),
     )
     p.add_argument("volume", help="volume file, DICOM folder, or raw files / glob pattern")
-    p.add_argument("--out", required=True, help="subject folder to write")
+    add_options(p, "out", required=("out",))
     p.add_argument(
         "--bone-iso",
         type=float,

@@ -107,6 +107,7 @@ def main(argv=None):
     except KeyboardInterrupt:  # Ctrl-C while the commands' modules are imported
         print(f"{_prog(argv)}: interrupted", file=sys.stderr)
         return 130
+    args.argv = [str(a) for a in (sys.argv[1:] if argv is None else argv)]  # the provenance
     debug = os.environ.get(DEBUG_ENV, "") not in ("", "0")
     try:
         with warnings.catch_warnings():

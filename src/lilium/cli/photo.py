@@ -10,7 +10,8 @@ import time
 from pathlib import Path
 
 from ..constants import VIEWS
-from .argtypes import int_in, positive_float
+from .argtypes import int_in
+from .options import add_options
 
 #: Exit status when no face was found but the folder was written for marking by hand.
 EXIT_NO_FACE = 3
@@ -29,18 +30,14 @@ def register(subparsers):
         ),
     )
     p.add_argument("image", type=Path, help="the photograph (PNG or JPEG)")
-    p.add_argument("--out", required=True, type=Path, help="photo folder to write")
+    add_options(p, "out", required=("out",))
     p.add_argument("--view", choices=VIEWS, help="default: from the head's yaw")
     p.add_argument(
         "--landmarks",
         type=Path,
         help="reviewed landmarks (review.html's landmarks.json, or any SPEC facial file)",
     )
-    p.add_argument(
-        "--sensor-width-mm",
-        type=positive_float(),
-        help="sensor long side (mm), for the EXIF focal",
-    )
+    add_options(p, "sensor_width_mm")
     p.add_argument(
         "--face",
         type=int_in(1, why=" (faces are numbered from the left, 1 = the leftmost)"),

@@ -1,10 +1,12 @@
 """``lilium synth``: generate a synthetic evaluation dataset (subjects, photos A/B/C)."""
 
 import argparse
+import os
 import time
 from pathlib import Path
 
-from .argtypes import int_in, output_folder, seed
+from .argtypes import int_in
+from .options import add_options
 
 #: ``--subjects``, ``--photos``: as an experiment config's ``dataset.subjects`` / ``photos``; a
 #: typing slip (100000000) would otherwise generate for days.
@@ -63,21 +65,19 @@ def register(subparsers):
             "writes OUT/subjects, OUT/photos/<exp> and OUT/dataset.json."
         ),
     )
-    p.add_argument("--out", required=True, type=output_folder, help="output folder")
+    add_options(p, "out", required=("out",))
     p.add_argument("--subjects", type=COUNT, default=17, help="number of subjects (default 17)")
     p.add_argument(
         "--photos", type=COUNT, default=30, help="frontal (and lateral) photos per subject"
     )
-    p.add_argument("--seed", type=seed, default=0)
+    add_options(p, "seed")
     p.add_argument(
         "--experiments",
         type=experiment_list,
         default="A,B,C",
         help="comma-separated noise profiles (default A,B,C)",
     )
-    p.add_argument(
-        "--workers", type=int_in(1, 256), default=2, help="processes over subjects (default 2)"
-    )
+    add_options(p, "workers", workers=2)
     p.add_argument(
         "--no-mandible-share",
         type=fraction(closed=True),
@@ -99,7 +99,7 @@ def register(subparsers):
         ),
     )
     p.add_argument("--contact-sheet", type=Path, help="also write a contact sheet PNG here")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_options(p, "no_progress")
     p.set_defaults(func=run)
 
 
@@ -127,7 +127,7 @@ def run(args):
             seed=args.seed,
             experiments=experiments,
             progress=progress,
-            workers=args.workers,
+            workers=args.workers or os.cpu_count() or 1,
             no_mandible_share=args.no_mandible_share,
             drop_landmark_rate=args.drop_landmark_rate,
         )

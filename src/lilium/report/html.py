@@ -503,6 +503,8 @@ def format_report(page):
     provenance.append(["report date (UTC)", _e(page.date)])
     if page.command:
         provenance.append(["command", f"<code>{_e(page.command)}</code>"])
+    if page.request:
+        provenance.append(["request", f"<code>{_e(page.request)}</code>"])
     return _fill(
         "report.html",
         title=_e(page.title),
@@ -523,7 +525,7 @@ def format_report(page):
     )
 
 
-def build_report(entries, title=None, command=None, date=None, decisions=()):
+def build_report(entries, title=None, command=None, date=None, decisions=(), request=None):
     """The report's HTML text.
 
     Parameters
@@ -537,13 +539,18 @@ def build_report(entries, title=None, command=None, date=None, decisions=()):
         ISO date-time; now (UTC) by default.
     decisions : sequence of (str, dict), optional
         Identifications of several photos taken together (:func:`report_record`).
+    request : dict, optional
+        The run's request, for the provenance (:func:`report_record`).
 
     Returns
     -------
     str
     """
     return format_report(
-        report_record(entries, title=title, command=command, date=date, decisions=decisions)
+        report_record(
+            entries, title=title, command=command, date=date, decisions=decisions,
+            request=request,
+        )
     )
 
 

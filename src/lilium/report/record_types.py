@@ -278,6 +278,7 @@ class ReportRecord:
     date : str
         ISO date-time (UTC).
     command : str or None
+        The command line as typed.
     skull_ids : tuple of str
     versions : tuple of (str, str)
         Python, platform and package versions.
@@ -288,6 +289,8 @@ class ReportRecord:
         The identifications (SPEC section 12), shown first: a label, the anchor of the section
         that shows it ("" for none) and the ``"identification"`` record; every photo's SFO, every
         joint SFO and, with several photos, their separate SFOs taken together.
+    request : str or None
+        The run's request as JSON (:meth:`lilium.casework.request.CaseRequest.to_dict`).
     """
 
     title: str
@@ -298,6 +301,7 @@ class ReportRecord:
     sfos: tuple
     joints: tuple = ()
     decisions: tuple = ()
+    request: str | None = None
 
     @property
     def lilium_version(self):

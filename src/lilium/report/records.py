@@ -10,6 +10,7 @@ camera follow :class:`lilium.geometry.camera.Camera` (``x_cam = R x_skull + t``)
 """
 
 import datetime as _dt
+import json
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -315,7 +316,7 @@ def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
     )
 
 
-def report_record(entries, title=None, command=None, date=None, decisions=()):
+def report_record(entries, title=None, command=None, date=None, decisions=(), request=None):
     """The plain record of a report page.
 
     Parameters
@@ -331,6 +332,9 @@ def report_record(entries, title=None, command=None, date=None, decisions=()):
     decisions : sequence of (str, dict), optional
         Identifications of several photos' SFOs taken together (label, record), shown first
         beside each SFO's own.
+    request : dict, optional
+        The run's request (:meth:`lilium.casework.request.CaseRequest.to_dict`), for the
+        provenance.
 
     Returns
     -------
@@ -359,7 +363,10 @@ def report_record(entries, title=None, command=None, date=None, decisions=()):
         for i, e in enumerate(entries, start=1)
         if e.joint is None and "identification" in e.result.extra
     ]
-    return ReportRecord(title, date, command, skull_ids, versions, sfos, joints, tuple(found))
+    request = None if request is None else json.dumps(request, sort_keys=True)
+    return ReportRecord(
+        title, date, command, skull_ids, versions, sfos, joints, tuple(found), request
+    )
 
 
 def _unique_joints(entries):
