@@ -99,14 +99,15 @@ def run_case(
         before reading anything, when ``lilium[photo]`` is not installed.
     joint : bool
         Run each method that has a joint form (Lilium) as one joint SFO of all the photos
-        (SPEC section 9: one soft tissue shared by the photos, one camera each), written to
+        (docs/method/joint.md: one soft tissue shared by the photos, one camera each), written to
         ``<out>/joint/<method tag>/`` (``result.json`` with ``"joint": true`` and
         ``overlay_<photo id>.png`` per photo); the other methods run per photo as usual. The
         report shows every photo's overlay and terms from the shared soft tissue, and its 3D
         facial landmarks. Needs two or more distinct photos.
     calibration : path, optional
         Identification calibration file (default: the shipped one). Every result gets its
-        ``"identification"`` (SPEC section 12); with several photos, each method's separate
+        ``"identification"`` (docs/method/identification.md); with several photos, each method's
+        separate
         SFOs are also taken together as one decision (shared soft tissue), shown first in the
         report and logged.
 

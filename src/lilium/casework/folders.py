@@ -1,4 +1,4 @@
-"""One SFO on case folders (SPEC section 8): read, check, run, write ``result.json``; and
+"""One SFO on case folders (docs/contract.md): read, check, run, write ``result.json``; and
 what lets ``lilium case`` and ``lilium lineup`` resume: each stored result's input fingerprint
 (:func:`sfo_fingerprint`), the test that a stored result is this SFO's (:func:`stored_result`),
 and the lock that keeps a second run off an output folder (:func:`output_lock`).
@@ -78,8 +78,8 @@ def sfo_on_folders(
     The photo's priors come from ``photo.json``, or its focal prior from the image's EXIF
     (:func:`~lilium.casework.inputs.with_priors`), those of a ``lilium photo`` folder with
     ``"source": "automatic"`` and its head orientation converted through the skull's frame
-    (:func:`~lilium.casework.prepared.with_automatic_priors`); the left/right checks of SPEC
-    section 10 run before the SFO (:func:`~lilium.methods.checks.check_inputs`).
+    (:func:`~lilium.casework.prepared.with_automatic_priors`); the left/right checks of
+    docs/checks.md run before the SFO (:func:`~lilium.methods.checks.check_inputs`).
 
     Parameters
     ----------
@@ -134,7 +134,7 @@ def joint_overlay_name(photo_id):
 
 def write_joint_result(out_dir, result, skull, photos, overlay=True):
     """Write a joint SFO's ``overlay_<photo id>.png`` per photo (the photo's plain image when
-    its camera failed), then its ``result.json`` (SPEC section 9).
+    its camera failed), then its ``result.json`` (docs/method/joint.md).
 
     As :func:`~lilium.io.results.write_result`: an earlier ``result.json`` and the overlays of
     an earlier SFO (:func:`~lilium.io.results.remove_overlays`, a single one's too) are removed
@@ -225,7 +225,7 @@ def joint_sfo_on_folders(
     overlay=True,
     calibration=None,
 ):
-    """One joint SFO (SPEC section 9) of a subject folder and two or more photo folders of the
+    """One joint SFO (docs/method/joint.md) of a subject folder and two or more photo folders of the
     same person: read, check, run, write ``out_dir``.
 
     As :func:`sfo_on_folders`, with ``photo_dirs`` a list; writes ``result.json`` with

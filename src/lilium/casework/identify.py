@@ -1,4 +1,5 @@
-"""The identification of a case's SFO results (SPEC section 12): terms, calibrated log10 LR and
+"""The identification of a case's SFO results (docs/method/identification.md): terms, calibrated
+log10 LR and
 the conclusion, for one photo, a joint SFO, or a person's photos taken together.
 
 Which calibration model a decision uses (``lilium/data/calibration.json`` unless the user
@@ -9,7 +10,8 @@ with ``<method>/<variant>/pair_sum`` (a slope and an offset fitted on same- and
 different-person pairs instead of assuming the photos independent, which they are not: they
 share the soft tissue; Lilium's slope came out above 1, each photo's own model being
 conservative; without that model, the plain sum, and the note says so).
-Measured on 52 generated subjects (docs/method.md): Cllr 0.242 against 0.265 for the plain
+Measured on 52 generated subjects (docs/decisions/0014-identification-several-photos.md): Cllr 0.242
+against 0.265 for the plain
 sum and 0.417 for one model of both photos with their soft tissue shared. Any other two or
 more photos use ``<method>/<variant>/pair``
 (that shared-soft-tissue model, fitted on a frontal and a lateral photo; the result says so).

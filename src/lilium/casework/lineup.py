@@ -1,4 +1,5 @@
-"""A lineup (SPEC section 12): one skull against several candidate persons, each with one or
+"""A lineup (docs/method/identification.md): one skull against several candidate persons, each with
+one or
 more photos, ranked by the identification's likelihood ratio in one report.
 
 The usual case of a found skull and a missing-persons list. Every photo of every candidate
@@ -115,7 +116,7 @@ def run_lineup(
     skull_path : path
         Subject folder or skull mesh.
     candidates : list of (str, list of path)
-        Each candidate's name and photo folders (SPEC section 8) or images.
+        Each candidate's name and photo folders (docs/contract.md) or images.
     out : path
     methods : sequence of str
         The first one ranks the candidates; the others are shown beside it.

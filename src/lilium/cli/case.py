@@ -1,6 +1,6 @@
 """``lilium case``: superimpose one skull on one or more photos and report them together.
 
-Inputs are SPEC section 8 folders or the files a practitioner already has::
+Inputs are docs/contract.md folders or the files a practitioner already has::
 
     lilium case --skull SUBJECT_DIR --photo PHOTO_DIR [--photo PHOTO_DIR ...] --out DIR
     lilium case --skull SUBJECT_DIR --auto-landmarks --photo portrait.jpg --out DIR
@@ -34,7 +34,7 @@ from .sfo import (
 )
 
 #: What ``lilium case --help`` says after the options: the face mask, the sidecar files and
-#: the output layout (docs/conventions.md says the same, with a picture).
+#: the output layout (docs/conventions.md and docs/contract.md say the same).
 EPILOG = """\
 face mask (--mask FILE, NAME_mask.png beside an image, face_mask.png in a photo folder):
   a PNG of the photo's size, non-zero on the head as seen in the photo: the face, the
@@ -53,12 +53,12 @@ sidecar files (used when the option is not given; each one found is printed, e.g
                             --mask), NAME_face_curve.json (facial curve, --face-curve)
   in a photo folder         image.png/.jpg, photo.json, face_mask.png, face_curve.json
 
-automatic landmarks (lilium photo, SPEC section 11): a folder written by lilium photo is a
+automatic landmarks (lilium photo, docs/method/photo.md): a folder written by lilium photo is a
   photo folder; its tracked landmarks are used, its template ones only once confirmed in
   review.html, its priors with "source": "automatic", its head orientation turned into
   head_rotation_skull2cam through the skull's frame. --auto-landmarks prepares each bare
   image itself into OUT/<photo>/prepared/ (nothing is written beside the image); the report
-  says the landmarks are automatic and unreviewed and links the review page (docs/photo.md).
+  says the landmarks are automatic and unreviewed and links the review page (docs/method/photo.md).
 
 facial curve (face_curve.json format): {"chin_jaw": [[u, v], ...]} for a frontal photo,
   {"forehead": [[u, v], ...]} for a lateral one (pixels); without one, the pll variants
@@ -85,7 +85,7 @@ def register(subparsers):
         "--skull",
         required=True,
         type=Path,
-        help="subject folder (SPEC section 8) or a skull mesh (PLY/OBJ/STL, mm)",
+        help="subject folder (docs/contract.md) or a skull mesh (PLY/OBJ/STL, mm)",
     )
     p.add_argument(
         "--landmarks",
@@ -175,9 +175,9 @@ def register(subparsers):
         help=(
             "run Lilium as one joint SFO of all the photos (two or more of the same person): "
             "one soft tissue shared by the photos, one camera each; outputs in "
-            "DIR/joint/lilium-<variant>/ (SPEC section 9). Measured: 0.87-0.98 x the separate "
+            "DIR/joint/lilium-<variant>/. Measured: 0.87-0.98 x the separate "
             "SFOs' BPE on generated subjects, level on a real CT head, where more of its "
-            "overlays leave the face (docs/method.md)"
+            "overlays leave the face (docs/method/joint.md)"
         ),
     )
     add_calibration_option(p)

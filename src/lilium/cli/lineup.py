@@ -18,7 +18,7 @@ def register(subparsers):
         description=(
             "Runs the SFO of the skull on every photo of every candidate, takes each "
             "candidate's photos together, ranks the candidates by the identification's log10 "
-            "LR (SPEC section 12) and writes OUT/report.html (the ranking first, then every "
+            "LR and writes OUT/report.html (the ranking first, then every "
             "overlay), OUT/lineup.json and OUT/<candidate>/<photo>/<method>/result.json. "
             "Resumable: run the same command again after an interruption."
         ),

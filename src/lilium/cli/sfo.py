@@ -1,7 +1,7 @@
 """``lilium sfo``: one skull-face overlay from a subject folder and a photo folder.
 
 With two or more ``--photo`` folders of the same person, ``--method lilium`` runs one joint SFO
-(SPEC section 9): one soft tissue shared by the photos, one camera each; ``OUT/result.json``
+(docs/method/joint.md): one soft tissue shared by the photos, one camera each; ``OUT/result.json``
 has ``"joint": true`` and a ``photos`` list, with ``OUT/overlay_<photo id>.png`` per photo.
 """
 
@@ -42,14 +42,14 @@ def register(subparsers):
             '("joint": true) and OUT/overlay_<photo id>.png per photo.'
         ),
     )
-    p.add_argument("--skull", required=True, type=Path, help="subject folder (SPEC section 8)")
+    p.add_argument("--skull", required=True, type=Path, help="subject folder (docs/contract.md)")
     p.add_argument(
         "--photo",
         required=True,
         action="append",
         type=Path,
         help=(
-            "photo folder (SPEC section 8); repeat for a joint SFO of several photos of the "
+            "photo folder (docs/contract.md); repeat for a joint SFO of several photos of the "
             "same person (--method lilium)"
         ),
     )
@@ -138,14 +138,14 @@ def run(args):
         f"{name}: focal {result.camera.focal_px:.0f} px, score {result.fitness:.3f}, "
         f"{result.seconds:.2f} s -> {args.out}"
     )
-    for term, why in result.terms_off.items():  # inputs missing: ran without it (SPEC 5)
+    for term, why in result.terms_off.items():  # inputs missing: ran without it
         print(f"  {term} switched off: {why}")
     print(conclusion_line(result.extra["identification"]))
     return 0
 
 
 def run_joint(args):
-    """``lilium sfo`` with two or more ``--photo``: one joint SFO (SPEC section 9)."""
+    """``lilium sfo`` with two or more ``--photo``: one joint SFO (docs/method/joint.md)."""
     if args.method != "lilium":
         raise ValueError(
             f"--method {args.method}: a joint SFO of {len(args.photo)} photos runs with --method "
