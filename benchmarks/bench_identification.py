@@ -22,13 +22,15 @@ again continues, or only prints when all is stored), and prints:
 
 Then, over every database pooled: each decision's cross-validated log10 LR (Cllr, Cllr_min,
 misleading evidence, wrong conclusions), the shipped logistic calibration beside the
-bi-Gaussianized one (SPEC section 12), where the misleading evidence falls (the equal error
+bi-Gaussianized one (docs/method/identification.md), where the misleading evidence falls (the equal
+error
 rate no calibration can beat, and look-alike skulls: ``lookalikes.py``), the rankings by the
 LR, and with ``--headsq`` the headsq CT's conclusions.
 
 At the full budget (DE 30 x 750, 8 subjects: 128 SFOs per method, 640 in all) it took 438 s on
 2 workers and 936 s on one (measured); ``--generations 3 --subjects 3`` checks the pipeline in
-under a minute. Results and their discussion: docs/method.md, "Identification on frontal photos".
+under a minute. Results and their discussion:
+docs/decisions/0012-identification-marginal-likelihood.md.
 """
 
 import argparse
@@ -269,7 +271,7 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
 
 def print_terms_comparison(decision_pairs, validated, file=sys.stdout):
     """What leaving the cohort terms out of the calibration costs on generated subjects (they
-    do not transfer to real photos, docs/identification.md): every decision's cross-validated
+    do not transfer to real photos, docs/method/identification.md): every decision's cross-validated
     AUC, Cllr and misleading evidence with the shipped terms beside the same with the cohort
     terms and ``landmark_snorm`` (the same folds; ``validated`` holds the first)."""
     cohort = validate(decision_pairs, names=COHORT_CALIBRATED_TERMS)
@@ -290,7 +292,8 @@ def print_terms_comparison(decision_pairs, validated, file=sys.stdout):
 
 def print_calibration_comparison(decision_pairs, validated, file=sys.stdout):
     """Every decision's logistic regression beside its bi-Gaussianized one (Morrison 2024;
-    SPEC section 12 names both), the same folds: Cllr and misleading evidence, cross-validated.
+    docs/method/identification.md names both), the same folds: Cllr and misleading evidence,
+    cross-validated.
     The shipped models warp the decisions of :data:`lilium.experiments.calibrate.WARPED` only
     (``validated``, the LR tables' figures, from :func:`validate`)."""
     logistic = validate(decision_pairs, warped=frozenset())

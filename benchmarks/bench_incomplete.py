@@ -21,8 +21,8 @@ and view:
     python benchmarks/bench_incomplete.py --subjects 8 --jobs 2
     python benchmarks/bench_incomplete.py --data DIR   # reuse DIR/complete, DIR/no_mandible
 
-The photos' focal lengths are below 6,000 px (the paper's ranges), so the focal cap of SPEC
-section 4 does not bind here; were it to, the ``ran`` and ``f max`` columns would show it.
+The photos' focal lengths are below 6,000 px (the paper's ranges), so the focal cap of
+docs/method/pose.md does not bind here; were it to, the ``ran`` and ``f max`` columns would show it.
 """
 
 import argparse

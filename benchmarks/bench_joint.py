@@ -27,7 +27,8 @@ the fix; issue 16 asked for 0.9 x).
 intervals (same widths) so that the truth lies at a uniform position in the central 80 % of
 each, drawn per photo from ``--priors-seed`` (the same priors for the independent and the
 joint SFOs); the paper's protocol (the default, ``centred``) centres them on the truth, which
-a case's priors do not promise (docs/method.md, "The joint SFO's cameras on the edge of the
+a case's priors do not promise (docs/decisions/0010-joint-sfo-cameras-on-prior-edges.md, "The joint
+SFO's cameras on the edge of the
 priors"). The head orientation prior stays the true rotation.
 
 ``--headsq DIR`` adds the headsq real-anatomy case (issue 27, ``benchmarks/headsq_case.py``; its

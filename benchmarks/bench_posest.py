@@ -38,7 +38,8 @@ SFO problems (``--sfo``): the positive pairs of Exp. C made by the project's gen
 as POSEST-SFO hands them to POSEST (:mod:`sfo_problems`: the photo's visible landmarks with
 +-5 px noise, 3D points = cranial landmark + population mean depth along the subject's axes set
 C1, each true soft-tissue direction turned by up to 30 degrees; frontal and lateral photos; 6-22
-points). Scored by BPE (mm, SPEC section 7) against the truth and the failure rate (no camera or
+points). Scored by BPE (mm, docs/method/evaluation.md) against the truth and the failure rate (no
+camera or
 f > 10,000 px), for ``pycolmap`` (``estimate_and_refine_absolute_pose``: LO-RANSAC over P4Pf,
 12 px threshold, focal refined, its default refinement: Cauchy loss of scale 1 px) and POSEST
 with the settings of :data:`SFO_VARIANTS` (prototypes of decisions, through the public

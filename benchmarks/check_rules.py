@@ -1,4 +1,4 @@
-"""Run the SPEC section 10 checks over a whole generated dataset: no generated case may trip
+"""Run the docs/checks.md checks over a whole generated dataset: no generated case may trip
 a rule.
 
 For every photo of every experiment of a ``lilium synth`` dataset, against its own skull (with

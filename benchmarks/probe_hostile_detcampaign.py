@@ -60,11 +60,12 @@ TIMING_COLUMNS = {"id", "seconds", "task_seconds", "worker", "finished_at"}
 #: ``result`` JSON keys of the same kind.
 TIMING_KEYS = {"seconds"}
 
-#: The identification terms docs/method.md "Known limits" says depend on the first skull a
+#: The identification terms docs/method/identification.md says depend on the first skull a
 #: worker scored against a photo.
 COHORT_TERMS = ("cohort_mean", "cohort_sd")
 
-#: Their documented spread between two runs of identical SFOs (docs/method.md: "0.015 at most").
+#: Their documented spread between two runs of identical SFOs (docs/method/identification.md: "0.015
+#: at most").
 COHORT_BOUND = 0.015
 
 #: ``summary.csv`` columns of time per SFO.

@@ -1,6 +1,7 @@
 """The comparisons of the determinism probes (``probe_hostile_determinism.py``): the stored
 rows of two databases key by key (every stored value, the timing columns and the cohort terms
-aside; the cohort terms measured apart, against docs/method.md's bound), two report or
+aside; the cohort terms measured apart, against docs/method/identification.md's bound), two report
+or
 calibration folders file by file (CSV cell by cell, JSON parsed, some keys or columns left
 out), and two datasets file by file; each as a probe's ``check``.
 """
@@ -143,7 +144,8 @@ def _same_rows(kind, compare_to=_ref_db):
 
 
 def _cohort_known_limit(ws):
-    """Check: the run's rows equal the reference's except the cohort terms (docs/method.md
+    """Check: the run's rows equal the reference's except the cohort terms
+    (docs/method/identification.md
     "Known limits"); how much those differ is kept (:data:`MEASURED`), with a note where it
     is more than :data:`COHORT_BOUND`, the largest difference the docs measured."""
     ref, mine = _load(_ref_db(ws)), _load(ws.out / "r.sqlite")
@@ -175,7 +177,7 @@ def _cohort_known_limit(ws):
             lines.append(f"{term}: equal on every row")
     if worst > COHORT_BOUND:
         lines.append(
-            f"up to {worst:.3g}: more than the {COHORT_BOUND} docs/method.md "
+            f"up to {worst:.3g}: more than the {COHORT_BOUND} docs/method/identification.md "
             "measured on the joint database"
         )
     MEASURED[ws.root.name] = "; ".join(lines)

@@ -18,7 +18,8 @@ landmarks, warnings, identification terms; the timing columns and the worker's n
 - ``lilium calibrate`` twice on one database, on the same rows stored in another order, and
   on two databases given in the other order.
 
-docs/method.md ("Known limits") says the stored cohort terms (``cohort_mean``, ``cohort_sd``)
+docs/method/identification.md (cohorts) says the stored cohort terms (``cohort_mean``,
+``cohort_sd``)
 depend a little on which skull a worker scored first; they are left out of the row comparisons
 above and measured by one probe of their own (``det known limit: ...``), which passes while they
 stay within the documented bound (0.015 at most) and every other stored value is equal. The

@@ -1,4 +1,5 @@
-"""Metamorphic probes (SPEC sections 10-12): one case under a transformation that must not
+"""Metamorphic probes (docs/checks.md, docs/method/photo.md, docs/method/identification.md): one
+case under a transformation that must not
 change the answer, beyond the DE's own seed noise. A photo resampled 0.5x/2x with its
 landmarks, mask and pixel priors, a canvas padded or cropped off-centre, the landmark rows
 permuted or written with other names or in another format, the skull moved rigidly, its

@@ -59,7 +59,8 @@ def _rank_key(entry, first):
 
 def _lineup_extra(expect_tie=False, expect_failed=None, order=None):
     """The lineup's own checks: ``lineup.json``'s order follows its LRs (README: ranked by LR;
-    docs/method.md: ties at the bound by the views' sum, then the score), its entries are the
+    docs/method/identification.md: ties at the bound by the views' sum, then the score), its entries
+    are the
     candidates' ``result.json`` identifications, the report's ranking rows and the console's
     say the same. ``expect_tie``: two candidates must tie on the LR (a probe of tie-breaking);
     ``expect_failed``: that candidate's decision is undetermined without an LR; ``order``: the

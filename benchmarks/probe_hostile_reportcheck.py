@@ -323,7 +323,8 @@ def _load_results(rep, sec, facts):
         if part is None:
             return None, data, True
         # A joint result's photo: the method and the 3D landmarks are the whole SFO's; its
-        # "fitness" is its weighted share (SPEC 9), the section shows its own, unweighted.
+        # "fitness" is its weighted share (docs/method/joint.md), the section shows its own,
+        # unweighted.
         part = {**part, "method": data.get("method"), "variant": data.get("variant"),
                 "facial_landmarks_3d": data.get("facial_landmarks_3d"),
                 "fitness": part.get("fitness_unweighted", part.get("fitness"))}  # fmt: skip

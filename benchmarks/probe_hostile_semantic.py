@@ -1,4 +1,4 @@
-"""Semantic probes, run by ``probe_hostile.py`` (SPEC section 10): valid files that do not
+"""Semantic probes, run by ``probe_hostile.py`` (docs/checks.md): valid files that do not
 belong together. Every file passes its own checks (names, sizes, ranges); what is wrong is
 their relation: a landmark file of another photo, the mask of another photo or an inverted
 one, a lateral photo declared frontal (or the other side), the cranial landmarks of another

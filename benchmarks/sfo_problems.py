@@ -5,7 +5,7 @@ visible 2D landmarks moved by up to +-5 px per coordinate, and 3D points = the s
 landmarks pushed by the population *mean* depth along the subject's first perturbed axes set
 (``axes_C1``: each true soft-tissue direction turned by up to 30 degrees). The truth is the photo
 camera and the subject's true facial landmarks; an estimate is scored by BPE (mm) over every
-facial landmark, visible or not, at its noise-free image point (SPEC section 7).
+facial landmark, visible or not, at its noise-free image point (docs/method/evaluation.md).
 
 The seeds follow :func:`lilium.synthetic.dataset.generate_dataset` (one
 :class:`numpy.random.SeedSequence` child per subject, split into subject / axes / photos; one

@@ -1,4 +1,4 @@
-"""The readable P_pll of SPEC section 5, one skull curve at a time: the tests' oracle.
+"""The readable P_pll of docs/method/lilium.md, one skull curve at a time: the tests' oracle.
 
 Production has one implementation, batched over a population of cameras
 (:func:`lilium.fitness.curves.detect_curves_batch`, :func:`lilium.fitness.pll.pll_terms_batch`);
@@ -119,7 +119,8 @@ def boundary_pixels(grid, origin, view):
 
 
 def detect_curve(uv, faces=None, view="frontal", *, span_v=None, topology=None, image_shape=None):
-    """The skull curve ``(N, 2)`` of one projected region ``(K, 2)`` (SPEC 5 detection)."""
+    """The skull curve ``(N, 2)`` of one projected region ``(K, 2)`` (docs/method/lilium.md
+    detection)."""
     check_view(view)
     if topology is None:
         topology = mesh_edge_topology(faces)

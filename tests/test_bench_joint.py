@@ -1,4 +1,5 @@
-"""benchmarks/bench_joint.py's off-centre priors (docs/method.md, "The joint SFO's cameras on
+"""benchmarks/bench_joint.py's off-centre priors
+(docs/decisions/0010-joint-sfo-cameras-on-prior-edges.md, "The joint SFO's cameras on
 the edge of the priors")."""
 
 import sys

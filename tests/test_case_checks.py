@@ -1,6 +1,6 @@
 """End to end, what the user's trial of issue 18 did, on generated data: a skull with mirrored
 labels, a photo without priors, a wrong ``--view``, an EXIF focal length that cannot be used;
-each gives the error or the warning of SPEC section 10, in ``result.json``, on the console and
+each gives the error or the warning of docs/checks.md, in ``result.json``, on the console and
 in the report."""
 
 import json

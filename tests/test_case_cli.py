@@ -281,7 +281,8 @@ def test_face_curve_option_and_sidecar(files, tmp_path, capsys):
 
 
 def test_missing_inputs_switch_their_term_off_and_say_so_first(files, tmp_path, capsys):
-    """SPEC 5 "when a term cannot apply": no mask, no curve, no mandible landmarks are not
+    """docs/method/lilium.md "when a term cannot apply": no mask, no curve, no mandible landmarks
+    are not
     errors; each term they feed is switched off, said before the first SFO and in result.json."""
     _add_mandible_landmarks(files)
     chin = _chin_curve(files)

@@ -1,4 +1,4 @@
-"""SPEC section 10 checks: left and right of skulls and photos, the skull-faces-camera rule, the
+"""docs/checks.md checks: left and right of skulls and photos, the skull-faces-camera rule, the
 declared view, the priors' warnings and provenance, the landmark error, the focal cap."""
 
 from dataclasses import replace

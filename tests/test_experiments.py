@@ -66,7 +66,7 @@ def write_config(folder, dataset, experiments=("A", "B", "C"), axes_sets=1):
 
 
 def n_expected(n_photos, n_skulls, cfg):
-    """SFO count of the protocol from its definition (SPEC section 7)."""
+    """SFO count of the protocol from its definition (docs/method/evaluation.md)."""
     n_lilium = sum(1 for m, _ in cfg.methods if m == "lilium")
     n_posest = len(cfg.methods) - n_lilium
     per_pair = {
@@ -183,7 +183,7 @@ def test_run_resume_and_report_cli(dataset, tmp_path):
     assert all(r["bpe_mm"] is None for r in rows if not r["positive"])
     scored = [r for r in rows if r["success"]]
     assert all(r["skull_px"] > 0 and 0 <= r["percent_outside"] <= 100 for r in scored)
-    # SPEC section 10 in every row's result JSON: warnings, priors and their source, landmark
+    # docs/checks.md in every row's result JSON: warnings, priors and their source, landmark
     # error; the generated photos have every prior, so no missing-prior warning.
     for r in ResultStore(db).rows(["success", "result"]):
         if not r["success"]:
@@ -203,7 +203,8 @@ def test_run_resume_and_report_cli(dataset, tmp_path):
                  "calibration.csv", "tippett.png"):
         assert (out / name).is_file(), name
     assert "POSEST-SFO" in (out / "report.md").read_text()
-    # Identification (SPEC 12): every SFO's terms stored by the runner; the ranking by each
+    # Identification (docs/method/identification.md): every SFO's terms stored by the runner; the
+    # ranking by each
     # method's own score beside the ranking by the identification LR.
     stored = [json.loads(r["result"]) for r in ResultStore(db).rows(["success", "result"])
               if r["success"]]

@@ -1,4 +1,4 @@
-"""P_cam: exact values of SPEC section 5's camera penalty."""
+"""P_cam: exact values of docs/method/lilium.md's camera penalty."""
 
 import numpy as np
 import pytest

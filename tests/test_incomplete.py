@@ -1,5 +1,5 @@
-"""Incomplete skulls and photos: terms that cannot apply are switched off, not fatal (SPEC
-section 5), and the generator makes such cases (skulls without the mandible, unmarked
+"""Incomplete skulls and photos: terms that cannot apply are switched off, not fatal
+(docs/method/lilium.md), and the generator makes such cases (skulls without the mandible, unmarked
 landmarks)."""
 
 import json

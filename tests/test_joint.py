@@ -1,4 +1,4 @@
-"""Joint SFO (SPEC section 9): one soft tissue shared by several photos, one camera each."""
+"""Joint SFO (docs/method/joint.md): one soft tissue shared by several photos, one camera each."""
 
 import json
 import sqlite3
@@ -24,7 +24,7 @@ from standin_case import toy_dataset
 
 TINY_DE = DEOptions(population_size=8, max_generations=6, max_seconds=None)
 
-#: SPEC section 9: the keys of a joint result.json and of each of its photos.
+#: docs/method/joint.md: the keys of a joint result.json and of each of its photos.
 JOINT_KEYS = {"method", "variant", "seed", "subject", "joint", "photos", "fitness"}
 JOINT_KEYS |= {"facial_landmarks_3d", "seconds", "history"}
 PHOTO_KEYS = {"photo", "camera", "fitness", "terms", "terms_off"}
@@ -215,7 +215,8 @@ def test_sfo_cli_writes_the_joint_contract(pair, tmp_path, capsys):
             "skull2cam",
         }
         assert (out / f"overlay_{p['photo']}.png").is_file()
-    # SPEC 9: the total is the sum of the photos' fitnesses (each photo's weighted share).
+    # docs/method/joint.md: the total is the sum of the photos' fitnesses (each photo's weighted
+    # share).
     assert data["fitness"] == pytest.approx(sum(p["fitness"] for p in data["photos"]))
     weighted = sum(p["weight"] * p["fitness_unweighted"] for p in data["photos"])
     assert data["fitness"] == pytest.approx(weighted) and data["weighting"] == "scale"
@@ -227,7 +228,7 @@ def test_sfo_cli_writes_the_joint_contract(pair, tmp_path, capsys):
     assert not (out / "overlay.png").exists()
     printed = capsys.readouterr().out
     assert "joint (2 photos)" in printed and photo_dirs[1].name in printed
-    # One --photo keeps SPEC section 8.
+    # One --photo keeps docs/contract.md.
     single = tmp_path / "single"
     argv = ["sfo", "--method", "lilium", "--skull", str(subject_dir), "--out", str(single)]
     argv += ["--photo", str(photo_dirs[0]), "--generations", "3", "--population", "6"]

@@ -79,7 +79,7 @@ def test_full_method_recovers_the_camera_on_a_generated_noise_free_photo(tmp_pat
     Noise-free landmarks, true soft-tissue axes: the estimated soft tissue still differs from
     the truth inside its cones, so the camera is close, not exact (measured: focal within
     4.5 %, rotation 3.8 deg, BPE 2.0 mm). The lateral photo of this subject is not asserted
-    here: there Lilium measured 5.5 deg and BPE 4.7 mm (see docs/method.md, known limits).
+    here: there Lilium measured 5.5 deg and BPE 4.7 mm (see docs/method/lilium.md, known limits).
     """
     from lilium.synthetic.dataset import generate_dataset
 

@@ -1,4 +1,5 @@
-"""Identification as a likelihood ratio (SPEC section 12), its calibration: the fitted model
+"""Identification as a likelihood ratio (docs/method/identification.md), its calibration: the fitted
+model
 (classes balanced, bounds, the bi-Gaussian warp, round trips), cross-validation and
 performance, two views calibrated as one decision, the derived ``landmark_snorm`` term, and the
 models' known error rates (shipped and in the report). The terms are ``test_lr_terms.py``'s;

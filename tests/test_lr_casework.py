@@ -1,4 +1,5 @@
-"""Identification as a likelihood ratio (SPEC section 12) in casework: the conclusion and its
+"""Identification as a likelihood ratio (docs/method/identification.md) in casework: the conclusion
+and its
 caps, the ``"identification"`` record of ``lilium sfo`` and ``lilium case`` (a frontal and a
 lateral photo's LRs added, each photo's own decision reused), and the line-up's ranking. The
 terms are ``test_lr_terms.py``'s; the calibration ``test_lr_calibration.py``'s."""

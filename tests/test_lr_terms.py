@@ -1,4 +1,5 @@
-"""Identification as a likelihood ratio (SPEC section 12), its terms: the marginal landmark
+"""Identification as a likelihood ratio (docs/method/identification.md), its terms: the marginal
+landmark
 term (the soft tissue integrated out, shared between views), the camera priors' excess, the
 camera refits, the photo and skull cohorts, the landmarks' tension, and the late terms added to
 older records. The calibration is ``test_lr_calibration.py``'s; the conclusion and the records

@@ -4,11 +4,11 @@ The portraits ship with our dependencies: scikit-image's ``astronaut`` (Eileen C
 public domain) and Matplotlib's ``grace_hopper.jpg`` (US Navy, public domain). No other
 public-domain portrait ships with an installed package or one we could install (Pillow's
 ``hopper`` is the same photograph, scikit-image's ``camera`` is a profile, the others' licences
-do not allow it), so two portraits is all the evidence: thin, and ``docs/photo.md`` says so.
+do not allow it), so two portraits is all the evidence: thin, and ``docs/method/photo.md`` says so.
 
 The points below were placed by hand on zoomed crops (upscaled, with a pixel grid; pixels,
 u = column, v = row); only points visible in the photo are listed. Placement rules for the
-points beyond the eyes, nose and mouth (soft tissue, SPEC section 2, frontal view):
+points beyond the eyes, nose and mouth (soft tissue, docs/method/skull.md, frontal view):
 
 - the **midline** points (nasion, pogonion, gnathion) lie on the face's midline, the line
   through the hand-placed subnasale perpendicular to the hand-placed exocanthion line; only

@@ -1,4 +1,5 @@
-"""``lilium case`` with photos prepared by ``lilium photo`` (SPEC section 11): a prepared folder
+"""``lilium case`` with photos prepared by ``lilium photo`` (docs/method/photo.md): a prepared
+folder
 as ``--photo``, ``--auto-landmarks`` on a bare image, the automatic priors' provenance, the
 template rule, the report's "automatic, unreviewed" line and the one-line errors.
 
@@ -76,7 +77,7 @@ def test_a_prepared_folder_is_a_photo_folder(standin, prepared, tmp_path, capsys
     meta = json.loads((prepared / "photo.json").read_text())
     result = _result(out, "astro", "lilium-skof+pll")
     priors = result["priors"]
-    # Every prior lilium photo found keeps its provenance (SPEC section 10).
+    # Every prior lilium photo found keeps its provenance (docs/checks.md).
     assert priors["focal_px"]["source"] == "automatic"
     assert priors["focal_px"]["range"] == pytest.approx(meta["priors"]["focal_px"])
     assert priors["scd_mm"]["source"] == "automatic"

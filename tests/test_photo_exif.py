@@ -1,4 +1,5 @@
-"""``lilium photo`` and the EXIF of edited photos (SPEC section 11): the focal is taken only from
+"""``lilium photo`` and the EXIF of edited photos (docs/method/photo.md): the focal is taken only
+from
 the camera's own full frame (``exif_focal_unusable`` names the tag that disagrees), a focal
 whose iris distance is outside 0.3-10 m gets ``implausible_prior``, and the runtime's own
 logging stays off stderr."""

@@ -65,7 +65,7 @@ def test_a_prepared_head_mask_never_gives_a_curve(astro, tmp_path):
     photo = read_photo(legacy)
     # An empty curve, not the mask's lower edge: P_pll is switched off ("curve is empty").
     assert photo.face_mask is not None and photo.face_curve_uv.shape == (0, 2)
-    # A hand-made folder's mask (no landmark_sources) still gives the curve (SPEC section 5).
+    # A hand-made folder's mask (no landmark_sources) still gives the curve (docs/method/lilium.md).
     del meta["landmark_sources"]
     (legacy / "photo.json").write_text(json.dumps(meta))
     assert read_photo(legacy).face_curve_uv is None
@@ -80,7 +80,7 @@ def test_a_second_photo_replaces_the_first_one_s_files(tmp_path, capsys):
     # Rerun on the folder's own image: it stays in place.
     assert main(["photo", str(folder / "image.jpg"), "--out", str(folder)]) == 3
     assert (folder / "image.jpg").is_file() and (folder / "photo.json").is_file()
-    # A user's folder holding only the photo, named as SPEC section 8 names it.
+    # A user's folder holding only the photo, named as docs/contract.md names it.
     mine = tmp_path / "mine"
     mine.mkdir()
     (mine / "image.jpg").write_bytes((folder / "image.jpg").read_bytes())

@@ -114,7 +114,8 @@ def test_face_curves(head):
     # Ordered along u; the joined 8-connected curve may step vertically within a column.
     assert len(curve) > 10 and np.all(np.diff(curve[:, 0]) >= 0)
     assert curve[:, 0].min() >= lo - 1 and curve[:, 0].max() <= hi + 1
-    # Boundary pixels of the mask, joined into one curve by straight segments (SPEC 5), so a
+    # Boundary pixels of the mask, joined into one curve by straight segments
+    # (docs/method/lilium.md), so a
     # few joining pixels may fall off the mask.
     on_mask = frontal.face_mask[curve[:, 1], curve[:, 0]]
     assert on_mask.mean() > 0.9

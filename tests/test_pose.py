@@ -16,7 +16,7 @@ from lilium.pose import (
 )
 
 PRINCIPAL_POINT_PX = np.array([1999.5, 1499.5])
-#: Noise-free recovery (SPEC 4 target).
+#: Noise-free recovery (docs/method/pose.md target).
 EXACT_FOCAL_REL = 1e-6
 EXACT_RMS_PX = 1e-6
 

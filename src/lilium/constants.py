@@ -3,34 +3,36 @@
 #: Penalty for a camera that POSEST could not produce (no solution, focal out of range).
 C_INF = 1e12
 
-#: Largest focal length (pixels) a real lens/sensor combination is taken to reach (SPEC 4, 5).
+#: Largest focal length (pixels) a real lens/sensor combination is taken to reach
+#: (docs/method/pose.md).
 FOCAL_MAX_PX = 10_000.0
 
 #: Smallest focal length (pixels) taken as a camera: below one pixel the "camera" is a collapsed
-#: fit, not a lens (treated like SPEC's f <= 0 failure).
+#: fit, not a lens (treated like an f <= 0 failure, docs/method/pose.md).
 FOCAL_MIN_PX = 1.0
 
 #: Smallest camera-frame depth (mm) for a point to count as in front of the camera.
 MIN_DEPTH_MM = 1e-6
 
-#: Photo views (SPEC section 8): lateral_left = the face points towards the image's left edge.
+#: Photo views (docs/contract.md): lateral_left = the face points towards the image's left edge.
 VIEWS = ("frontal", "lateral_left", "lateral_right")
 
-#: The experiments of SPEC section 7, each named by its noise profile (ideal, landmark noise,
+#: The experiments of docs/method/evaluation.md, each named by its noise profile (ideal, landmark
+#: noise,
 #: realistic): :mod:`lilium.synthetic.noise` and :mod:`lilium.experiments.config`.
 EXPERIMENTS = ("A", "B", "C")
 
 #: Fewest 2D-3D correspondences POSEST accepts (a P4Pf sample).
 MIN_CORRESPONDENCES = 4
 
-#: Largest soft-tissue polar angle from the cone axis (degrees), SPEC section 3.
+#: Largest soft-tissue polar angle from the cone axis (degrees), docs/method/lilium.md.
 CONE_MAX_POLAR_DEG = 40.0
 
 #: Angular spread (degrees) of a soft-tissue direction about its cone axis: the identification
 #: model's (:mod:`lilium.identification.terms`) and the joint SFO's angular prior's.
 DIRECTION_SD_DEG = 15.0
 
-#: Weight of the bilateral hybrid: right genes = W * left + (1 - W) * right (SPEC section 3).
+#: Weight of the bilateral hybrid: right genes = W * left + (1 - W) * right (docs/method/lilium.md).
 BILATERAL_LEFT_WEIGHT = 0.9
 
 #: Radius (mm) of the skull-surface neighbourhood averaged for a default cone axis.
@@ -41,20 +43,20 @@ RANSAC_THRESHOLD_PX = 12.0
 
 #: Largest angle (degrees) between the skull's anterior direction (porion midpoint -> nasion)
 #: and the direction from the skull to the camera for the camera to see the front of the skull
-#: (SPEC section 10; a lateral view is about 90). A camera beyond it sees the back of the skull:
-#: treated as no solution. SPEC section 10's 110 degrees. (The generator's lateral yaw once
+#: (docs/checks.md; a lateral view is about 90). A camera beyond it sees the back of the skull:
+#: treated as no solution. docs/checks.md's 110 degrees. (The generator's lateral yaw once
 #: reached 105 deg, which with 10 deg of pitch against the anterior axis, tilted about 14 deg
 #: above the mesh horizontal, put true cameras at up to 112.7 deg: the generator's lateral yaw
 #: range is 75-95 deg since, see lilium.synthetic.photos.CameraRanges.)
 FACING_MAX_DEG = 110.0
 
-#: The view check (SPEC section 10): a frontal camera lies at most this far (degrees) from the
+#: The view check (docs/checks.md): a frontal camera lies at most this far (degrees) from the
 #: skull's anterior direction, a lateral one at least this far, on the declared side.
 VIEW_SPLIT_DEG = 45.0
 
 
 def focal_cap_px(focal_prior_px=None):
-    """Largest focal length (pixels) accepted as a camera (SPEC section 4, focal cap).
+    """Largest focal length (pixels) accepted as a camera (docs/method/pose.md, focal cap).
 
     :data:`FOCAL_MAX_PX` unless a focal prior reaches above it; then twice the prior's upper
     bound (a long lens on a large sensor: 200 mm full-frame on a 6,000 px photo is 33,000 px).

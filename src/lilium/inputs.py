@@ -15,13 +15,13 @@ from .softtissue.landmarks import CRANIAL_TO_FACIAL
 #: tolerance; each optional): the same object P_cam takes.
 Priors = CameraPriors
 
-#: Where a prior came from (SPEC section 10, ``result.json``'s ``"priors"``).
+#: Where a prior came from (docs/checks.md, ``result.json``'s ``"priors"``).
 PRIOR_SOURCES = ("command line", "photo.json", "exif", "automatic", "none")
 
 
 @dataclass(frozen=True)
 class CaseWarning:
-    """A warning about an input or a result (SPEC section 10): a stable code and a sentence.
+    """A warning about an input or a result (docs/checks.md): a stable code and a sentence.
 
     Attributes
     ----------
@@ -101,7 +101,7 @@ class Photo:
         carries them.
     landmark_sources : dict of str -> str
         Who placed each facial landmark: ``manual`` (by hand, or an automatic point the user
-        reviewed), ``tracked`` or ``template`` (automatic, unreviewed; SPEC section 11). A
+        reviewed), ``tracked`` or ``template`` (automatic, unreviewed; docs/method/photo.md). A
         landmark not listed is ``manual``. Sets its 2D uncertainty in the identification
         (:mod:`lilium.identification`).
     """

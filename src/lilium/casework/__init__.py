@@ -1,6 +1,6 @@
 """Case workflows: from the user's files to written results (what the ``lilium`` commands call).
 
-- :mod:`~lilium.casework.folders`: one SFO on SPEC section 8 folders (``lilium sfo``);
+- :mod:`~lilium.casework.folders`: one SFO on docs/contract.md folders (``lilium sfo``);
 - :mod:`~lilium.casework.inputs`: a user's skull and photos from folders or plain files, with
   the precedence of priors (command line, ``photo.json``, EXIF);
 - :mod:`~lilium.casework.prepared`: photo folders of ``lilium photo`` in a case (landmarks'

@@ -73,7 +73,7 @@ def run_case(request, log=print):
         report shows every photo's overlay and terms from the shared soft tissue, and its 3D
         facial landmarks. Needs two or more distinct photos.
 
-        Every result gets its ``"identification"`` (docs/identification.md); with several
+        Every result gets its ``"identification"`` (docs/method/identification.md); with several
         photos, each method's separate SFOs are also taken together as one decision (shared
         soft tissue), shown first in the report and logged.
     log : callable

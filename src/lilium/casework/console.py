@@ -10,6 +10,6 @@ def status_text(result):
 
 
 def log_warnings(result, log):
-    """One console line per SPEC section 10 warning of an SFO."""
+    """One console line per docs/checks.md warning of an SFO."""
     for warning in result.warnings:
         log(f"  warning {warning.code}: {warning.message}")

@@ -1,4 +1,4 @@
-"""One SFO on case folders (SPEC section 8): read, check, run, write ``result.json``; and
+"""One SFO on case folders (docs/contract.md): read, check, run, write ``result.json``; and
 what lets ``lilium case`` and ``lilium lineup`` resume: each stored result's input fingerprint
 (:func:`sfo_fingerprint`), the test that a stored result is this SFO's (:func:`stored_result`),
 and the lock that keeps a second run off an output folder (:func:`output_lock`).
@@ -120,7 +120,7 @@ def joint_overlay_name(photo_id):
 
 def write_joint_result(out_dir, result, skull, photos, overlay=True):
     """Write a joint SFO's ``overlay_<photo id>.png`` per photo (the photo's plain image when
-    its camera failed), then its ``result.json`` (SPEC section 9).
+    its camera failed), then its ``result.json`` (docs/method/joint.md).
 
     As :func:`~lilium.io.results.write_result`: an earlier ``result.json`` and the overlays of
     an earlier SFO (:func:`~lilium.io.results.remove_overlays`, a single one's too) are removed

@@ -1,4 +1,4 @@
-"""A user's skull and photos, from SPEC section 8 folders or the files a practitioner has.
+"""A user's skull and photos, from docs/contract.md folders or the files a practitioner has.
 
 Sidecar files, used when the command line does not name the file (each one found is logged,
 e.g. ``front: using mask front_mask.png (found beside the photo)``): a mesh's landmark file is
@@ -6,7 +6,7 @@ a sibling with the mesh's stem (``skull.fcsv``, ``skull.mrk.json``, ...); beside
 ``<stem>.png``/``.jpg``, its facial landmarks ``<stem>.csv``/``.json``/``.tsv``/``.txt`` or
 ``<stem>_landmarks.*``, its face mask ``<stem>_mask.png`` and its facial curve
 ``<stem>_face_curve.json``. A photo folder holds its own ``face_mask.png`` and
-``face_curve.json`` (SPEC section 8). Priors: the command line's ``--focal-px``/``--scd-mm``
+``face_curve.json`` (docs/contract.md). Priors: the command line's ``--focal-px``/``--scd-mm``
 override ``photo.json``; without either, the focal prior comes from the photo's EXIF when it
 has one.
 """
@@ -398,7 +398,7 @@ def check_runnable(skull, photo, methods, variant, skull_inputs, photo_inputs):
     one case no term set can run); otherwise the ``ValueError`` starts with the file to fix.
     For Lilium, a term the variant asks for whose inputs are missing (P_skof without a face
     mask; P_pll without the cranial landmarks that cut its region, e.g. a skull without its
-    mandible, or without a facial curve) is switched off, not an error (SPEC section 5), and
+    mandible, or without a facial curve) is switched off, not an error (docs/method/lilium.md), and
     so is each P_cam part without its prior.
 
     Parameters

@@ -1,4 +1,4 @@
-"""The ``--joint`` path of a user's case (``lilium case --joint``, SPEC section 9).
+"""The ``--joint`` path of a user's case (``lilium case --joint``, docs/method/joint.md).
 
 Each method that has a joint form (Lilium) runs once for all the photos of the person: one soft
 tissue shared by the photos, one camera each. Its outputs go to ``<out>/joint/<method tag>/``:

@@ -1,4 +1,5 @@
-"""A lineup (SPEC section 12): one skull against several candidate persons, each with one or
+"""A lineup (docs/method/identification.md): one skull against several candidate persons, each with
+one or
 more photos, ranked by the identification's likelihood ratio in one report.
 
 The usual case of a found skull and a missing-persons list. Every photo of every candidate

@@ -1,10 +1,10 @@
-"""Photo folders written by ``lilium photo`` (SPEC section 11) in a case: their landmarks'
+"""Photo folders written by ``lilium photo`` (docs/method/photo.md) in a case: their landmarks'
 origin, their automatic priors paired with the skull, and ``lilium case --auto-landmarks``.
 
-Decisions (docs/photo.md, "In a case"):
+Decisions (docs/method/photo.md, "In a case"):
 
 - A prior ``lilium photo`` found (``priors.source`` ``"automatic"`` with a ``priors.sources``
-  line) keeps ``"source": "automatic"`` in ``result.json`` (SPEC section 10), the EXIF focal
+  line) keeps ``"source": "automatic"`` in ``result.json`` (docs/checks.md), the EXIF focal
   included: nobody has checked it; the report gives the line (``"automatic: EXIF: ..."``).
   The command line still wins (``--focal-px``, ``--scd-mm``).
 - The head orientation becomes ``head_rotation_skull2cam = face2cam @ skull2face`` through the

@@ -1,6 +1,6 @@
 """``lilium case``: superimpose one skull on one or more photos and report them together.
 
-Inputs are SPEC section 8 folders or the files a practitioner already has::
+Inputs are docs/contract.md folders or the files a practitioner already has::
 
     lilium case --skull SUBJECT_DIR --photo PHOTO_DIR [--photo PHOTO_DIR ...] --out DIR
     lilium case --skull SUBJECT_DIR --auto-landmarks --photo portrait.jpg --out DIR
@@ -23,7 +23,7 @@ from ..casework.case import run_case
 from .options import PHOTO_FILES, PRIORS, SFO, add_options, case_request
 
 #: What ``lilium case --help`` says after the options: the face mask, the sidecar files and
-#: the output layout (docs/conventions.md says the same, with a picture).
+#: the output layout (docs/conventions.md and docs/contract.md say the same).
 EPILOG = """\
 face mask (--mask FILE, NAME_mask.png beside an image, face_mask.png in a photo folder):
   a PNG of the photo's size, non-zero on the head as seen in the photo: the face, the
@@ -42,12 +42,12 @@ sidecar files (used when the option is not given; each one found is printed, e.g
                             --mask), NAME_face_curve.json (facial curve, --face-curve)
   in a photo folder         image.png/.jpg, photo.json, face_mask.png, face_curve.json
 
-automatic landmarks (lilium photo, SPEC section 11): a folder written by lilium photo is a
+automatic landmarks (lilium photo, docs/method/photo.md): a folder written by lilium photo is a
   photo folder; its tracked landmarks are used, its template ones only once confirmed in
   review.html, its priors with "source": "automatic", its head orientation turned into
   head_rotation_skull2cam through the skull's frame. --auto-landmarks prepares each bare
   image itself into OUT/<photo>/prepared/ (nothing is written beside the image); the report
-  says the landmarks are automatic and unreviewed and links the review page (docs/photo.md).
+  says the landmarks are automatic and unreviewed and links the review page (docs/method/photo.md).
 
 facial curve (face_curve.json format): {"chin_jaw": [[u, v], ...]} for a frontal photo,
   {"forehead": [[u, v], ...]} for a lateral one (pixels); without one, the pll variants
@@ -81,7 +81,7 @@ def register(subparsers):
             "one soft tissue shared by the photos, one camera each; outputs in "
             "DIR/joint/lilium-<variant>/. Measured: 0.87-0.98 x the separate SFOs' BPE on "
             "generated subjects, level on a real CT head, where more of its overlays leave the "
-            "face (docs/method.md)"
+            "face (docs/method/joint.md)"
         ),
     )
     add_options(p, "calibration", "title")

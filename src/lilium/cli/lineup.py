@@ -10,8 +10,9 @@ def register(subparsers):
         description=(
             "Runs the SFO of the skull on every photo of every candidate, takes each "
             "candidate's photos together, ranks the candidates by the identification's log10 "
-            "LR (docs/identification.md) and writes OUT/report.html (the ranking first, then "
-            "every overlay), OUT/lineup.json and OUT/<candidate>/<photo>/<method>/result.json. "
+            "LR (docs/method/identification.md) and writes OUT/report.html (the ranking "
+            "first, then every overlay), OUT/lineup.json and "
+            "OUT/<candidate>/<photo>/<method>/result.json. "
             "Resumable: run the same command again after an interruption."
         ),
     )

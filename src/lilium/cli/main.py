@@ -10,7 +10,7 @@ out, or, as a last resort, any other exception (a bug: the line asks to report i
 :data:`DEBUG_ENV` (``LILIUM_DEBUG=1``) to get the traceback of anything but an input error
 instead; the test suite does, so real bugs stay visible there. Python warnings of the libraries
 (numpy, Pillow, matplotlib) are not shown unless :data:`DEBUG_ENV` is set: what a user needs to
-know is said by Lilium's own warnings (SPEC section 10), not by a library's internals.
+know is said by Lilium's own warnings (docs/checks.md), not by a library's internals.
 """
 
 import argparse

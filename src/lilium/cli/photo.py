@@ -1,4 +1,4 @@
-"""``lilium photo``: prepare a photo folder from a plain photograph (SPEC section 11).
+"""``lilium photo``: prepare a photo folder from a plain photograph (docs/method/photo.md).
 
 Exit status: 0 when a face was found and the folder holds automatic landmarks; 3 when no face
 was found (the folder is written without automatic landmarks, to be marked by hand in
@@ -35,7 +35,7 @@ def register(subparsers):
     p.add_argument(
         "--landmarks",
         type=Path,
-        help="reviewed landmarks (review.html's landmarks.json, or any SPEC facial file)",
+        help="reviewed landmarks (review.html's landmarks.json, or any facial landmark file)",
     )
     add_options(p, "sensor_width_mm")
     p.add_argument(

@@ -65,7 +65,7 @@ def run(args):
         f"{name}: focal {result.camera.focal_px:.0f} px, score {result.fitness:.3f}, "
         f"{result.seconds:.2f} s -> {request.out}"
     )
-    for term, why in result.terms_off.items():  # inputs missing: ran without it (SPEC 5)
+    for term, why in result.terms_off.items():  # inputs missing: ran without it
         print(f"  {term} switched off: {why}")
     print(conclusion_line(result.extra["identification"]))
     return 0

@@ -1,4 +1,4 @@
-"""CT volume -> subject folder (SPEC section 8): skull and skin meshes, optional landmarks.
+"""CT volume -> subject folder (docs/contract.md): skull and skin meshes, optional landmarks.
 
 Everything is written in one right-handed patient frame, LPS (:mod:`lilium.ct.frame`), whatever
 the file's own frame; ``ct_import.json`` names it, gives the map from the file's coordinates,

@@ -1,4 +1,4 @@
-"""Evaluation of SFO results against synthetic ground truth (SPEC section 7)."""
+"""Evaluation of SFO results against synthetic ground truth (docs/method/evaluation.md)."""
 
 from .metrics import (
     ImplausibleSFO,

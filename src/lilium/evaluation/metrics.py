@@ -1,4 +1,4 @@
-"""Scores of the paper's evaluation protocol (SPEC section 7), as pure functions.
+"""Scores of the paper's evaluation protocol (docs/method/evaluation.md), as pure functions.
 
 - :func:`back_projection_error` (BPE, mm): for every ground-truth facial landmark ``F_i`` (visible
   or not), the distance from ``F_i`` to the ray that the *estimated* camera back-projects through
@@ -184,7 +184,7 @@ def outside_depth_px(skull_mask, face_mask):
 
 
 def outside_face(camera, vertices_mm, faces, face_mask, topology=None):
-    """Skull pixels outside the face mask for a camera and a skull mesh (SPEC section 7).
+    """Skull pixels outside the face mask for a camera and a skull mesh (docs/method/evaluation.md).
 
     The skull is projected by ``camera`` and rasterised at the mask's resolution by the one
     mesh raster (:func:`lilium.imaging.raster.mesh_mask`: the exact union of the projected

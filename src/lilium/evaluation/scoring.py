@@ -1,4 +1,4 @@
-"""Score one SFO result against the ground truth of its photo (SPEC section 7)."""
+"""Score one SFO result against the ground truth of its photo (docs/method/evaluation.md)."""
 
 import math
 from dataclasses import dataclass

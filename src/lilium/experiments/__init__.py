@@ -1,4 +1,4 @@
-"""The paper's evaluation protocol at scale (SPEC section 7).
+"""The paper's evaluation protocol at scale (docs/method/evaluation.md).
 
 - :mod:`lilium.experiments.config`  TOML config and the presets ``quick`` and ``paper``
 - :mod:`lilium.experiments.store`   SQLite results store (one row per finished SFO, WAL) and

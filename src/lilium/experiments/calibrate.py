@@ -1,4 +1,5 @@
-"""Identification over a results database (SPEC section 12): every stored SFO's terms, the
+"""Identification over a results database (docs/method/identification.md): every stored SFO's terms,
+the
 decisions (one photo; a frontal + lateral pair), their calibration and its validation.
 
 The terms of an SFO are stored by the runner in its ``result`` JSON
@@ -20,9 +21,10 @@ photo once.
   photos as independent evidence, which they are not (they share the soft tissue); the fitted
   slope and offset calibrate the combination instead (for Lilium the slope came out above 1:
   each photo's model is conservative). Measured beside ``pair`` and beside the plain sum: for
-  Lilium better than both, for POSEST-SFO level with the plain sum (docs/method.md); it is
+  Lilium better than both, for POSEST-SFO level with the plain sum
+  (docs/decisions/0014-identification-several-photos.md); it is
   what a case with one frontal and one lateral photo reports (:mod:`lilium.casework.identify`);
-- ``joint``: a joint SFO (SPEC section 9) of the pair: its shared soft tissue and two cameras.
+- ``joint``: a joint SFO (docs/method/joint.md) of the pair: its shared soft tissue and two cameras.
 """
 
 import hashlib
@@ -461,7 +463,8 @@ def _pair_sum(pairs, decision_pairs, validated, key):
 #: The decisions whose logistic regression is bi-Gaussianized
 #: (:func:`lilium.identification.calibration.bigaussian_warp`): the frontal + lateral sum
 #: (since 2026-12-05). The warp moves LR 1 to where the two kinds of pair are misled equally
-#: often; on 232 generated subjects (cross-validated, docs/method.md "The worst landmark") it
+#: often; on 232 generated subjects (cross-validated, docs/decisions/0016-identification-features.md
+#: "The worst landmark") it
 #: takes Lilium's sum from 3.0 / 5.6 % misleading same / different-person pairs to 4.7 / 4.5 %
 #: and its different-person wrong conclusions from 3.4 to 2.9 % (same-person ones 1.3 % both
 #: ways), for a Cllr of 0.187 against 0.179: fewer wrong persons supported, no more wrong

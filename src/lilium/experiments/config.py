@@ -1,7 +1,8 @@
 """Experiment configuration (a small TOML file) and the presets ``quick`` and ``paper``.
 
 A config names the dataset (an existing folder with ``dataset.json``, or one to generate), the
-experiments (A, B, C of SPEC section 7), the methods, the repetitions, the DE settings of Lilium,
+experiments (A, B, C of docs/method/evaluation.md), the methods, the repetitions, the DE settings of
+Lilium,
 the number of local workers and the results database. Relative paths are relative to the config
 file's folder (to the current folder for a preset). Example::
 
@@ -33,7 +34,7 @@ file's folder (to the current folder for a preset). Example::
 ``methods`` entries are ``"posest-sfo"``, ``"lilium:<variant>"`` (variant among ``base``,
 ``pll``, ``skof``, ``skof+pll``) or ``"lilium"`` for all four variants; ``"lilium-joint:<variant>"``
 (or ``"lilium-joint"``, all variants) runs one joint SFO per subject's frontal + lateral photo
-pair and skull (SPEC section 9, :mod:`lilium.experiments.joint_tasks`).
+pair and skull (docs/method/joint.md, :mod:`lilium.experiments.joint_tasks`).
 
 Every key is checked, with a message naming it: integers in the ranges of
 :data:`LIMITS` (seeds such that ``seed + run`` fits :data:`MAX_SEED`), ``max_seconds`` a finite
@@ -121,7 +122,7 @@ DE_KEYS = {
 
 @dataclass(frozen=True)
 class ExperimentConfig:
-    """One run of the protocol (SPEC section 7).
+    """One run of the protocol (docs/method/evaluation.md).
 
     Attributes
     ----------

@@ -32,7 +32,7 @@ import json
 import os
 from pathlib import Path, PurePosixPath, PureWindowsPath
 
-#: Views a photo entry may name (SPEC section 8).
+#: Views a photo entry may name (docs/contract.md).
 VIEWS = ("frontal", "lateral_left", "lateral_right")
 
 #: Skull mesh file names a subject folder must hold one of (``lilium.io.case.read_skull``).

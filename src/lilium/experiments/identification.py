@@ -1,4 +1,4 @@
-"""Identification metrics of an experiment (SPEC section 7): rank-1 rate, CMC, ROC AUC.
+"""Identification metrics of an experiment (docs/method/evaluation.md): rank-1 rate, CMC, ROC AUC.
 
 For one photo in one run of a method the true skull's score is compared with the scores of the
 photo against every other skull of the experiment (lower is better; a failed SFO scores worse

@@ -1,5 +1,5 @@
 """Joint SFOs in the experiment protocol: each subject's frontal + lateral photo pair against
-every skull (SPEC section 9), scored like the single-photo methods.
+every skull (docs/method/joint.md), scored like the single-photo methods.
 
 A joint method is named ``<method>-joint`` (``lilium-joint``) in a config's ``methods``
 (``"lilium-joint:skof+pll"``). Its photos: each subject's frontal photos and lateral photos,

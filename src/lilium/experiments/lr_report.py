@@ -1,4 +1,4 @@
-"""Files of the identification's calibration (SPEC section 12): ``calibration.json``,
+"""Files of the identification's calibration (docs/method/identification.md): ``calibration.json``,
 ``calibration.csv`` (Cllr, Cllr_min, rates of misleading evidence and of wrong conclusions per
 decision), the Tippett plot, and the ranking of every photo's skulls by the cross-validated
 log10 LR beside the ranking by the methods' own scores (``identification.csv``).

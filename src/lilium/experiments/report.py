@@ -1,4 +1,4 @@
-"""The paper's tables and plots from an experiment database (SPEC section 7).
+"""The paper's tables and plots from an experiment database (docs/method/evaluation.md).
 
 Definitions (decisions the paper leaves open are marked *):
 
@@ -22,7 +22,7 @@ Definitions (decisions the paper leaves open are marked *):
   a camera), with the mean % of skull pixels outside the mask among its implausible SFOs and
   how many of them were positive / negative pairs.
 - **Time**: the method's own seconds per SFO (reading and scoring excluded), mean and median.
-- **Terms switched off** (SPEC section 5): per experiment, method and view, how many SFOs ran
+- **Terms switched off** (docs/method/lilium.md): per experiment, method and view, how many SFOs ran
   with a term switched off because its inputs were missing (``terms_off`` of the stored
   result: P_pll for a skull without its mandible, P_skof without a mask, a P_cam part without
   its prior), in all and per term. *Ranks over skulls with different terms off are biased (an
@@ -576,7 +576,7 @@ def write_report(db, out_dir, dataset=None, log=None):
         paths.update(lr_paths)
         identification += lr_table
         lr_note = (
-            "\n\nRanked by the identification log10 LR (SPEC section 12): each pair scored by "
+            "\n\nRanked by the identification log10 LR: each pair scored by "
             "a calibration that never saw its subject (cross-validated); Cllr, Cllr_min, "
             "the rates of misleading evidence and of conclusions that support the wrong "
             "proposition in calibration.csv, the Tippett plot:\n\n"

@@ -1,4 +1,5 @@
-"""Run the paper's protocol (SPEC section 7): enumerate the SFOs, run them, store each at once.
+"""Run the paper's protocol (docs/method/evaluation.md): enumerate the SFOs, run them, store each at
+once.
 
 Tasks: every photo x every skull x every method, for each experiment:
 
@@ -228,7 +229,7 @@ def enumerate_tasks(cfg, root, index):
 
 # -- worker -------------------------------------------------------------------------------------
 def _run_method(task, skull, photo):
-    """Run the task's SFO; its SPEC section 10 warnings land in the row's ``result`` JSON.
+    """Run the task's SFO; its docs/checks.md warnings land in the row's ``result`` JSON.
 
     The left/right checks run first (:func:`lilium.methods.run_sfo`); a broken rule is a
     ``ValueError`` naming the subject's or the photo's landmark file (an error row).

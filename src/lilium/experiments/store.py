@@ -51,7 +51,7 @@ VALUE_COLUMNS = {
     "error": "TEXT",
     "worker": "TEXT",
     "finished_at": "REAL",  # Unix time
-    "result": "TEXT",  # the SPEC result.json dictionary (without the fitness history)
+    "result": "TEXT",  # the result.json dictionary (docs/contract.md) (without the fitness history)
 }
 
 COLUMNS = KEY_COLUMNS + tuple(VALUE_COLUMNS)

@@ -1,4 +1,4 @@
-"""How many SFOs of an experiment ran with a term switched off (SPEC section 5).
+"""How many SFOs of an experiment ran with a term switched off (docs/method/lilium.md).
 
 A term whose inputs are missing for a skull or photo (P_pll for a skull without its mandible,
 P_skof without a face mask, a P_cam part without its prior) is switched off for that SFO and
@@ -86,7 +86,7 @@ def terms_off_markdown(table):
     if table:
         keys = [k for k in table[0] if k.startswith("off_")]
         parts.append(
-            "A term whose inputs are missing (SPEC section 5) is switched off for that SFO: it "
+            "A term whose inputs are missing is switched off for that SFO: it "
             "counts zero, so ranks over skulls with different terms off are biased.\n"
         )
         lines = [

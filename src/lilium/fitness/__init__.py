@@ -1,4 +1,4 @@
-"""Fitness terms of SPEC section 5, as pure functions over arrays (no file I/O).
+"""Fitness terms of docs/method/lilium.md, as pure functions over arrays (no file I/O).
 
 - :mod:`lilium.fitness.camera_penalty`  P_cam over a population (focal, SCD, head prior)
 - :mod:`lilium.fitness.skof`            P_skof = 100 |S \\ F| (S from :mod:`lilium.imaging.raster`)

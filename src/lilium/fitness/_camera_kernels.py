@@ -1,4 +1,4 @@
-"""Compiled camera terms of Lilium's fitness: MSE_pix and P_cam (SPEC section 5) of a
+"""Compiled camera terms of Lilium's fitness: MSE_pix and P_cam (docs/method/lilium.md) of a
 population, and the validity of its cameras; numba, see :mod:`lilium.jit`.
 
 The numpy path they replace: :meth:`lilium.methods.lilium.LiliumProblem._terms` (MSE_pix, the

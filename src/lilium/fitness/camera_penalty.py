@@ -1,4 +1,4 @@
-"""P_cam, the camera-plausibility term of SPEC section 5, over a whole population at once.
+"""P_cam, the camera-plausibility term of docs/method/lilium.md, over a whole population at once.
 
 ``P_cam = C_INF * [no solution or f <= 0 or f > focal cap]
 + max(0, fmin - f)^2 + max(0, f - fmax)^2
@@ -28,7 +28,7 @@ def _interval(value, name):
 
 @dataclass(frozen=True)
 class CameraPriors:
-    """A priori camera information of one photo (SPEC 1 and 8); every field is optional.
+    """A priori camera information of one photo (docs/contract.md); every field is optional.
 
     Attributes
     ----------
@@ -71,7 +71,7 @@ class CameraPriors:
 
 
 def head_deviation_deg(R, R_prior):
-    """dbeta of SPEC 5: geodesic angle (degrees) of ``R @ R_prior.T``.
+    """dbeta of docs/method/lilium.md: geodesic angle (degrees) of ``R @ R_prior.T``.
 
     Parameters
     ----------

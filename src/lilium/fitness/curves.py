@@ -1,4 +1,4 @@
-"""The curves of the parallelism term (SPEC section 5): skull-curve detection, facial curves.
+"""The curves of the parallelism term (docs/method/lilium.md): skull-curve detection, facial curves.
 
 Curves are pixel polylines ``(N, 2)`` in ``uv`` (u = column, v = row), ordered along the curve
 and 8-connected after refinement. Orientation, written once: chin-jaw curves (frontal views)
@@ -186,7 +186,7 @@ def missing_curve_bounds(view, landmarks_uv):
 
 
 def face_curve_from_mask(face_mask, view, landmarks_uv):
-    """The facial contour of a photo from its face mask (SPEC section 5).
+    """The facial contour of a photo from its face mask (docs/method/lilium.md).
 
     Chin-jaw (frontal): for every column between the two cheilion u's, going down from the
     mouth level (mean v of the cheilions), the last face pixel before the background. Forehead

@@ -1,4 +1,4 @@
-"""P_pll, the parallelism term of SPEC section 5: ``Delta_d + P_conv + P_int``.
+"""P_pll, the parallelism term of docs/method/lilium.md: ``Delta_d + P_conv + P_int``.
 
 One implementation, over a population: the skull curves of ``S`` cameras
 (:class:`lilium.fitness.curves.CurveBatch`, pixel polylines in ``uv`` ordered as in
@@ -57,13 +57,14 @@ from ._pll_kernels import (
 )
 from .curves import CurveBatch, check_view
 
-#: Fraction of a curve's length whose mean tangent defines its end normal (SPEC: 20 %).
+#: Fraction of a curve's length whose mean tangent defines its end normal (docs/method/lilium.md: 20
+#: %).
 END_FRACTION = 0.2
 
 #: An end converges when its deviation from the mean distance exceeds this fraction of it.
 CONVERGENCE_RATIO = 0.25
 
-#: Penalty per pair with the skull on the wrong side of the face (SPEC: 1000).
+#: Penalty per pair with the skull on the wrong side of the face (docs/method/lilium.md: 1000).
 INTERSECTION_WEIGHT = 1000.0
 
 #: P_pll when either curve is empty: as bad as an impossible camera.
@@ -510,7 +511,7 @@ def pll_terms_batch(curves, face_index, view, trim=True):
     face_index : FaceCurveIndex
     view : {"frontal", "lateral_left", "lateral_right"}
     trim : bool
-        Trim first (step 1; SPEC 5 does).
+        Trim first (step 1; docs/method/lilium.md does).
 
     Returns
     -------
@@ -536,7 +537,7 @@ def pll_penalty(skull_curve, face_curve, view, trim=True):
         Refined (:func:`lilium.fitness.curves.refine_curve`), same direction as the skull curve.
     view : {"frontal", "lateral_left", "lateral_right"}
     trim : bool
-        Trim first (SPEC 5 does).
+        Trim first (docs/method/lilium.md does).
 
     Returns
     -------

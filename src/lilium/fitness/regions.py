@@ -1,4 +1,4 @@
-"""Mesh regions of the parallelism term (SPEC section 5): forehead and chin-jaw.
+"""Mesh regions of the parallelism term (docs/method/lilium.md): forehead and chin-jaw.
 
 Computed once per SFO (skull) or once per face mesh, from 3D landmarks in the mesh frame.
 

@@ -1,4 +1,4 @@
-"""P_skof, the skull-outside-face term of SPEC section 5: ``100 * |S \\ F|``.
+"""P_skof, the skull-outside-face term of docs/method/lilium.md: ``100 * |S \\ F|``.
 
 ``S`` is the union of the projected skull triangles rasterised at the photo's resolution (pixel
 centres, see :mod:`lilium.imaging.raster` for the rule), clipped to the photo: pixels beyond the
@@ -47,7 +47,7 @@ from ._skof_kernels import (
     squared_distance_to_background,
 )
 
-#: Weight of the outside-pixel count in P_skof (SPEC section 5).
+#: Weight of the outside-pixel count in P_skof (docs/method/lilium.md).
 SKOF_WEIGHT = 100.0
 
 #: Members x faces processed at once by :func:`skull_outside_pixels_batch` (cache-sized).

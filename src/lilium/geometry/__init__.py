@@ -1,4 +1,4 @@
-"""Rotations and the pinhole camera of SPEC section 8 (:class:`Camera`, :class:`Cameras`)."""
+"""Rotations and the pinhole camera of docs/contract.md (:class:`Camera`, :class:`Cameras`)."""
 
 from .camera import (
     Camera,

@@ -1,4 +1,4 @@
-"""The pinhole camera of SPEC section 8: one type, one projection.
+"""The pinhole camera of docs/contract.md: one type, one projection.
 
 Convention, written once: ``skull2cam`` is a 4x4 rigid transform (mm) from the skull-mesh frame to
 the camera frame (x right, y down, z forward). A point ``X`` of the skull frame goes to
@@ -212,7 +212,7 @@ class Camera:
         return np.linalg.norm(np.asarray(points_mm, dtype=float) @ self.R.T + self.t, axis=-1)
 
     def to_dict(self):
-        """The ``camera`` object of ``result.json`` (SPEC section 8)."""
+        """The ``camera`` object of ``result.json`` (docs/contract.md)."""
         return {
             "focal_px": float(self.focal_px),
             "principal_point_px": [float(x) for x in self.principal_point_px],

@@ -1,4 +1,5 @@
-"""Identification (SPEC section 12): from an SFO result to a likelihood ratio and a conclusion.
+"""Identification (docs/method/identification.md): from an SFO result to a likelihood ratio and a
+conclusion.
 
 - :mod:`~lilium.identification.terms`: the model, maths only (marginal landmark likelihood
   over the soft tissue, soft-tissue typicality, prior excess);

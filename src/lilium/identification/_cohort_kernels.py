@@ -9,7 +9,8 @@ the projection the numpy path calls too), the projection's Jacobian, the margina
 ``S = J Sigma J^T + sigma^2 I`` and its Cholesky whitening. The numpy path takes the camera-frame
 point of the Jacobian from a matrix product, this kernel from the pinhole's own sums, so the two
 agree to rounding (about 1e-15 relative), not bit for bit (``tests/test_kernels_camera.py``);
-a refit's accept / reject steps can carry such a difference further (docs/method.md, "The
+a refit's accept / reject steps can carry such a difference further
+(docs/decisions/0020-compiled-kernels.md, "The
 identification's camera refits compiled").
 """
 

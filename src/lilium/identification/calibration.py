@@ -1,4 +1,4 @@
-"""From identification terms to a calibrated log10 likelihood ratio (SPEC section 12).
+"""From identification terms to a calibrated log10 likelihood ratio (docs/method/identification.md).
 
 **Model.** Logistic regression on the transformed terms (:func:`features`): with ``x`` the
 standardised features of one SFO, ``logit P(same | x) = w . x + b``, fitted by L2-penalised
@@ -13,7 +13,8 @@ per method and variant for a frontal and a lateral photo's separate SFOs: the sa
 regression on one feature, the sum of the two photos' log10 LRs (:data:`VIEWS_TERMS`), which
 calibrates their combination instead of assuming them independent. A model may also carry a
 bi-Gaussianized warp of its LRs (:func:`bigaussian_warp`, Morrison 2024); the benchmark compares
-it with the plain logistic regression, and the shipped models are plain (docs/method.md).
+it with the plain logistic regression, and the shipped models are plain
+(docs/decisions/0015-identification-calibration-model.md).
 
 **Bounds.** An LR is never more extreme than the data it was fitted on can support: it is
 clipped to ``[-log10(n_same), log10(n_diff)]`` (a different-person score rarer than
@@ -85,7 +86,8 @@ VIEWS_TERMS = (VIEWS_LOG10_LR,)
 #: The terms' models' L2 penalty on their standardised weights is this over their number of
 #: same-person pairs (:func:`ridge_for`): the fitted loss is a mean over each class, so a
 #: prior worth a fixed number of pairs is a penalty that shrinks as the same-person pairs (the
-#: rarer class) grow. Chosen on 152 generated subjects and the joint SFO's 12 (docs/method.md,
+#: rarer class) grow. Chosen on 152 generated subjects and the joint SFO's 12
+#: (docs/decisions/0015-identification-calibration-model.md,
 #: "On 152 subjects"): a fixed 1e-3 lowered the single photos' Cllr on 140 subjects against the
 #: 1e-2 first shipped but overfitted the 12-subject joint model (Cllr 0.50 -> 0.76); scaled by
 #: the pairs it keeps both.

@@ -1,11 +1,13 @@
-"""Cohort normalisation of the landmark term (SPEC section 12): how well does this photo fit
+"""Cohort normalisation of the landmark term (docs/method/identification.md): how well does this
+photo fit
 *this* skull compared with how well it fits other people's skulls?
 
 The marginal landmark term ``landmark_chi2`` (:mod:`lilium.identification.terms`) varies from
 photo to photo for reasons that have nothing to do with the skull: the view, how many
 landmarks are visible, how sharp they are. Measured on 40 generated subjects, that spread
 across photos, not the ranking within a photo, is what kept the pooled calibration poor
-(docs/method.md, Identification). Speaker and face recognition meet the same problem and
+(docs/method/identification.md, Identification). Speaker and face recognition meet the same problem
+and
 answer it with test normalisation ("T-norm"): score the same observation against a cohort of
 impostor models and express the candidate's score in the cohort's units.
 
@@ -24,7 +26,7 @@ The mean and the SD of ``ln chi2_j`` over the cohort are two terms of the identi
 (``cohort_mean``, ``cohort_sd``): they change nothing in how the skulls of one photo rank, and
 tell the calibration how far this photo's ``landmark_chi2`` values spread. Test normalisation
 proper (dividing the candidate's term by them) was measured too and lost to letting the
-calibration weigh them (docs/method.md, Identification).
+calibration weigh them (docs/method/identification.md, Identification).
 
 Maths only: the shipped cohort is read by :mod:`lilium.io.calibration`.
 """

@@ -1,4 +1,5 @@
-"""From a log10 likelihood ratio to a conclusion an examiner can sign (SPEC section 12).
+"""From a log10 likelihood ratio to a conclusion an examiner can sign
+(docs/method/identification.md).
 
 **The verbal scale** (after MEPROCS' seven levels; the bands are Lilium's own):
 
@@ -15,7 +16,7 @@ log10 LR                   conclusion
 =========================  ===============================
 
 An LR of 3 (log10 0.5) is the least called support: below it the calibration's own spread
-between subject folds is of the same size (docs/method.md, "Identification").
+between subject folds is of the same size (docs/method/identification.md, "Identification").
 
 **Caps.** Support is capped by the material: each of these lowers the highest support
 level the case can reach by one step (strong -> moderate -> limited -> undetermined), and each
@@ -90,7 +91,7 @@ def level(log10_lr):
 
 
 def material_caps(has_mandible, photos, unreviewed_automatic, pairs):
-    """The caps of SPEC section 12 that apply, as ``{code: sentence}``.
+    """The caps of docs/method/identification.md that apply, as ``{code: sentence}``.
 
     Parameters
     ----------

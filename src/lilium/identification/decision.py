@@ -8,11 +8,12 @@ the sum with ``<method>/<variant>/pair_sum`` (a slope and an offset fitted on sa
 different-person pairs instead of assuming the photos independent, which they are not: they
 share the soft tissue; Lilium's slope came out above 1, each photo's own model being
 conservative; without that model, the plain sum, and the note says so). Measured on 52
-generated subjects (docs/identification.md): Cllr 0.242 against 0.265 for the plain sum and
-0.417 for one model of both photos with their soft tissue shared. Any other two or more photos
-use ``<method>/<variant>/pair`` (that shared-soft-tissue model, fitted on a frontal and a
-lateral photo; the decision's note says so). Without a model for the decision the LR is not
-given and the conclusion is "undetermined", naming the model missing and how to fit it.
+generated subjects (docs/decisions/0014-identification-several-photos.md): Cllr 0.242
+against 0.265 for the plain sum and 0.417 for one model of both photos with their soft tissue
+shared. Any other two or more photos use ``<method>/<variant>/pair`` (that shared-soft-tissue
+model, fitted on a frontal and a lateral photo; the decision's note says so). Without a model
+for the decision the LR is not given and the conclusion is "undetermined", naming the model
+missing and how to fit it.
 
 Maths and rules only: the calibration models and the cohort are passed in (the workflow reads
 them, :mod:`lilium.casework.identify`).

@@ -1,4 +1,5 @@
-"""The identification terms and score of one SFO result, single or joint (SPEC section 12).
+"""The identification terms and score of one SFO result, single or joint
+(docs/method/identification.md).
 
 :func:`identification_terms` turns a skull, the photo(s) and the camera(s) and soft tissue an
 SFO found into the terms of :mod:`lilium.identification.terms`; :func:`nll_score` adds them up
@@ -72,7 +73,8 @@ def outside_fraction(skull, photo, camera):
 #: distance (:data:`OUTSIDE_BAND_MIN_PX` at least) outside the head mask
 #: (:func:`skull_beyond_head`): a pixel or two at the mask's edge is raster and mask noise, not
 #: a skull that leaves the head. 1 % is about 0.9 mm at the face, a third of the thinnest soft
-#: tissue at the head's outline. Measured on true pairs of the headsq CT (docs/identification.md,
+#: tissue at the head's outline. Measured on true pairs of the headsq CT
+#: (docs/method/identification.md,
 #: "Skull outside the head"): Lilium's skulls lie wholly inside the head; POSEST-SFO's failed
 #: lateral cameras put 44-25,000 pixels beyond the band, 2-185 % of the eye-corner distance deep.
 OUTSIDE_BAND_EYE = 0.01

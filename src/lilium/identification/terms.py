@@ -1,7 +1,9 @@
-"""The identification terms of an SFO result (SPEC section 12): how likely the observations
+"""The identification terms of an SFO result (docs/method/identification.md): how likely the
+observations
 are under "this skull is this person", given the camera(s) the SFO found.
 
-The model (docs/method.md, "Identification"), for every landmark pair ``i`` (cranial point
+The model (docs/method/identification.md, "Identification"), for every landmark pair ``i`` (cranial
+point
 ``C_i``, soft-tissue axis ``a_i``, population depth mean ``mu_i`` and SD ``s_i``):
 
 - **the soft tissue is a random vector**, not a free parameter: the facial point is
@@ -56,7 +58,7 @@ The terms (all "lower is better", dimensionless):
   :func:`lilium.identification.cohort.centred_cohort_terms`): how much another person's
   differences cost this skull's fit to this photo. Unlike the cohort terms they do not compare
   the photo with the generated population's mean face, so they read a real photo as they read
-  a generated one (docs/identification.md, "The realism gap").
+  a generated one (docs/method/identification.md, "The realism gap").
 
 A term whose input is missing (no mask, no curve, no prior) is None; the calibration
 (:mod:`lilium.identification.calibration`) reads a None as the term's typical value and says so.
@@ -115,12 +117,14 @@ REFERENCE_TERMS = (*COHORT_TERMS, "landmark_refit", "landmark_worst", "centred_m
                    "centred_sd")
 
 #: The terms the calibration uses. ``soft_tissue_z2`` is reported but left out: measured on 20
-#: generated subjects (docs/method.md, Identification) it lowered Lilium's frontal per-photo
+#: generated subjects (docs/decisions/0012-identification-marginal-likelihood.md, Identification) it
+#: lowered Lilium's frontal per-photo
 #: AUC from 0.963 to 0.939; the soft tissue's plausibility is already in the marginal
 #: landmark term. ``landmark_refit`` enters through its gap to ``landmark_chi2``
-#: (``landmark_tension``, docs/method.md: "The landmarks' own fit").
+#: (``landmark_tension``, docs/decisions/0016-identification-features.md: "The landmarks' own fit").
 #:
-#: The cohort terms and ``landmark_snorm`` are left out since 2026-12-06 (docs/identification.md,
+#: The cohort terms and ``landmark_snorm`` are left out since 2026-12-06
+#: (docs/method/identification.md,
 #: "The realism gap"): they read a photo or a skull against the generated population, and a real
 #: head lies outside it (headsq's photos: ``cohort_mean`` 1.7-2.0 against the generated photos'
 #: -0.5-0.5; its skull: ``skull_mean`` 1.1-1.9 against -0.5-0.2), so every real skull, the wrong

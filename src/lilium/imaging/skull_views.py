@@ -12,7 +12,7 @@ landmarks, :func:`lilium.fitness.regions.anatomical_frame`):
   subject's left (``up x anterior``, computed from the mesh, not from the labels) is at the
   image's right, as in a frontal photo;
 - ``lateral_left``: the camera on the subject's left, the face towards the image's left edge
-  (SPEC section 8's ``lateral_left``); ``lateral_right`` the mirror set-up.
+  (docs/contract.md's ``lateral_left``); ``lateral_right`` the mirror set-up.
 
 Because the image's left-right comes from the mesh and its anatomical directions, labels that
 were swapped between the sides show on the wrong side of the picture.

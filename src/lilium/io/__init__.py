@@ -1,1 +1,1 @@
-"""Case folders, meshes and result files (SPEC section 8): all file formats live here."""
+"""Case folders, meshes and result files (docs/contract.md): all file formats live here."""

@@ -1,4 +1,5 @@
-"""Identification calibrations on disk (SPEC section 12): the shipped one and a user's.
+"""Identification calibrations on disk (docs/method/identification.md): the shipped one and a
+user's.
 
 A calibration file is JSON: ``{"format": "lilium-calibration", "version": 1, "models":
 {"<method>/<variant>/<decision>": Calibration.to_dict(), ...}, "provenance": {...}}``, with

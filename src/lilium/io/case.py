@@ -1,4 +1,4 @@
-"""Case folders of SPEC section 8: subject (skull) folders and photo folders.
+"""Case folders of docs/contract.md: subject (skull) folders and photo folders.
 
 Every problem found is a ``ValueError`` whose message names the file, the field and the fix.
 """
@@ -152,7 +152,7 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
     mesh_path : str or Path
         PLY, OBJ or STL (millimetres).
     landmarks_path : str or Path
-        ``cranial_landmarks.json`` (SPEC section 8), or any file
+        ``cranial_landmarks.json`` (docs/contract.md), or any file
         :func:`lilium.io.formats.read_landmarks` reads (3D Slicer, MeshLab, CSV, JSON; aliases).
     axes_path : str or Path, optional
         ``soft_tissue_axes.json``; absent axes default to the outward skull-surface normal.
@@ -309,7 +309,7 @@ def read_photo(folder, load_image=True):
     if not isinstance(meta, dict):
         raise ValueError(
             f'{meta_path}: must be a JSON object {{"view": ..., "landmarks": {{...}}}}, '
-            f"got a JSON {json_type(meta)}; see SPEC section 8 for the photo folder"
+            f"got a JSON {json_type(meta)}; see docs/contract.md for the photo folder"
         )
     view = _field(meta_path, meta, "view")
     if view not in VIEWS:
@@ -334,7 +334,8 @@ def read_photo(folder, load_image=True):
     curve_path = folder / "face_curve.json"
     curve = read_face_curve(curve_path, view, size_wh) if curve_path.is_file() else None
     if curve is None and mask is not None and written_by_lilium_photo(meta):
-        # A head mask ends at the neck (often the collar): never a facial curve (SPEC 11).
+        # A head mask ends at the neck (often the collar): never a facial curve
+        # (docs/method/photo.md).
         curve = np.empty((0, 2))
     return Photo(
         path_id(folder),

@@ -1,8 +1,9 @@
-"""The facial curve file of SPEC section 8: ``face_curve.json``.
+"""The facial curve file of docs/contract.md: ``face_curve.json``.
 
 ``{"chin_jaw": [[u, v], ...]}`` for a frontal photo, ``{"forehead": [[u, v], ...]}`` for a
 lateral one (pixels, ``u`` = column, ``v`` = row). P_pll compares the skull's chin-jaw or
-forehead contour with it; without it, the curve is derived from the face mask (SPEC section 5).
+forehead contour with it; without it, the curve is derived from the face mask
+(docs/method/lilium.md).
 A file that holds no curve for the photo's view is an error, not silently ignored: the SFO
 would otherwise run on the mask's curve while the user believes it ran on theirs. A file that
 holds the other view's curve (``forehead`` for a photo declared frontal) names the view to

@@ -10,9 +10,9 @@ The focal length in pixels is ``focal_mm * pixels_per_mm_on_the_sensor``. In ord
    a 36 x 24 mm frame; the interval covers both readings.
 
 ``DigitalZoomRatio`` > 1 multiplies the focal length of 1. The interval is the estimate
-``+- tolerance`` (5 % by default: the SPEC's focal prior width).
+``+- tolerance`` (5 % by default: the protocol's focal prior width).
 
-EXIF describes the camera's pixel grid, not necessarily the file's (SPEC section 11): a photo
+EXIF describes the camera's pixel grid, not necessarily the file's (docs/method/photo.md): a photo
 cropped or resized after the shot converts to the wrong number of pixels. The focal is used only
 when the tags agree that the file is the camera's full frame at its own resolution
 (:func:`full_frame_problem`): ``PixelXDimension``/``PixelYDimension`` and ``ImageWidth``/
@@ -21,7 +21,7 @@ when the tags agree that the file is the camera's full frame at its own resoluti
 ``--sensor-width-mm``) and with ``FocalLengthIn35mmFilm`` over ``FocalLength``; each focal
 length lies in :data:`EXIF_FOCAL_RANGE_MM`. Otherwise, and when a ``FocalLength`` cannot be
 converted at all (no 35 mm value, no pixel pitch, an unknown camera), :func:`exif_focal` says
-which tag and what fixes it (warning ``exif_focal_unusable`` of SPEC section 10), and no prior
+which tag and what fixes it (warning ``exif_focal_unusable`` of docs/checks.md), and no prior
 is taken.
 """
 
@@ -315,7 +315,7 @@ def full_frame_problem(info, sensor_width_mm=None):
     Returns
     -------
     str
-        One clause naming the tag that disagrees (SPEC section 11), or "".
+        One clause naming the tag that disagrees (docs/method/photo.md), or "".
     """
     w, h = info["image_size_wh"]
     size = f"the file's {w}x{h} px"

@@ -1,4 +1,4 @@
-"""Landmark files users already have, converted to the canonical names of SPEC section 2.
+"""Landmark files users already have, converted to the canonical names of docs/method/skull.md.
 
 Readers
 -------
@@ -7,7 +7,7 @@ Readers
 - CSV: ``name,x,y,z`` (cranial, mm) or ``name,u,v`` (facial, pixels), with or without a header
   (a header may name the columns ``name``/``label``/``landmark`` and ``x,y,z`` or ``u,v``);
   ``,``, ``;`` or tab separated;
-- JSON: the SPEC format ``{"landmarks": {name: coords}}``, a flat ``{name: coords}``, or a
+- JSON: the contract's format ``{"landmarks": {name: coords}}``, a flat ``{name: coords}``, or a
   Slicer markups document.
 
 Names
@@ -238,13 +238,13 @@ def name_error(path, where, name, kind):
     if elsewhere is not None:
         return ValueError(
             f"{_at(path, where)}: {name!r} is a {other} landmark ({elsewhere}) but this file "
-            f"holds {kind} landmarks; use the {kind} name (see SPEC section 2) or the other file"
+            f"holds {kind} landmarks; use the {kind} name (docs/conventions.md) or the other file"
         )
     guess = suggest_name(key, kind)
     if guess:
         hint = f"did you mean {guess}?"
     else:
-        hint = f"use a {kind} name of SPEC section 2 (e.g. {names[0]!r})"
+        hint = f"use a {kind} name of docs/method/skull.md (e.g. {names[0]!r})"
     return ValueError(f"{_at(path, where)}: unknown {kind} landmark {name!r}; {hint}")
 
 
@@ -281,7 +281,7 @@ def suggest_name(key, kind):
 def canonical_points(path, entries, kind, dim=None, allow_empty=False, finite=True):
     """Validate and rename ``(name, coords, where)`` entries read from a landmark file.
 
-    The one check every landmark reader goes through (SPEC JSON files, 3D Slicer, MeshLab,
+    The one check every landmark reader goes through (the contract's JSON files, 3D Slicer, MeshLab,
     CSV): names through the alias tables, ``dim`` numbers each, finite, each canonical landmark
     once.
 
@@ -352,7 +352,7 @@ def _short_repr(value, limit=60):
 
 
 def points_from_object(path, field, raw, kind, dim=None, allow_empty=False, finite=True):
-    """Validate a JSON object ``{name: coords}`` (the ``field`` of a SPEC section 8 file).
+    """Validate a JSON object ``{name: coords}`` (the ``field`` of a docs/contract.md file).
 
     The ``"landmarks"`` of ``cranial_landmarks.json``, ``facial_landmarks.json`` and
     ``photo.json``, the ``"axes"`` of ``soft_tissue_axes.json``: the same checks and aliases as

@@ -60,7 +60,7 @@ def _unique_keys(pairs):
     return out
 
 
-#: Deepest nesting of arrays and objects a JSON input may have: SPEC files need 4 levels; a
+#: Deepest nesting of arrays and objects a JSON input may have: contract files need 4 levels; a
 #: deeper file is hostile or broken, and would exhaust Python's recursion further on.
 MAX_JSON_DEPTH = 64
 

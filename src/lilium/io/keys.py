@@ -1,6 +1,6 @@
 """Keys of ``photo.json`` and its ``priors`` that Lilium reads: any other key is reported.
 
-SPEC section 8 allows extra fields, so an unknown key is a warning (``unknown_key``), not an
+docs/contract.md allows extra fields, so an unknown key is a warning (``unknown_key``), not an
 error; but a typo'd prior (``focal_pxx``) would otherwise vanish without a word while the user
 believes the SFO used it. The warning names the key and the closest known one.
 """
@@ -9,7 +9,8 @@ import difflib
 
 from ..inputs import CaseWarning
 
-#: Top-level keys of ``photo.json`` (SPEC sections 8 and 11, the generator's extras).
+#: Top-level keys of ``photo.json`` (docs/contract.md and docs/method/photo.md, the generator's
+#: extras).
 PHOTO_KEYS = (
     "view",
     "landmarks",
@@ -17,13 +18,13 @@ PHOTO_KEYS = (
     "ground_truth",
     "landmark_sources",
     "soft_tissue_axes_sets",
-    # written by ``lilium photo`` (SPEC section 11)
+    # written by ``lilium photo`` (docs/method/photo.md)
     "prepared_by",
     "face_mask_is_head",
     "warnings",
 )
 
-#: Keys of ``photo.json``'s ``priors`` (SPEC section 8; ``lilium photo``'s automatic ones).
+#: Keys of ``photo.json``'s ``priors`` (docs/contract.md; ``lilium photo``'s automatic ones).
 PRIOR_KEYS = (
     "focal_px",
     "scd_mm",

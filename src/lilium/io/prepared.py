@@ -1,4 +1,5 @@
-"""Photo folders prepared by ``lilium photo`` (SPEC section 11): what it wrote beyond SPEC 8.
+"""Photo folders prepared by ``lilium photo`` (docs/method/photo.md): what it wrote beyond
+docs/contract.md.
 
 Recognising such a folder, the landmarks it placed from its face template and who placed each
 landmark, and the extra facts of its ``photo.json`` (:func:`read_prepared`).
@@ -28,7 +29,7 @@ PREPARED_BY = "lilium photo"
 def written_by_lilium_photo(meta):
     """Whether a ``photo.json`` object was written by ``lilium photo`` (this or an older one,
     recognised by its automatic ``landmark_sources`` and ``priors.sources``): its
-    ``face_mask.png`` is then a head mask, down to the neck (SPEC section 11)."""
+    ``face_mask.png`` is then a head mask, down to the neck (docs/method/photo.md)."""
     if not isinstance(meta, dict):
         return False
     if meta.get("prepared_by") == PREPARED_BY:
@@ -43,7 +44,7 @@ def written_by_lilium_photo(meta):
 
 
 def _without_unconfirmed_templates(landmarks, sources):
-    """Drop the landmarks ``lilium photo`` placed from its face template (SPEC section 11).
+    """Drop the landmarks ``lilium photo`` placed from its face template (docs/method/photo.md).
 
     The rule: a landmark whose ``landmark_sources`` entry says ``"quality": "template"`` is
     left out unless the entry also says ``"confirmed": true`` (the review page sets it).
@@ -80,7 +81,8 @@ def landmark_qualities(sources, landmarks):
 
 @dataclass(frozen=True)
 class PreparedFacts:
-    """What ``lilium photo`` wrote into a photo folder beyond SPEC section 8 (SPEC section 11).
+    """What ``lilium photo`` wrote into a photo folder beyond docs/contract.md
+    (docs/method/photo.md).
 
     Attributes
     ----------

@@ -1,4 +1,4 @@
-"""SFO outputs: ``result.json`` (SPEC section 8) and PNG pictures."""
+"""SFO outputs: ``result.json`` (docs/contract.md) and PNG pictures."""
 
 import os
 from pathlib import Path
@@ -190,7 +190,7 @@ def read_result(path):
 
 def read_joint_result(path, facial_names=None):
     """A :class:`~lilium.methods.joint.JointSfoResult` back from a joint SFO's ``result.json``
-    (SPEC section 9; what a resumed ``lilium case --joint`` keeps).
+    (docs/method/joint.md; what a resumed ``lilium case --joint`` keeps).
 
     Parameters
     ----------

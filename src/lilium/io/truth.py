@@ -1,4 +1,5 @@
-"""The ground truth of a generated photo (SPEC sections 7 and 8), read in one place.
+"""The ground truth of a generated photo (docs/method/evaluation.md and docs/contract.md), read in
+one place.
 
 A generated photo's ``photo.json`` carries ``ground_truth`` (``subject``, ``skull2cam``,
 ``focal_px``, ``scd_mm``, ``noise``, ``landmarks_noise_free``, and from the generator also
@@ -20,7 +21,7 @@ FACIAL_LANDMARKS_FILE = "facial_landmarks.json"
 
 @dataclass(frozen=True)
 class GroundTruth:
-    """What is known about a generated photo, for scoring an SFO (SPEC section 7).
+    """What is known about a generated photo, for scoring an SFO (docs/method/evaluation.md).
 
     Attributes
     ----------
@@ -119,7 +120,7 @@ def read_ground_truth(photo_dir, subject_dir=None):
     Parameters
     ----------
     photo_dir : str or Path
-        Holds ``photo.json`` with a ``ground_truth`` object (SPEC section 8).
+        Holds ``photo.json`` with a ``ground_truth`` object (docs/contract.md).
     subject_dir : str or Path, optional
         The subject's folder, for its true 3D facial landmarks (``facial_landmarks.json``).
 

@@ -1,4 +1,4 @@
-"""What is checked before and after an SFO (SPEC section 10), as pure functions.
+"""What is checked before and after an SFO (docs/checks.md), as pure functions.
 
 Anatomical directions of a skull, from its landmarks (:func:`skull_directions`):
 

@@ -1,4 +1,4 @@
-"""Joint Lilium: one soft tissue shared by every photo of a person (SPEC section 9).
+"""Joint Lilium: one soft tissue shared by every photo of a person (docs/method/joint.md).
 
 One DE genotype (the soft tissue) for all photos, one camera per photo. The genes are defined
 over the *union* of the cranial landmarks any photo uses (in the order of
@@ -9,7 +9,7 @@ focal cap, P_skof and P_pll, terms switched off): the joint problem calls its tw
 :meth:`~LiliumProblem.camera_terms` then :meth:`~LiliumProblem.add_image_terms`, with that
 photo's rows of the shared facial landmarks.
 
-Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``):
+Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method/joint.md``):
 
 - **Camera chains.** The DE payload holds one camera per photo per member (arrays of shape
   ``(S, P, ...)``); photo ``p``'s trial camera is warm-started from photo ``p``'s camera of the
@@ -32,7 +32,7 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   cameras even the *true* soft tissue scores P_cam in the millions (the focal length of a
   least-squares camera is 0.2-6 x the truth under Exp. C's landmark noise), so the joint DE
   bent the soft tissue away from the face. ``camera="least_squares"`` is the design before
-  (docs/method.md, "The joint SFO's cameras on the priors").
+  (docs/decisions/0006-joint-sfo-cameras-and-budget.md).
 - **Early exit.** A trial's image penalties of photo ``p`` are skipped when the partial sum
   over all photos already exceeds its threshold (the other photos' partial sums are the
   offset): the run is the same, with fewer P_skof/P_pll evaluations. Each term is added for
@@ -44,9 +44,9 @@ Design (measured in ``benchmarks/bench_joint.py``, results in ``docs/method.md``
   frontal and one lateral photo a shared soft tissue still had the cones' angular freedom to
   absorb the landmarks' noise (it fitted them tighter than either single SFO), and a real face
   may lie outside the depth table (the headsq CT's canthi and alare), so the prior is on the
-  direction only. The result's fitness is the photos' weighted sum without it (SPEC section
-  9); ``joint_fitness`` in ``extra`` is the DE's, with it. ``prior_weight=0`` is the design
-  before (docs/method.md, "An angular prior").
+  direction only. The result's fitness is the photos' weighted sum without it
+  (docs/method/joint.md); ``joint_fitness`` in ``extra`` is the DE's, with it.
+  ``prior_weight=0`` is the design before (docs/decisions/0007-joint-sfo-soft-tissue-prior.md).
 - **Budget.** ``generations_factor`` scales the DE generations (default
   :data:`DEFAULT_GENERATIONS_FACTOR`, 0.5: with the cameras on the priors half the generations
   gave the same BPE as all of them on 8 generated subjects x 3 seeds, complete and
@@ -81,7 +81,8 @@ CAMERAS = ("priors", "least_squares")
 
 #: The defaults, chosen by ``benchmarks/bench_joint.py`` (full budget, seeds 1-3, scale
 #: weighting; mean BPE of both photos against the independent SFOs of the same photos,
-#: docs/method.md): least-squares cameras x1.044 / x1.177 on 8 generated subjects complete /
+#: docs/decisions/0006-joint-sfo-cameras-and-budget.md): least-squares cameras x1.044 / x1.177 on 8
+#: generated subjects complete /
 #: without mandible and x1.223 / x1.440 on headsq ``hq`` / ``hq_nm``; cameras on the priors at
 #: half the generations x0.898 / x1.022 / x1.101 / x1.058 (all the generations: x0.894 /
 #: x0.995 / x1.141 / x1.015), x0.922 / x0.995 / x1.018 / x1.034 since the refinement takes 10
@@ -281,7 +282,8 @@ class JointLiliumProblem:
 #: the member's refined camera, so a chain keeps converging over the generations). 10, not 5:
 #: with 5 a camera far outside its priors (a mandible-less photo's least-squares focal length)
 #: was still on the prior's edge, or outside it, at the end of the run; measured
-#: (``bench_joint.py``, seeds 1-3, docs/method.md) 5 -> 10 -> 15 iterations: mean BPE against
+#: (``bench_joint.py``, seeds 1-3, docs/decisions/0006-joint-sfo-cameras-and-budget.md) 5 -> 10 ->
+#: 15 iterations: mean BPE against
 #: the independent SFOs x0.898 -> x0.922 -> x0.972 on generated complete subjects, x1.022 ->
 #: x0.995 -> x0.974 without mandible, x1.101 -> x1.018 -> x1.088 on headsq ``hq``, x1.058 ->
 #: x1.034 -> x1.037 on ``hq_nm``; time x1.19-2.31 -> x1.17-1.82 -> x1.10-1.47 of the pair.
@@ -294,16 +296,15 @@ def camera_on_priors(problem, facial_mm, terms, members=None):
     :meth:`LiliumProblem.camera_terms` fits each camera to the landmarks alone; P_cam then
     only judges it. A single SFO lives with that: its soft tissue bends until the
     least-squares camera lands inside the priors. A joint SFO's soft tissue is shared, so it
-    cannot do that for every photo at once (docs/method.md, "Joint SFO on real anatomy"); here
-    the camera itself takes the priors into account
+    cannot do that for every photo at once (docs/decisions/0009-joint-sfo-real-anatomy.md); here the
+    camera itself takes the priors into account
     (:func:`~lilium.pose.prior_refine.refine_with_priors`, :data:`PRIOR_CAMERA_ITERATIONS`
     iterations, started from the camera of the member the trial competes with, the previous
     such refinement, where it has a valid one, else from the least-squares camera). A member
     whose least-squares camera is valid and inside every prior (P_cam = 0) keeps it; a refined
     camera replaces it only when it is valid and lowers MSE_pix + P_cam. Along a dolly zoom the
     landmarks hardly tell focal lengths apart, so most refined cameras stop on an edge of the
-    focal prior, at little cost in BPE (docs/method.md, "The joint SFO's cameras on the edge of
-    the priors").
+    focal prior, at little cost in BPE (docs/decisions/0010-joint-sfo-cameras-on-prior-edges.md).
 
     Parameters
     ----------
@@ -423,10 +424,10 @@ class JointSfoResult:
         return tuple(w for r in self.photos for w in r.warnings)
 
     def to_dict(self):
-        """The ``result.json`` dictionary of SPEC section 9.
+        """The ``result.json`` dictionary of docs/method/joint.md.
 
         Each photo's ``fitness`` is its share of the total, ``weight x`` its own fitness, so
-        that the total is the sum of the photos' fitnesses as SPEC section 9 states; its own
+        that the total is the sum of the photos' fitnesses as docs/method/joint.md states; its own
         (unweighted) fitness, the sum of its ``terms``, is ``fitness_unweighted``.
         """
         photos = []

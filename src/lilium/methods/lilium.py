@@ -1,7 +1,7 @@
 """Lilium: differential evolution over soft-tissue cones with a composite fitness.
 
-Each DE individual is a genotype of three genes per usable cranial landmark (SPEC section 3).
-Its fitness (SPEC section 5) is ``MSE_pix + P_cam [+ P_skof] [+ P_pll]``:
+Each DE individual is a genotype of three genes per usable cranial landmark (docs/method/lilium.md).
+Its fitness (docs/method/lilium.md) is ``MSE_pix + P_cam [+ P_skof] [+ P_pll]``:
 
 1. decode the genes into soft-tissue vectors, facial 3D landmarks ``F = C + ST``;
 2. fit the camera to ``(F, f)`` by Levenberg-Marquardt, warm-started from the camera of the
@@ -17,8 +17,8 @@ Its fitness (SPEC section 5) is ``MSE_pix + P_cam [+ P_skof] [+ P_pll]``:
 
 The whole population is evaluated at once (batched LM, batched projections).
 
-A camera that sees the back of the skull (SPEC section 10) or whose focal length exceeds the
-photo's focal cap (SPEC section 4) is "no solution" (P_cam's C_INF). When the best member has
+A camera that sees the back of the skull (docs/checks.md) or whose focal length exceeds the
+photo's focal cap (docs/method/pose.md) is "no solution" (P_cam's C_INF). When the best member has
 no camera for one of those reasons the SFO fails with a message that says which and what to
 fix. Without a focal prior, warning ``focal_cap`` when members fitted the landmarks better than
 the result but exceeded the cap, or when the mean soft tissue fits a focal length above the cap
@@ -112,7 +112,8 @@ class LiliumProblem:
         self.scd_index = [names.index("nasion")] if "nasion" in names else list(range(len(names)))
         self.rng = np.random.default_rng(rng)
         self.periodic = np.tile([False, False, True], len(self.corr.cranial_names))
-        # Asked-for terms whose inputs are missing are switched off (SPEC section 5), and so is
+        # Asked-for terms whose inputs are missing are switched off (docs/method/lilium.md), and so
+        # is
         # each P_cam part without its prior: ``terms_off`` says which and why.
         # Without image terms the DE scores nothing at a working level: none is built.
         images = self.use_skof or self.use_pll
@@ -226,7 +227,8 @@ class LiliumProblem:
         # towards an infinite focal length (near-coplanar landmarks: a skull without the
         # mandible seen from the front) and every later warm start would start from a run-off
         # camera and run off again: each member takes its own POSEST, whose inliers fix a
-        # finite focal length (docs/method.md, "No camera on a mandible-less frontal photo").
+        # finite focal length (docs/decisions/0004-no-camera-on-flat-landmarks.md, "No camera on a
+        # mandible-less frontal photo").
         facing = self._facing(R, t)
         ok = self._valid(f, facing)
         if not lender and not ok.any():

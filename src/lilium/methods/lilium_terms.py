@@ -55,7 +55,7 @@ class SkofTerm:
 class TermOff(ValueError):
     """A fitness term cannot apply to this skull and photo: its inputs are missing.
 
-    Not an error of the SFO (SPEC section 5, "When a term cannot apply"): :func:`image_terms`
+    Not an error of the SFO (docs/method/lilium.md, "When a term cannot apply"): :func:`image_terms`
     switches the term off and keeps the message as the reason (``SfoResult.terms_off``).
     """
 
@@ -245,7 +245,7 @@ def image_terms(skull, photo, centre, use_skof, use_pll, level=None):
     """The image penalties an SFO asks for, each built or switched off.
 
     An asked-for term whose inputs are missing (:class:`TermOff`) is switched off, not an
-    error (SPEC section 5): the SFO runs with the other terms. With a working ``level``
+    error (docs/method/lilium.md): the SFO runs with the other terms. With a working ``level``
     (:mod:`lilium.methods.working_level`) the terms are built on its skull and photo and take
     full-resolution cameras (their values in full-resolution units).
 

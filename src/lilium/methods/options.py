@@ -53,7 +53,7 @@ FOCAL_STOP_FACTOR = 100.0
 
 
 def with_focal_cap(options, focal_prior_px):
-    """``options`` with the focal cap of a photo's focal prior (SPEC section 4).
+    """``options`` with the focal cap of a photo's focal prior (docs/method/pose.md).
 
     POSEST's ``focal_max_px`` becomes :func:`lilium.constants.focal_cap_px` of the prior
     (10,000 px, or twice the prior's upper bound when the prior reaches above that), and each

@@ -1,4 +1,4 @@
-"""Checks of a photo's files against each other, before any SFO (SPEC section 10).
+"""Checks of a photo's files against each other, before any SFO (docs/checks.md).
 
 - **left, right, up and down** (:func:`check_photo_labels`): an upside-down photo (any view),
   and in a frontal photo every left/right pair reversed (mirrored) or some pairs reversed while

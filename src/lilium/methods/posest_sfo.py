@@ -5,10 +5,10 @@ population's mean depth; POSEST then finds the camera from those 3D points and t
 landmarks. The score (used for ranking skulls) is the mean reprojection error in pixels over the
 landmarks visible in the photo. Deterministic: RANSAC runs with a fixed seed.
 
-A camera that sees the back of the skull (SPEC section 10) is treated like no solution; when the
+A camera that sees the back of the skull (docs/checks.md) is treated like no solution; when the
 landmarks fit only from behind, the SFO fails with a message that asks whether left and right
 are swapped in the skull's (or the photo's) landmark file. A camera refused for its focal
-length above the cap says how to lift the cap (SPEC section 4).
+length above the cap says how to lift the cap (docs/method/pose.md).
 """
 
 import time
@@ -126,7 +126,7 @@ RUN_OFF_FACTOR = 10.0
 
 
 def focal_cap_message(photo, focal_px=None):
-    """How to lift the focal cap a camera ran into (SPEC section 4), or what else is wrong.
+    """How to lift the focal cap a camera ran into (docs/method/pose.md), or what else is wrong.
 
     Parameters
     ----------

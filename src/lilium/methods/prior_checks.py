@@ -1,4 +1,4 @@
-"""The priors' checks of an SFO result (SPEC section 10): each prior's provenance
+"""The priors' checks of an SFO result (docs/checks.md): each prior's provenance
 (:func:`priors_record`, the ``"priors"`` of ``result.json``), the warnings about missing priors
 and about a camera outside one (:func:`prior_warnings`), a camera whose perspective
 contradicts the distance prior (:func:`perspective_conflict`, which keeps a conclusion from
@@ -56,7 +56,7 @@ def priors_record(photo):
 
 
 def scd_point_mm(facial_landmarks_mm):
-    """The point the subject-to-camera distance is measured to (SPEC section 5)."""
+    """The point the subject-to-camera distance is measured to (docs/method/lilium.md)."""
     if "nasion" in facial_landmarks_mm:
         return np.asarray(facial_landmarks_mm["nasion"], float)
     return np.mean([np.asarray(v, float) for v in facial_landmarks_mm.values()], axis=0)

@@ -30,7 +30,7 @@ class Method:
         Whether the seed changes the result (repetitions make sense).
     run_joint : callable or None
         ``run_joint(skull, photos, options, seed) -> JointSfoResult``: one SFO of several
-        photos of one person with one shared soft tissue (SPEC section 9); None when the
+        photos of one person with one shared soft tissue (docs/method/joint.md); None when the
         method has no joint form.
     """
 
@@ -95,7 +95,7 @@ def run_sfo(method, skull, photo, options=SfoOptions(), seed=0):
     Returns
     -------
     SfoResult
-        With its warnings, priors' provenance and landmark error (SPEC section 10,
+        With its warnings, priors' provenance and landmark error (docs/checks.md,
         :func:`~lilium.methods.checks.finish_result`).
 
     Raises
@@ -124,7 +124,8 @@ def check_joint_method(method, variant=None):
 
 
 def run_joint_sfo(method, skull, photos, options=SfoOptions(), seed=0):
-    """Run one joint SFO: several photos of one person, one shared soft tissue (SPEC section 9).
+    """Run one joint SFO: several photos of one person, one shared soft tissue
+    (docs/method/joint.md).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""The result of one SFO and its SPEC section 8 dictionary."""
+"""The result of one SFO and its docs/contract.md dictionary."""
 
 from dataclasses import dataclass, field
 
@@ -32,7 +32,7 @@ class SfoResult:
     extra : dict
         Method-specific additions (e.g. the fitness history).
     warnings : tuple of lilium.inputs.CaseWarning
-        SPEC section 10 warnings (``view_mismatch``, ``no_focal_prior``, ...).
+        docs/checks.md warnings (``view_mismatch``, ``no_focal_prior``, ...).
     priors : dict or None
         The priors used and where each came from
         (:func:`lilium.methods.prior_checks.priors_record`).
@@ -40,8 +40,8 @@ class SfoResult:
         ``mean_px``, ``mean_mm``, ``per_landmark_px``
         (:func:`lilium.methods.checks.landmark_error`); None when the SFO failed.
     terms_off : dict of str -> str
-        Terms switched off for this SFO because their inputs are missing, and why (SPEC
-        section 5, "When a term cannot apply"): ``p_skof``, ``p_pll`` (asked for by the
+        Terms switched off for this SFO because their inputs are missing, and why
+        (docs/method/lilium.md, "When a term cannot apply"): ``p_skof``, ``p_pll`` (asked for by the
         variant), ``p_cam_focal``, ``p_cam_scd``, ``p_cam_head`` (a P_cam part without its
         prior). Empty when every term ran; ``result.json`` then has no ``terms_off`` key.
 
@@ -70,7 +70,7 @@ class SfoResult:
         return self.camera is not None
 
     def to_dict(self):
-        """The ``result.json`` dictionary of SPEC section 8."""
+        """The ``result.json`` dictionary of docs/contract.md."""
         camera = self.camera.to_dict() if self else None
         out = {
             "method": self.method,

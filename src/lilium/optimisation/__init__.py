@@ -1,4 +1,4 @@
-"""Differential Evolution on the unit cube (SPEC section 6)."""
+"""Differential Evolution on the unit cube (docs/method/lilium.md)."""
 
 from .de import DEOptions, DEResult, DifferentialEvolution, differential_evolution
 

@@ -4,7 +4,7 @@ Shape of scipy's ``differential_evolution``: a solver object that is also an ite
 generation per ``next``), a thin function over it, and a frozen result. The objective evaluates a
 whole population at once: ``(S, D) -> (S,)``.
 
-Decisions the paper leaves open (SPEC section 6), fixed here:
+Decisions the paper leaves open (docs/method/lilium.md), fixed here:
 
 - Population initialised uniformly at random in ``[0, 1]^D``.
 - Mutant ``x_r1 + F (x_r2 - x_r3)``, with ``r1, r2, r3`` distinct and different from the target.
@@ -38,7 +38,8 @@ class DEOptions:
 
     Defaults: population 30, F = 0.8, CR = 0.9, 750 generations and 500 s as in the paper.
     Chosen by measurement on generated Exp. C photos (8 frontal, 8 lateral, Lilium skof+pll,
-    see ``docs/method.md``): with F = 0.5 the best fitness is still falling at 750 generations;
+    see ``docs/decisions/0002-de-defaults.md``): with F = 0.5 the best fitness is still falling at
+    750 generations;
     F = 0.8 converges further and lowered the mean BPE from 2.47 to 1.89 mm (frontal) and from
     3.36 to 2.76 mm (lateral); CR = 0.5 or 0.7 and F = 0.9 did worse; a population of 30 costs
     about 60 % of the time of 50 for a similar BPE.

@@ -34,7 +34,7 @@ class FaceAnalysis:
         Mesh points (u, v, depth) pixels.
     landmarks : dict of str -> ndarray of shape (2,)
     sources : dict of str -> dict
-        ``landmark_sources`` of SPEC section 11.
+        ``landmark_sources`` of docs/method/photo.md.
     face2cam : ndarray of shape (3, 3) or None
         Face-frame orientation (:mod:`.headpose`).
     angles_deg : dict
@@ -77,7 +77,8 @@ class FaceAnalysis:
 
     @property
     def view(self):
-        """``frontal`` or the lateral view the yaw suggests (SPEC: lateral_left faces -u)."""
+        """``frontal`` or the lateral view the yaw suggests (docs/contract.md: lateral_left faces
+        -u)."""
         yaw = self.angles_deg.get("yaw", 0.0)
         if abs(yaw) < LATERAL_YAW_DEG:
             return "frontal"

@@ -1,6 +1,7 @@
-"""The photo folder ``lilium photo`` writes, and owns (issue 28, SPEC sections 8 and 11).
+"""The photo folder ``lilium photo`` writes, and owns (issue 28, docs/contract.md and
+docs/method/photo.md).
 
-Rules (docs/photo.md):
+Rules (docs/method/photo.md):
 
 - ``lilium photo`` writes only :data:`OWN_FILES` and marks its ``photo.json`` with
   ``"prepared_by": "lilium photo"`` (a folder of an older version is recognised by its automatic

@@ -5,7 +5,7 @@ The face frame
 --------------
 MediaPipe's legacy mesh model returns 3D points (u, v in image pixels, depth in the same
 scale, larger = farther) in a weak-perspective camera frame: x right, y down, z forward, as
-SPEC section 8's camera. The *face frame* is defined on landmarks that exist both on the
+docs/contract.md's camera. The *face frame* is defined on landmarks that exist both on the
 mesh and on a skull, so that it can be built on both:
 
 - ``x``: the subject's left, the mean direction right -> left of the bilateral pairs (eye
@@ -37,7 +37,8 @@ IRIS_DIAMETER_MM = 11.7
 #: Its spread (mm) between adults and the measuring error (px) assumed on the diameter.
 IRIS_DIAMETER_SPREAD_MM = 0.5
 IRIS_MEASURE_ERROR_PX = 0.5
-#: Subject-to-camera distances (mm) of a portrait (SPEC section 11): a focal prior that puts the
+#: Subject-to-camera distances (mm) of a portrait (docs/method/photo.md): a focal prior that puts
+#: the
 #: camera nearer or farther through the iris is wrong (warning ``implausible_prior``).
 PLAUSIBLE_DISTANCE_MM = (300.0, 10_000.0)
 #: Angle (degrees) from the Frankfurt plane's normal (up) to the face frame's ``-y`` axis
@@ -51,7 +52,7 @@ FRANKFURT_TO_FACE_PITCH_DEG = 5.0
 MESH_PAIRS = ((33, 263), (133, 362), (234, 454), (172, 397), (61, 291), (64, 294))
 MESH_UPPER = (168, 9)
 MESH_LOWER = (175, 152)
-#: The same on a skull (cranial landmark names, SPEC section 2).
+#: The same on a skull (cranial landmark names, docs/method/skull.md).
 SKULL_PAIRS = ("ectoconchion", "dacryon", "zygion", "gonion", "alare", "frontotemporale")
 SKULL_UPPER = ("nasion", "glabella")
 SKULL_LOWER = ("pogonion", "gnathion")
@@ -150,7 +151,8 @@ def skull_face_frame(cranial_landmarks):
 
 
 def head_rotation_skull2cam(face2cam, cranial_landmarks):
-    """The SPEC head-orientation prior for a paired skull: ``face2cam @ skull2face``."""
+    """The head-orientation prior (docs/contract.md) for a paired skull: ``face2cam @
+    skull2face``."""
     skull2face, _ = skull_face_frame(cranial_landmarks)
     return np.asarray(face2cam, dtype=float) @ skull2face
 
@@ -185,7 +187,7 @@ def iris_distance_mm(focal_px, iris_diameter_px):
 
 
 def implausible_distance(focal_px, iris_diameter_px):
-    """Why a focal prior is implausible through the iris, or "" (SPEC section 11).
+    """Why a focal prior is implausible through the iris, or "" (docs/method/photo.md).
 
     Parameters
     ----------

@@ -1,13 +1,13 @@
-"""SPEC section 2 facial landmarks from MediaPipe's 468-point face mesh.
+"""docs/method/skull.md facial landmarks from MediaPipe's 468-point face mesh.
 
 Each landmark is one mesh vertex, chosen by where the vertex lies on the mesh's own topology
 and checked on real portraits against points placed by hand (``tests/test_photo_accuracy.py``,
-``docs/photo.md``). ``"tracked"`` points sit on image evidence the model follows (eye
+``docs/method/photo.md``). ``"tracked"`` points sit on image evidence the model follows (eye
 corners, the alar wings, the nostril base, the lip border, the mouth corners, the chin: pogonion
 and gnathion, within 5 % of the eye-corner distance of hand marks on every portrait where the
 chin is visible); ``"template"`` points are where the model's face template puts them (nasion,
 glabella and the forehead, the cheek and jaw contour): plausible, not within that bound, and
-not used by an SFO until the user confirms them (SPEC section 11).
+not used by an SFO until the user confirms them (docs/method/photo.md).
 """
 
 import numpy as np
@@ -15,7 +15,7 @@ import numpy as np
 TRACKED = "tracked"
 TEMPLATE = "template"
 
-#: SPEC facial landmark -> (mesh vertex index, quality). ``_r`` is the subject's right, the
+#: Catalogue facial landmark -> (mesh vertex index, quality). ``_r`` is the subject's right, the
 #: image's left in a frontal photo (MediaPipe's "right eye" 33/133 is the subject's right).
 MESH_LANDMARKS = {
     "exocanthion_r": (33, TRACKED),
@@ -78,7 +78,7 @@ def mesh_to_landmarks(mesh_uv):
 FOREHEAD_LINE = (10, 151, 9)
 
 #: Mesh vertices of the mouth corners (cheilion_r, cheilion_l): the chin-jaw curve lies between
-#: their verticals (the span the face mask's curve takes, SPEC section 5).
+#: their verticals (the span the face mask's curve takes, docs/method/lilium.md).
 MOUTH_CORNERS = (61, 291)
 
 #: Largest step (pixels) between two points of a facial curve.
@@ -96,7 +96,7 @@ def _densify(points, step=CURVE_STEP_PX):
 
 
 def mesh_face_curves(mesh_uv, image_size_wh):
-    """The facial curves of SPEC section 11 from the face mesh, for ``face_curve.json``.
+    """The facial curves of docs/method/photo.md from the face mesh, for ``face_curve.json``.
 
     Chin-jaw: the mesh's lower face contour (:data:`JAW_LINE`) between the verticals of the mouth
     corners. Forehead: the midline (:data:`FOREHEAD_LINE`) from the top of the mesh to glabella.

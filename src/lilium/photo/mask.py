@@ -1,4 +1,4 @@
-"""The head mask of SPEC section 11: the head as seen (face, forehead, hair, ears) down to the
+"""The head mask of docs/method/photo.md: the head as seen (face, forehead, hair, ears) down to the
 upper neck; not shoulders or background.
 
 No open model parses skin and hair, so the mask is built from two models' outputs:
@@ -11,7 +11,7 @@ No open model parses skin and hair, so the mask is built from two models' output
 3. the union with the face mesh's outline (dilated by :data:`MESH_MARGIN` face heights), so
    every landmark the mesh gives lies inside even where the person mask misses skin.
 
-Hair makes the mask larger than the skull, as SPEC section 11 intends.
+Hair makes the mask larger than the skull, as docs/method/photo.md intends.
 """
 
 import cv2

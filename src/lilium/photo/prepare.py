@@ -1,8 +1,9 @@
-"""``lilium photo``: write a SPEC section 8 photo folder from a plain photograph (SPEC 11).
+"""``lilium photo``: write a docs/contract.md photo folder from a plain photograph
+(docs/method/photo.md).
 
 The folder holds the image (copied unchanged for PNG/JPEG, so its EXIF stays), ``photo.json``
 (landmarks, ``landmark_sources``, priors with their sources), ``face_mask.png`` and
-``review.html``. ``photo.json``'s priors carry, beside the SPEC fields:
+``review.html``. ``photo.json``'s priors carry, beside the contract's fields:
 
 - ``"source": "automatic"`` and ``"sources"``: where each prior came from;
 - ``"head_rotation_face2cam"`` (3 x 3) and ``"head_angles_deg"`` (yaw, pitch, roll): the face
@@ -47,7 +48,7 @@ class PreparedPhoto:
     view : str
     n_tracked, n_template : int
     warnings : tuple of dict
-        ``{"code", "message"}`` (SPEC section 10 codes), also in ``photo.json``.
+        ``{"code", "message"}`` (docs/checks.md codes), also in ``photo.json``.
     """
 
     folder: Path
@@ -139,7 +140,7 @@ def prepare_photo(
     view : {"frontal", "lateral_left", "lateral_right"}, optional
         Default: from the fitted yaw (frontal under 30 degrees).
     landmarks_path : str or Path, optional
-        Reviewed landmarks (the review page's ``landmarks.json``, or any SPEC facial landmark
+        Reviewed landmarks (the review page's ``landmarks.json``, or any catalogue facial landmark
         file): they replace the automatic ones and count as confirmed.
     sensor_width_mm : float, optional
         For the EXIF focal (see :mod:`lilium.io.exif`).
@@ -221,7 +222,7 @@ def prepare_photo(
         "priors": priors,
     }
     if analysis:
-        meta["face_mask_is_head"] = True  # never a source of facial curves (SPEC section 11)
+        meta["face_mask_is_head"] = True  # never a source of facial curves (docs/method/photo.md)
     if warnings:
         meta["warnings"] = warnings
     out.mkdir(parents=True, exist_ok=True)

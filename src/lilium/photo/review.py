@@ -4,7 +4,7 @@ outline and the priors, in one self-contained page (no network, no server).
 A page opened from ``file://`` cannot write to disk, so **Save** offers the edited landmarks
 as a download, ``landmarks.json`` (a ``data:`` link): ``{"landmarks": {name: [u, v]},
 "landmark_sources": {name: {"source": "reviewed", "quality": ..., "confirmed": true}}}``,
-the SPEC landmark file that ``lilium case --landmarks`` and ``lilium photo --landmarks``
+the contract's landmark file that ``lilium case --landmarks`` and ``lilium photo --landmarks``
 read. Only the points switched on are saved; template points start switched off, so saving
 without looking confirms none of them. Opened with ``?test``, the page drags the first
 landmark by (+10, +5) px with pointer events, presses Save and shows the file in

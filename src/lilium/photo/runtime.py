@@ -8,7 +8,7 @@ person mask. The pre- and post-processing follows MediaPipe's legacy CPU graphs
 ``ai-edge-litert`` (``pip install 'lilium[photo]'``).
 
 Image coordinates are ``uv`` (column, row) pixels of the original image, the centre of the
-top-left pixel at (0, 0) (SPEC section 8).
+top-left pixel at (0, 0) (docs/contract.md).
 """
 
 import contextlib

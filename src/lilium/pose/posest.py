@@ -54,7 +54,8 @@ class PosestOptions:
     hypotheses and one refinement each gave 0.62-0.85 x pycolmap's mean BPE with no more
     failures, where the fixed 12 px, 4 hypotheses and 4 rounds gave 0.76-1.12 x.
 
-    ``select="inliers"`` (issue 27, docs/method.md): on near-planar landmark sets (frontal
+    ``select="inliers"`` (issue 27, docs/decisions/0001-posest-hypothesis-selection.md): on
+    near-planar landmark sets (frontal
     photos of a skull without the mandible) the focal length is barely determined, and the
     lowest truncated cost often belongs to a camera far too close to the face (a focal length
     0.1-0.2 x the truth) that fits a few landmarks tightly and leaves the others outside the
@@ -139,7 +140,7 @@ REJECTED_MESSAGE = "the camera was rejected by the caller's check"
 
 
 def check_camera(R, t, focal_px, sq_err_px2, focal_max_px=FOCAL_MAX_PX):
-    """Why a camera is unacceptable, or "" if it is fine (SPEC section 4 failures)."""
+    """Why a camera is unacceptable, or "" if it is fine (docs/method/pose.md failures)."""
     if not np.isfinite(focal_px) or focal_px < FOCAL_MIN_PX:
         return f"focal length {focal_px:.4g} px is not positive (below {FOCAL_MIN_PX:g} px)"
     if focal_px > focal_max_px:

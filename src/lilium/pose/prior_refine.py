@@ -2,14 +2,15 @@
 
 :func:`~lilium.pose.refine.refine_batch` fits the camera to the landmarks alone; the priors
 (focal length, subject-to-camera distance, head orientation intervals) then only judge the
-result (P_cam, SPEC section 5). :func:`refine_with_priors` moves a camera to the minimum of
+result (P_cam, docs/method/lilium.md). :func:`refine_with_priors` moves a camera to the minimum of
 
 ``mean_i |P(X_i) - uv_i|^2 + max(0, fmin - f)^2 + max(0, f - fmax)^2
 + max(0, SCDmin - SCD)^2 + max(0, SCD - SCDmax)^2 + max(0, dbeta - tol)^2``
 
-i.e. ``MSE_pix + P_cam`` of SPEC section 5 for a fixed set of 3D points: the camera-dependent
+i.e. ``MSE_pix + P_cam`` of docs/method/lilium.md for a fixed set of 3D points: the camera-dependent
 part of Lilium's fitness without the image terms. A prior that is None switches its residuals
-off. Used by the joint SFO (:mod:`lilium.methods.joint`, docs/method.md: one shared soft tissue
+off. Used by the joint SFO (:mod:`lilium.methods.joint`, docs/method/joint.md: one shared soft
+tissue
 cannot bend itself to bring every photo's least-squares camera inside that photo's priors).
 
 Unknowns as in :mod:`lilium.pose.refine` (a left rotation increment; the image position, log

@@ -1,4 +1,4 @@
-"""The report's first section: the identification's conclusions (SPEC section 12).
+"""The report's first section: the identification's conclusions (docs/method/identification.md).
 
 One row per decision (each SFO, each joint SFO, and a person's photos taken together): the
 conclusion on the verbal scale, the calibrated log10 LR, what capped it (the material, a
@@ -92,7 +92,7 @@ def conclusion_section(decisions):
         "<h2 style='border:0;margin-top:12px'>Identification</h2>\n"
         "<p class='note'>Is this the person? The likelihood ratio compares the observations "
         "under \"this skull is the person in the photo\" with \"a random other person\", "
-        "calibrated on generated subjects (docs/identification.md says where it holds). The "
+        "calibrated on generated subjects (docs/method/identification.md says where it holds). The "
         "conclusion follows a verbal scale, capped by the material. A decision whose features "
         "lie outside the range its calibration was fitted on (<b>outside_calibration</b>) gets "
         "no support: its LR would be an extrapolation. A skull outside the head, a camera whose "

@@ -25,7 +25,7 @@ Formats the plain records of :mod:`lilium.report.records` into the templates shi
 A summary table on top lists every SFO of the page: the landmark error in pixels and in
 millimetres at the landmarks' depth for every method side by side (comparable), each method's
 own score in a column of its own (not comparable across methods), "implausible" for any camera
-with skull pixels outside the face mask whatever its method, and the SPEC section 10 warnings,
+with skull pixels outside the face mask whatever its method, and the docs/checks.md warnings,
 which each SFO's section lists in full. Nothing is fetched from the network: the
 pictures are base64 ``data:`` URIs, styles and script are inline.
 """
@@ -121,7 +121,7 @@ def _summary_row(sfo):
     status = _e(s.status)
     if s.implausible:
         status = (
-            '<span class="fail" title="skull pixels outside the face mask (SPEC section 7)">'
+            '<span class="fail" title="skull pixels outside the face mask">'
             "implausible</span>"
         )
     return [
@@ -317,7 +317,7 @@ def _camera_table(sfo):
 
 
 def _terms_table(sfo):
-    off = dict(sfo.terms_off)  # asked for but without their inputs: say why (SPEC section 5)
+    off = dict(sfo.terms_off)  # asked for but without their inputs: say why (docs/method/lilium.md)
     rows = [
         [
             TERM_LABELS.get(k, _e(k)),
@@ -471,7 +471,7 @@ def format_joint(joint):
     return (
         f"<section><h2>Joint SFO: {_e(joint.method_label)}, skull {_e(joint.skull_id)}, "
         f"photos {_e(', '.join(joint.photo_ids))}{status}</h2>\n"
-        "<p>One soft tissue shared by every photo, one camera per photo (SPEC section 9). "
+        "<p>One soft tissue shared by every photo, one camera per photo (docs/method/joint.md). "
         f"Joint fitness {_num(joint.fitness, '{:.4g}')} = {parts}: each photo's fitness "
         "weighted by its scale (pixels per mm at the face) so that photos of different sizes "
         "count alike. Each photo's section below shows its overlay and terms from this soft "

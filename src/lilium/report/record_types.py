@@ -94,10 +94,10 @@ class Summary:
     ----------
     status : str
         ``"ok"``, ``"implausible"`` (a camera with skull pixels outside the face mask, whatever
-        the method: SPEC section 7) or ``"failed: ..."``.
+        the method: docs/method/evaluation.md) or ``"failed: ..."``.
     focal_px, scd_mm : float or None
     mean_error_px, mean_error_mm : float or None
-        ``landmark_error`` of the result (SPEC section 10): comparable across methods.
+        ``landmark_error`` of the result (docs/checks.md): comparable across methods.
     fitness : float
         The method's own score (lower is better), not comparable across methods.
     score_label : str
@@ -159,7 +159,7 @@ class SfoRecord:
     run_extra : tuple of (str, str)
         Run facts (generations, evaluations, ...).
     warnings : tuple of (str, str)
-        SPEC section 10 warnings of the result, ``(code, message)``.
+        docs/checks.md warnings of the result, ``(code, message)``.
     priors : tuple of (str, str, str)
         Each prior: name, value (text) and where it came from.
     inputs : tuple of InputFile
@@ -240,7 +240,7 @@ class JointLandmarkRow:
 
 @dataclass(frozen=True)
 class JointRecord:
-    """A joint SFO: one soft tissue shared by several photos (SPEC section 9).
+    """A joint SFO: one soft tissue shared by several photos (docs/method/joint.md).
 
     Attributes
     ----------
@@ -284,9 +284,10 @@ class ReportRecord:
         Python, platform and package versions.
     sfos : tuple of SfoRecord
     joints : tuple of JointRecord
-        The joint SFOs (SPEC section 9) whose photos the page shows; empty without any.
+        The joint SFOs (docs/method/joint.md) whose photos the page shows; empty without any.
     decisions : tuple of (str, str, dict)
-        The identifications (SPEC section 12), shown first: a label, the anchor of the section
+        The identifications (docs/method/identification.md), shown first: a label, the anchor of the
+        section
         that shows it ("" for none) and the ``"identification"`` record; every photo's SFO, every
         joint SFO and, with several photos, their separate SFOs taken together.
     request : str or None

@@ -64,7 +64,7 @@ class ReportEntry:
     review_href : str
         The review page as a link relative to the report ("" when it lies elsewhere).
     joint : lilium.methods.joint.JointSfoResult or None
-        The joint SFO (SPEC section 9) that ``result`` is this photo's part of; None for a
+        The joint SFO (docs/method/joint.md) that ``result`` is this photo's part of; None for a
         single-photo SFO. The page then lists the shared soft tissue's 3D facial landmarks.
     """
 

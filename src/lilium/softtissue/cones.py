@@ -1,4 +1,4 @@
-"""Soft-tissue cones: decoding genes into soft-tissue vectors (SPEC section 3).
+"""Soft-tissue cones: decoding genes into soft-tissue vectors (docs/method/lilium.md).
 
 Three genes per cranial landmark, each in [0, 1]: depth ``p1`` (between the population min and max),
 polar angle ``p2`` (0 to 40 degrees from the cone axis) and azimuth ``p3`` (0 to 360 degrees about

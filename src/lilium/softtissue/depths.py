@@ -1,4 +1,4 @@
-"""Population soft-tissue depth intervals (SPEC section 3).
+"""Population soft-tissue depth intervals (docs/method/lilium.md).
 
 The built-in table holds approximate adult values on the scale of published meta-analyses; a
 user's own table (CSV with columns ``landmark,mean,sd,min,max``, see

@@ -1,4 +1,4 @@
-"""The landmark catalogue of SPEC section 2.
+"""The landmark catalogue of docs/method/skull.md.
 
 Canonical names are snake_case; ``_l``/``_r`` are the *subject's* left/right. A cranial landmark
 (on bone) is paired with a facial landmark (on skin); the soft-tissue vector of the pair goes from

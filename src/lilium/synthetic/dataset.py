@@ -1,4 +1,4 @@
-"""Generate a synthetic evaluation dataset on disk (SPEC sections 7 and 8).
+"""Generate a synthetic evaluation dataset on disk (docs/method/evaluation.md and docs/contract.md).
 
 Layout under ``out_dir``::
 

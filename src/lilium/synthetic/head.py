@@ -9,10 +9,12 @@ through the gonia. The *jaw-line cut* lowers them by :data:`NECK_CUT_MARGIN_MM`,
 hanging below the bone farther than the subject's chin depth + :data:`JAW_CUT_MARGIN_MM` is neck
 (:data:`JAW_BELOW_ANGLE_DEG`).
 The skin above it is the face's own outline, from which the chin-jaw curve of ``face_curve.json`` is
-taken (SPEC 5's mask rule applied to that outline). A plane there would be seen nearly edge-on from
+taken (docs/method/lilium.md's mask rule applied to that outline). A plane there would be seen
+nearly edge-on from
 the front, so the facial chin-jaw curve would be a flat line whatever the jaw's shape, while the
 bony chin's outline is a U: the true skull's own P_pll was then large (issue 20, measured in
-docs/method.md); following the bone keeps the skin's chin outline as curved as the real one
+docs/decisions/0011-generator-chin-jaw-curve.md); following the bone keeps the skin's chin outline
+as curved as the real one
 (``benchmarks/chin_profile.py``).
 
 The *face mask* keeps the upper neck too: its cut lies :data:`NECK_SKULL_CLEARANCE_MM` below the

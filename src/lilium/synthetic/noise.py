@@ -1,4 +1,4 @@
-"""Noise profiles of the paper's experiments (SPEC section 7).
+"""Noise profiles of the paper's experiments (docs/method/evaluation.md).
 
 - ``A`` (ideal): no noise.
 - ``B`` (landmark noise): each given 2D landmark moved by an offset drawn uniformly in

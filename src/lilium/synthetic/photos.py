@@ -1,4 +1,5 @@
-"""Synthetic photographs of a subject's skin mesh with known cameras (SPEC sections 7 and 8).
+"""Synthetic photographs of a subject's skin mesh with known cameras (docs/method/evaluation.md and
+docs/contract.md).
 
 A photo is a render of the skin mesh under a random camera, with the projected facial landmarks
 (the visible ones; all of them noise-free in the ground truth), the face mask and the facial
@@ -74,7 +75,7 @@ class CameraRanges:
 
     frontal_yaw_deg: tuple = (-15.0, 15.0)
     # Magnitude (lateral_left uses the negative). At most 95 so that, with the pitch, a true
-    # camera stays within SPEC 10's 110 deg of the skull's anterior direction.
+    # camera stays within docs/checks.md's 110 deg of the skull's anterior direction.
     lateral_yaw_deg: tuple = (75.0, 95.0)
     pitch_deg: tuple = (-10.0, 10.0)
     roll_deg: tuple = (-5.0, 5.0)
@@ -241,7 +242,8 @@ def sample_camera(head, view, rng, ranges=CameraRanges()):
 def face_curve_from_mask(mask, view, landmarks_uv):
     """The photo's facial contour curve from its face mask, for ``face_curve.json``.
 
-    The rule of SPEC section 5 (:func:`lilium.fitness.curves.face_curve_from_mask`) on the mask
+    The rule of docs/method/lilium.md (:func:`lilium.fitness.curves.face_curve_from_mask`) on the
+    mask
     with its holes filled: the chin-jaw between the cheilion u-coordinates (frontal) or the
     forehead between the glabella and metopion v-coordinates (lateral).
 
@@ -331,7 +333,7 @@ def priors_of(camera):
 
 
 def photo_record(photo, subject_id, noise="A", landmarks_uv=None, extra=None, unmarked=()):
-    """The ``photo.json`` content of SPEC section 8.
+    """The ``photo.json`` content of docs/contract.md.
 
     Parameters
     ----------

@@ -12,7 +12,7 @@ Skull frame (the frame of every mesh and landmark here), written once:
 millimetres; ``x`` = the subject's left, ``y`` = superior (up), ``z`` = anterior (the face looks
 along ``+z``); the origin is near the centre of the head, at the midpoint of the ear canals
 (porion height, so the Frankfurt plane is close to ``y = 0``). A camera frame is x right, y down,
-z forward (SPEC section 8), so a frontal photo camera looks along ``-z`` of the skull frame.
+z forward (docs/contract.md), so a frontal photo camera looks along ``-z`` of the skull frame.
 
 Soft tissue, per subject: for each cranial landmark of a correspondence, a depth drawn from the
 population table (``N(mean, sd)`` clipped inside ``[min, max]``) and a direction within
@@ -291,7 +291,7 @@ def make_subjects(n, seed=0, prefix="s"):
 
 
 def write_subject(folder, subject):
-    """Write a subject folder (SPEC section 8).
+    """Write a subject folder (docs/contract.md).
 
     ``skull.ply``, ``cranial_landmarks.json``, ``soft_tissue_axes.json`` (the true directions
     of the cranial landmarks the skull has), and the ground truth ``face.ply``,

@@ -155,7 +155,7 @@ def _neck(radius_mm, top_mm, bottom_mm, z_mm, n=32):
 
 
 def write_toy_subject(folder, subject):
-    """Write a stand-in subject folder (SPEC section 8) with trimesh PLY meshes."""
+    """Write a stand-in subject folder (docs/contract.md) with trimesh PLY meshes."""
     from pathlib import Path
 
     from ..io.jsonio import write_json
