@@ -36,7 +36,8 @@ import time
 t0, c0 = time.perf_counter(), time.process_time()
 import json, sys
 from lilium.cli.main import main
-import lilium.casework.folders as folders
+import lilium.casework.read as read
+import lilium.casework.single as single
 
 spent = {"inputs": [0.0, 0.0]}
 def timed(name, function):
@@ -48,9 +49,8 @@ def timed(name, function):
             spent[name][0] += time.perf_counter() - w
             spent[name][1] += time.process_time() - c
     return wrapper
-for name in ("load_skull", "load_photos", "check_inputs"):
-    setattr(folders, name, timed("inputs", getattr(folders, name)))
-run_sfo = folders.run_sfo
+single.read_case = timed("inputs", read.read_case)
+run_sfo = single.run_sfo
 def twice(*args, **kwargs):
     w1, c1 = time.perf_counter(), time.process_time()
     run_sfo(*args, **kwargs)
@@ -62,7 +62,7 @@ def twice(*args, **kwargs):
     spent["second"] = [w3 - w2, c3 - c2]
     spent["numba"] = "numba" in sys.modules
     return result
-folders.run_sfo = twice
+single.run_sfo = twice
 main(sys.argv[1:])
 print("STARTUP " + json.dumps(spent))
 """

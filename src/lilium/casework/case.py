@@ -4,22 +4,14 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..io.paths import safe_id
-from ..methods.checks import check_inputs
 from ..methods.registry import check_method, method_tag, run_sfo
 from .console import log_warnings, status_text
-from .folders import (
-    check_distinct_photos,
-    labelled_skull,
-    output_lock,
-    resumed_sfo,
-    sfo_fingerprint,
-    sfo_outputs,
-    with_depth_table,
-)
-from .identify import Calibrations, conclusion_line, decide
-from .inputs import check_runnable, load_photos, load_skull
+from .folders import check_distinct_photos, output_lock, resumed_sfo, sfo_fingerprint, sfo_outputs
+from .identify import conclusion_line, decide
+from .inputs import check_runnable
 from .joint_case import check_joint_case, joint_entry, run_joint_methods
 from .prepared import check_photo_extra
+from .read import read_case
 
 
 def term_label(term):
@@ -105,37 +97,24 @@ def run_case(request, log=print):
     """
     from ..report.html import write_report
 
-    methods, options, seed = list(request.methods), request.options, request.seed
+    methods, seed = list(request.methods), request.seed
     for method in methods:
-        check_method(method, options.variant)
+        check_method(method, request.options.variant)
     if request.auto_landmarks:
         check_photo_extra()
     paths = [source.path for source in request.photos]
     check_distinct_photos(paths)
     if request.joint:
         check_joint_case(paths, methods)
-    skull, skull_inputs = load_skull(request.skull, log=log)
-    skull = labelled_skull(skull, skull_inputs)
     out = Path(request.out)
     with output_lock(out):
-        records = load_photos(
-            request.photos, request.priors, log=log, skull=skull,
-            auto_landmarks=request.auto_landmarks, out=out,
-        )
-        if request.depth_table:
-            options, photos_in = with_depth_table(
-                options, request.depth_table, [r.photo for r in records]
-            )
-            records = [r._replace(photo=p) for r, p in zip(records, photos_in, strict=True)]
-        calibrations = Calibrations(request.calibration)
-        _check_records(skull, skull_inputs, records, methods, options.variant, log)
+        inputs = read_case(request, log=log, out=out)
+        _check_records(inputs, methods, log)
         joints = {}  # method -> (JointSfoResult, folder), for the joint methods
         if request.joint:
-            joints = run_joint_methods(
-                skull, skull_inputs, records, methods, options, seed, out, log, calibrations
-            )
-        run = _CaseRun(skull, skull_inputs, out, options, seed, calibrations, log)
-        entries = run.entries(records, methods, joints)
+            joints = run_joint_methods(inputs, methods, seed, out, log)
+        run = _CaseRun(inputs, out, seed, log)
+        entries = run.entries(inputs.records, methods, joints)
         decisions = run.decisions(methods)
         report = write_report(
             out / "report.html", entries, title=request.title, command=request.command,
@@ -145,17 +124,19 @@ def run_case(request, log=print):
     return entries
 
 
-def _check_records(skull, skull_inputs, records, methods, variant, log):
+def _check_records(inputs, methods, log):
     """Every problem of the photos before any long run; log the terms switched off and the
     photos with unreviewed automatic landmarks."""
+    variant = inputs.options.variant
     planned = {}
-    for photo, inputs, _, _ in records:
-        planned[photo.id] = check_runnable(skull, photo, methods, variant, skull_inputs, inputs)
-        check_inputs(skull, photo)  # left/right of skull and photo (names the file)
+    for photo, photo_inputs, _, _ in inputs.records:
+        planned[photo.id] = check_runnable(
+            inputs.skull, photo, methods, variant, inputs.skull_inputs, photo_inputs
+        )
     for photo_id, off in planned.items():
         for term, why in off.items():
             log(f"{photo_id}: lilium {variant}: {term_label(term)} switched off: {why}")
-    for photo, _, _, origin in records:
+    for photo, _, _, origin in inputs.records:
         if origin is not None and origin.unreviewed:
             log(f"{photo.id}: {origin.line()}")
 
@@ -164,9 +145,10 @@ class _CaseRun:
     """The per-photo SFOs of one case, each run or reused
     (:func:`~lilium.casework.folders.resumed_sfo`), with one file-digest cache."""
 
-    def __init__(self, skull, skull_inputs, out, options, seed, calibrations, log):
-        self.skull, self.skull_inputs, self.out = skull, skull_inputs, out
-        self.options, self.seed, self.calibrations, self.log = options, seed, calibrations, log
+    def __init__(self, inputs, out, seed, log):
+        self.skull, self.skull_inputs, self.out = inputs.skull, inputs.skull_inputs, out
+        self.options, self.calibrations = inputs.options, inputs.calibrations
+        self.seed, self.log = seed, log
         self.digests = {}
         self.separate = {}  # method -> [(photo, result)], for the decision over several photos
 

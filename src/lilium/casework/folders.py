@@ -1,7 +1,8 @@
-"""One SFO on case folders (docs/contract.md): read, check, run, write ``result.json``; and
-what lets ``lilium case`` and ``lilium lineup`` resume: each stored result's input fingerprint
-(:func:`sfo_fingerprint`), the test that a stored result is this SFO's (:func:`stored_result`),
-and the lock that keeps a second run off an output folder (:func:`output_lock`).
+"""The output folders of a case (docs/contract.md): what lets ``lilium case`` and ``lilium
+lineup`` resume (each stored result's input fingerprint, :func:`sfo_fingerprint`; the test that
+a stored result is this SFO's, :func:`stored_result`), the joint SFO's files, the refusal of a
+photo given twice, and the lock that keeps a second run off an output folder
+(:func:`output_lock`).
 """
 
 import filecmp
@@ -14,103 +15,19 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..inputs import CaseWarning
-from ..io.case import IMAGE_NAMES, read_depth_table
+from ..io.case import IMAGE_NAMES
 from ..io.jsonio import write_json
 from ..io.locks import RunLock
 from ..io.paths import printable, safe_id
 from ..io.provenance import input_files
 from ..io.results import png_readable, read_result, remove_overlays, write_png, write_result
-from ..methods.checks import check_inputs
 from ..methods.overlay import result_overlay
 from ..methods.registry import (
-    check_joint_method,
-    check_method,
     method_tag,
-    run_joint_sfo,
     run_sfo,
 )
-from ..softtissue.depths import depth_table_warning
-from .identify import Calibrations, with_identification
-from .inputs import first_file, load_photos, load_skull
-
-
-def with_depth_table(options, path, photos):
-    """``options`` with the depth table read from ``path``, and ``photos`` with its warning
-    ``implausible_depth`` when some of its mean depths are implausible
-    (:func:`~lilium.softtissue.depths.depth_table_warning`): the table's warning goes into the
-    result of every SFO that uses it (a photo's warnings are its results').
-
-    Returns
-    -------
-    options : SfoOptions
-    photos : list of Photo
-    """
-    table = read_depth_table(path)
-    message = depth_table_warning(table, str(path))
-    if message:
-        warning = CaseWarning("implausible_depth", message)
-        photos = [replace(p, warnings=(*p.warnings, warning)) for p in photos]
-    return replace(options, depth_table=table), list(photos)
-
-
-def labelled_skull(skull, inputs):
-    """The skull with its cranial landmark file named (for the left/right messages)."""
-    path = inputs.get("cranial landmarks")
-    return skull if path is None else replace(skull, landmarks_file=str(path))
-
-
-def single_sfo(request):
-    """One SFO: read the skull and the photo, check them, run the method, write ``request.out``.
-
-    The photo's priors come from the request, ``photo.json``, or its focal prior from the
-    image's EXIF (:func:`~lilium.casework.inputs.with_priors`), those of a ``lilium photo``
-    folder with ``"source": "automatic"`` and its head orientation converted through the skull's
-    frame (:func:`~lilium.casework.prepared.with_automatic_priors`); the left/right checks run
-    before the SFO (:func:`~lilium.methods.checks.check_inputs`).
-
-    Parameters
-    ----------
-    request : CaseRequest
-        One photo and one method (``request.methods[0]``); its axes, depth table (replaces
-        ``options.depth_table``), calibration (default: the shipped one,
-        :mod:`lilium.casework.identify`) and ``overlay`` (write ``overlay.png`` too).
-
-    Returns
-    -------
-    SfoResult
-        With its ``warnings`` (print them) and ``extra["identification"]``.
-
-    Raises
-    ------
-    ValueError
-        An invalid input (naming the file), including mirrored skull or photo labels.
-    """
-    (method,) = request.methods
-    options = request.options
-    check_method(method, options.variant)
-    skull, photos = _checked_inputs(request)
-    if request.depth_table is not None:
-        options, photos = with_depth_table(options, request.depth_table, photos)
-    calibrations = Calibrations(request.calibration)
-    (photo,) = photos
-    result = run_sfo(method, skull, photo, options, request.seed)
-    result = with_identification(result, skull, [photo], calibrations)
-    overlay = result_overlay(result, skull, photo) if request.overlay else None
-    write_result(request.out, result, overlay)
-    return result
-
-
-def _checked_inputs(request):
-    """The request's skull and photos, read and checked (left/right)."""
-    skull, skull_inputs = load_skull(request.skull)
-    skull = labelled_skull(skull, skull_inputs)
-    # A lilium photo folder's automatic head orientation is paired with this skull's frame.
-    records = load_photos(request.photos, request.priors, skull=skull)
-    photos = [record.photo for record in records]
-    for photo in photos:
-        check_inputs(skull, photo)
-    return skull, photos
+from .identify import with_identification
+from .inputs import first_file
 
 
 def joint_overlay_name(photo_id):
@@ -197,39 +114,6 @@ def check_distinct_photos(paths):
             f"--photo {paths[k]}: {how} --photo {paths[j]}; give each photo of the person once "
             "(a repeated photo is no second view)"
         )
-
-
-def joint_sfo(request):
-    """One joint SFO of the request's two or more photos of the same person (one soft tissue
-    shared by the photos, one camera each): read, check, run, write ``request.out``.
-
-    As :func:`single_sfo`; writes ``result.json`` with ``"joint": true`` and
-    ``overlay_<photo id>.png`` per photo (:func:`write_joint_result`).
-
-    Returns
-    -------
-    JointSfoResult
-
-    Raises
-    ------
-    ValueError
-        An invalid input (naming the file), a method without a joint form, fewer than two
-        photos, or a photo given twice.
-    """
-    (method,) = request.methods
-    options = request.options
-    check_joint_method(method, options.variant)
-    if len(request.photos) < 2:
-        raise ValueError("a joint SFO needs two or more --photo folders")
-    check_distinct_photos([source.path for source in request.photos])
-    skull, photos = _checked_inputs(request)
-    if request.depth_table is not None:
-        options, photos = with_depth_table(options, request.depth_table, photos)
-    calibrations = Calibrations(request.calibration)
-    result = run_joint_sfo(method, skull, photos, options, request.seed)
-    result = with_identification(result, skull, photos, calibrations)
-    write_joint_result(request.out, result, skull, photos, overlay=request.overlay)
-    return result
 
 
 #: ``result.json`` key of the SFO's input fingerprint (:func:`sfo_fingerprint`).

@@ -20,7 +20,7 @@ from .folders import (
     with_fingerprint,
     write_joint_result,
 )
-from .identify import Calibrations, conclusion_line, with_identification
+from .identify import conclusion_line, with_identification
 from .inputs import JOINT_FOLDER
 
 
@@ -46,9 +46,7 @@ def check_joint_case(photos, methods):
         )
 
 
-def run_joint_methods(
-    skull, skull_inputs, records, methods, options, seed, out, log=print, calibrations=None
-):
+def run_joint_methods(inputs, methods, seed, out, log=print):
     """Run every joint-capable method of ``methods`` once on all the photos; write each.
 
     A joint SFO already stored in its folder for the same input files, options, seed and
@@ -57,20 +55,14 @@ def run_joint_methods(
 
     Parameters
     ----------
-    skull : Skull
-    skull_inputs : dict of str -> path
-        The skull's labelled files (:func:`~lilium.casework.inputs.load_skull`), for the
-        input fingerprint.
-    records : list of PhotoRecord
-        From :func:`~lilium.casework.inputs.load_photos`.
+    inputs : CaseInputs
+        The case's skull, photo records, options (with its depth table) and calibrations
+        (:func:`~lilium.casework.read.read_case`).
     methods : sequence of str
-    options : SfoOptions
     seed : int
     out : Path
         The case's output folder.
     log : callable
-    calibrations : Calibrations, optional
-        For the joint SFO's identification (default: the shipped calibration).
 
     Returns
     -------
@@ -80,8 +72,8 @@ def run_joint_methods(
     A photo's id is never :data:`~lilium.casework.inputs.JOINT_FOLDER`
     (:func:`~lilium.casework.inputs.unique_id`).
     """
-    photos = [record.photo for record in records]
-    calibrations = calibrations or Calibrations()
+    skull, skull_inputs, records = inputs.skull, inputs.skull_inputs, inputs.records
+    options, calibrations, photos = inputs.options, inputs.calibrations, inputs.photos
     done = {}
     for method in methods:
         if METHODS[method].run_joint is None:

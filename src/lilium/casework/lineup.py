@@ -24,18 +24,16 @@ from pathlib import Path
 
 from ..io.jsonio import write_json
 from ..io.paths import printable, safe_id
-from ..methods.checks import check_inputs
 from ..methods.registry import check_method, method_tag, run_sfo
 from .folders import (
-    labelled_skull,
     output_lock,
     repeated_photo,
     resumed_sfo,
     sfo_fingerprint,
     sfo_outputs,
 )
-from .identify import Calibrations, conclusion_line, decide
-from .inputs import load_photos, load_skull
+from .identify import conclusion_line, decide
+from .read import read_case
 
 #: The lineup's own files in its output folder: no candidate's folder may take their names.
 OWN_FILES = ("lineup.json", "report.html")
@@ -121,36 +119,29 @@ def run_lineup(request, log=print):
 
     candidates = [(c.name, [source.path for source in c.photos]) for c in request.candidates]
     check_candidates(candidates)
-    methods, options, seed = list(request.methods), request.options, request.seed
+    methods, seed = list(request.methods), request.seed
     for method in methods:
-        check_method(method, options.variant)
+        check_method(method, request.options.variant)
     out = Path(request.out)
-    calibrations = Calibrations(request.calibration)
-    skull, skull_inputs = load_skull(request.skull, log=log)
-    skull = labelled_skull(skull, skull_inputs)
-    loaded = []
-    for candidate in request.candidates:  # every input checked before the first SFO
-        records = load_photos(candidate.photos, log=log, skull=skull)
-        for record in records:
-            check_inputs(skull, record.photo)
-        loaded.append((candidate.name, records))
-
+    inputs = read_case(request, log=log)  # every input checked before the first SFO
     with output_lock(out):
-        run = _LineupRun(skull, skull_inputs, out, methods, options, seed, calibrations, log)
-        entries, ranking = run.all(loaded, request.progress)
-        first = method_tag(methods[0], options.variant)
+        run = _LineupRun(inputs, out, methods, seed, log)
+        entries, ranking = run.all(inputs.candidates, request.progress)
+        first = method_tag(methods[0], inputs.options.variant)
         ranking.sort(key=lambda entry: rank_key(entry, first))
         for k, entry in enumerate(ranking, start=1):
             entry["rank"] = k
             log(f"{k}. {printable(entry['candidate'])} ({entry['method']}): "
                 f"{conclusion_line(entry['identification'])}")
-        write_json(out / "lineup.json", {"skull": skull.id, "ranking": ranking})
+        write_json(out / "lineup.json", {"skull": inputs.skull.id, "ranking": ranking})
         decisions = [
             (f"{e['rank']}. candidate {e['candidate']} ({len(e['photos'])} photo(s)), "
              f"{e['method']}", e["identification"])
             for e in ranking
         ]
-        title = request.title or f"Lineup: skull {skull.id} against {len(candidates)} candidates"
+        title = request.title or (
+            f"Lineup: skull {inputs.skull.id} against {len(candidates)} candidates"
+        )
         report = write_report(
             out / "report.html", entries, title=title, command=request.command,
             decisions=decisions, request=request.to_dict(),
@@ -163,14 +154,15 @@ class _LineupRun:
     """Every candidate's SFOs of one lineup, each run or reused
     (:func:`~lilium.casework.folders.resumed_sfo`), with one file-digest cache."""
 
-    def __init__(self, skull, skull_inputs, out, methods, options, seed, calibrations, log):
-        self.skull, self.skull_inputs, self.out = skull, skull_inputs, out
-        self.methods, self.options, self.seed = methods, options, seed
-        self.calibrations, self.log = calibrations, log
+    def __init__(self, inputs, out, methods, seed, log):
+        self.skull, self.skull_inputs, self.out = inputs.skull, inputs.skull_inputs, out
+        self.methods, self.options, self.seed = methods, inputs.options, seed
+        self.calibrations, self.log = inputs.calibrations, log
         self.digests = {}
 
     def all(self, loaded, progress):
-        """The report entries and the (unsorted) ranking of ``loaded``: (name, records)."""
+        """The report entries and the (unsorted) ranking of ``loaded``: (name, records) per
+        candidate."""
         from tqdm import tqdm
 
         total = sum(len(records) for _, records in loaded) * len(self.methods)

@@ -9,7 +9,7 @@ list, with ``OUT/overlay_<photo id>.png`` per photo.
 
 import sys
 
-from ..casework.folders import joint_sfo, single_sfo
+from ..casework.single import joint_sfo, single_sfo
 from ..casework.identify import conclusion_line
 from .options import PHOTO_FILES, SFO, add_options, case_request
 

@@ -1,0 +1,118 @@
+"""A request's inputs read once into typed inputs, every file parsed and checked, before
+anything runs: the skull (its cranial landmark file named), each photo with its priors, the SFO
+options with the request's depth table, and the calibration models.
+
+``lilium case``, ``lilium lineup`` and the single SFO read their request here
+(:func:`read_case`), then run on what it returns (:class:`CaseInputs`); nothing reads a file
+after that but the resume machinery (:mod:`~lilium.casework.folders`).
+"""
+
+from dataclasses import dataclass, replace
+
+from ..inputs import CaseWarning
+from ..io.case import read_depth_table
+from ..methods.checks import check_inputs
+from ..methods.options import SfoOptions
+from ..softtissue.depths import depth_table_warning
+from .identify import Calibrations
+from .inputs import load_photos, load_skull
+
+
+@dataclass(frozen=True)
+class CaseInputs:
+    """What a request's files hold, read and checked.
+
+    Attributes
+    ----------
+    skull : Skull
+        Its ``landmarks_file`` named (for the left/right messages).
+    skull_inputs : dict of str -> Path
+        The skull's files, labelled (provenance, fingerprints).
+    records : tuple of PhotoRecord
+        The request's photos (:func:`~lilium.casework.inputs.load_photos`), each with the
+        depth table's warning when it has one.
+    candidates : tuple of (str, tuple of PhotoRecord)
+        A lineup's candidates and their photos.
+    options : SfoOptions
+        The request's, with its depth table.
+    calibrations : Calibrations
+    """
+
+    skull: object
+    skull_inputs: dict
+    records: tuple
+    candidates: tuple
+    options: SfoOptions
+    calibrations: Calibrations
+
+    @property
+    def photos(self):
+        """The photos of :attr:`records`."""
+        return [record.photo for record in self.records]
+
+
+def read_case(request, log=None, out=None):
+    """Read and check every input of ``request``.
+
+    Parameters
+    ----------
+    request : CaseRequest
+    log : callable, optional
+        Receives one line per sidecar file found and per photo prepared automatically
+        (:func:`~lilium.casework.inputs.load_photos`).
+    out : Path, optional
+        The output folder photos are prepared in (``request.auto_landmarks``); hold its lock.
+
+    Returns
+    -------
+    CaseInputs
+
+    Raises
+    ------
+    ValueError
+        An invalid input, naming the file: a skull or a photo that cannot be read, mirrored
+        left/right labels (:func:`~lilium.methods.checks.check_inputs`), a depth table or a
+        calibration file that cannot be read.
+    """
+    skull, skull_inputs = load_skull(request.skull, log=log)
+    skull = labelled_skull(skull, skull_inputs)
+
+    def photos_of(sources, **kwargs):
+        # A lilium photo folder's automatic head orientation is paired with this skull's frame.
+        return load_photos(sources, request.priors, log=log, skull=skull, **kwargs)
+
+    records = photos_of(request.photos, auto_landmarks=request.auto_landmarks, out=out)
+    candidates = tuple((c.name, tuple(photos_of(c.photos))) for c in request.candidates)
+    options = request.options
+    if request.depth_table is not None:
+        options, photos = with_depth_table(options, request.depth_table, [r.photo for r in records])
+        records = [r._replace(photo=p) for r, p in zip(records, photos, strict=True)]
+    for record in [*records, *(r for _, rs in candidates for r in rs)]:
+        check_inputs(skull, record.photo)
+    calibrations = Calibrations(request.calibration)
+    return CaseInputs(skull, skull_inputs, tuple(records), candidates, options, calibrations)
+
+
+def with_depth_table(options, path, photos):
+    """``options`` with the depth table read from ``path``, and ``photos`` with its warning
+    ``implausible_depth`` when some of its mean depths are implausible
+    (:func:`~lilium.softtissue.depths.depth_table_warning`): the table's warning goes into the
+    result of every SFO that uses it (a photo's warnings are its results').
+
+    Returns
+    -------
+    options : SfoOptions
+    photos : list of Photo
+    """
+    table = read_depth_table(path)
+    message = depth_table_warning(table, str(path))
+    if message:
+        warning = CaseWarning("implausible_depth", message)
+        photos = [replace(p, warnings=(*p.warnings, warning)) for p in photos]
+    return replace(options, depth_table=table), list(photos)
+
+
+def labelled_skull(skull, inputs):
+    """The skull with its cranial landmark file named (for the left/right messages)."""
+    path = inputs.get("cranial landmarks")
+    return skull if path is None else replace(skull, landmarks_file=str(path))
