@@ -27,11 +27,12 @@ A kernel is compiled one of two ways, from the same source:
 - **just in time**, for every other call: numba (``cache=True``, so only the first run on a
   machine pays the compile time, cached in the package's ``__pycache__`` folders).
 
-numba is a pinned dependency (``pyproject.toml``); should it be missing, or fail to import (a
-numba built against another numpy), Lilium still runs, on the numpy path, only slower (a failed
-import warns once). ``LILIUM_KERNELS=numpy`` in the environment forces the numpy path (the
-benchmarks' reference timings), ``LILIUM_KERNELS=jit`` numba's JIT without the ahead-of-time
-module; :func:`kernels` switches them inside a process (tests).
+numba is a dependency (``pyproject.toml``: the minor release the build uses; its exact version in
+``requirements.lock``); should it be missing, or fail to import (a numba built against another
+numpy), Lilium still runs, on the numpy path, only slower (a failed import warns once).
+``LILIUM_KERNELS=numpy`` in the environment forces the numpy path (the benchmarks' reference
+timings), ``LILIUM_KERNELS=jit`` numba's JIT without the ahead-of-time module; :func:`kernels`
+switches them inside a process (tests).
 """
 
 import contextlib
