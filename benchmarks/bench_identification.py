@@ -65,7 +65,10 @@ from lilium.identification.terms import COHORT_CALIBRATED_TERMS
 from lilium.inputs import correspondences
 from lilium.methods.posest_sfo import mean_depth_landmarks
 from lilium.optimisation.de import DEOptions
-from lookalikes import print_lookalikes
+
+#: The data tools (benchmarks/datasets: ``headsq_case``) and studies (benchmarks/studies:
+#: ``lookalikes``) this script imports.
+sys.path[:0] = [str(Path(__file__).resolve().parent / d) for d in ("datasets", "studies")]
 
 TERMS = ("mse_pix", "p_pll", "p_skof", "score")
 
@@ -256,6 +259,8 @@ def print_likelihood_ratios(dbs, out_dir, file=sys.stdout):
     print(file=file)
     print_terms_comparison(decision_pairs, validated, file)
     print(file=file)
+    from lookalikes import print_lookalikes
+
     print_lookalikes(dbs, decision_pairs, validated, file)
     print(file=file)
     print("| ranked by identification log10 LR | view | mean rank | rank-1 | AUC | photos |",
@@ -312,10 +317,10 @@ def print_calibration_comparison(decision_pairs, validated, file=sys.stdout):
 
 
 def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):
-    """On the headsq CT (real anatomy, ``benchmarks/headsq_case.py``): its frontal and lateral
-    photo against its own skull, complete and without the mandible, and against a generated
-    one, through ``lilium case`` (the full budget, both methods): each photo's and the pair's
-    conclusion. Skipped without the CT."""
+    """On the headsq CT (real anatomy, ``benchmarks/datasets/headsq_case.py``): its frontal and
+    lateral photo against its own skull, complete and without the mandible, and against a
+    generated one, through ``lilium case`` (the full budget, both methods): each photo's and the
+    pair's conclusion. Skipped without the CT."""
     from headsq_case import build_headsq_dataset
     from lilium.casework.case import run_case
     from lilium.casework.identify import Calibrations, decide

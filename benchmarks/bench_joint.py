@@ -31,15 +31,17 @@ a case's priors do not promise (docs/decisions/0010-joint-sfo-cameras-on-prior-e
 SFO's cameras on the edge of the
 priors"). The head orientation prior stays the true rotation.
 
-``--headsq DIR`` adds the headsq real-anatomy case (issue 27, ``benchmarks/headsq_case.py``; its
-dataset built in DIR when absent): each frontal photo paired with the lateral one of the same
-index, on its complete skull and on its mandible-less skull (the same photos), summarised apart
-after the generated subjects (``--subjects 0``: headsq alone).
+``--headsq DIR`` adds the headsq real-anatomy case (issue 27,
+``benchmarks/datasets/headsq_case.py``; its dataset built in DIR when absent): each frontal photo
+paired with the lateral one of the same index, on its complete skull and on its mandible-less
+skull (the same photos), summarised apart after the generated subjects (``--subjects 0``: headsq
+alone).
 """
 
 import argparse
 import dataclasses
 import statistics
+import sys
 import tempfile
 import time
 import zlib
@@ -56,6 +58,9 @@ from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions, run_sfo
 from lilium.methods.joint import ANGLE_PRIOR_WEIGHT, DEFAULT_CAMERA, joint_lilium_sfo
 from lilium.optimisation import DEOptions
+
+#: The data tools (benchmarks/datasets) this script imports, e.g. ``headsq_case``.
+sys.path.insert(0, str(Path(__file__).resolve().parent / "datasets"))
 
 #: Issue 27's targets for the joint SFO against the independent ones (issue 16's BPE was 0.9 x).
 TARGET_BPE_RATIO = 0.95

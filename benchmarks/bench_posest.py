@@ -56,13 +56,15 @@ only (issue 27: the near-planar midface)::
     .venv/bin/python benchmarks/bench_posest.py --sfo --no-mandible --subjects 8 --photos 2
 
 ``--headsq DIR`` adds the same table for the headsq real-anatomy case (issue 27;
-``benchmarks/headsq_case.py``, its dataset built in DIR when absent): its complete skull and its
-mandible-less skull apart, on the same photos.
+``benchmarks/datasets/headsq_case.py``, its dataset built in DIR when absent): its complete skull
+and its mandible-less skull apart, on the same photos.
 """
 
 import argparse
+import sys
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -73,6 +75,9 @@ from lilium.geometry import Camera, geodesic_angle_deg, principal_point_of
 from lilium.pose import posest, refine_batch
 from lilium.pose.posest import PosestOptions
 from lilium.pose.ransac import RansacOptions
+
+#: The data tools (benchmarks/datasets) this script imports, ``sfo_problems``, ``headsq_case``.
+sys.path.insert(0, str(Path(__file__).resolve().parent / "datasets"))
 
 try:
     import pycolmap
@@ -432,7 +437,7 @@ def main(argv=None):
         "--headsq",
         metavar="DIR",
         help="--sfo: also the headsq real-anatomy case (its dataset in DIR, built there if "
-        "absent; benchmarks/headsq_case.py); --subjects 0 for headsq alone",
+        "absent; benchmarks/datasets/headsq_case.py); --subjects 0 for headsq alone",
     )
     parser.add_argument(
         "--no-mandible",

@@ -1,11 +1,11 @@
 """Identification on real anatomy: real photos against real skulls, the same person and another.
 
-The real heads are CT scans (``benchmarks/headsq_case.py``: headsq, with its mandible ``hq``
-and without ``hq_nm``; ``benchmarks/cranium_case.py``: InVesalius' Cranium ``cr``, no
-mandible), each photographed by the generator's cameras from its own skin (Exp. C: landmarks
-with noise, perturbed soft-tissue axes). Every photo pair (one frontal, one lateral) of a head
-runs through :func:`lilium.casework.case.run_case` against its own skull and against the other
-heads' skulls, with POSEST-SFO and Lilium at the full budget and the skull's first set of
+The real heads are CT scans (``benchmarks/datasets/headsq_case.py``: headsq, with its mandible
+``hq`` and without ``hq_nm``; ``benchmarks/datasets/cranium_case.py``: InVesalius' Cranium
+``cr``, no mandible), each photographed by the generator's cameras from its own skin (Exp. C:
+landmarks with noise, perturbed soft-tissue axes). Every photo pair (one frontal, one lateral) of
+a head runs through :func:`lilium.casework.case.run_case` against its own skull and against the
+other heads' skulls, with POSEST-SFO and Lilium at the full budget and the skull's first set of
 Exp. C soft-tissue axes (``axes_C1.json``: the true directions turned by up to 30 degrees, as
 the calibration's SFOs had them; with the true axes a real skull fits its photo better than
 any calibration pair and is read as outside the calibration); each decision (single photo,
@@ -30,6 +30,9 @@ import sys
 from pathlib import Path
 
 import numpy as np
+
+#: The data tools (benchmarks/datasets) this script imports, e.g. ``headsq_case``.
+sys.path.insert(0, str(Path(__file__).resolve().parent / "datasets"))
 
 #: The real heads: id -> (case module, subject ids of its skulls). Each head is one person.
 HEADS = {"headsq": ("headsq_case", ("hq", "hq_nm")), "cranium": ("cranium_case", ("cr",))}

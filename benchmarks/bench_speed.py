@@ -32,6 +32,7 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import statistics  # noqa: E402
+import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 from collections import defaultdict  # noqa: E402
@@ -46,6 +47,9 @@ from lilium.io.jsonio import read_json  # noqa: E402
 from lilium.methods import METHODS, SfoOptions, run_sfo  # noqa: E402
 from lilium.methods import lilium as lilium_method  # noqa: E402
 from lilium.optimisation import DEOptions  # noqa: E402
+
+#: The data tools (benchmarks/datasets) this script imports: ``real_size``.
+sys.path.insert(0, str(Path(__file__).resolve().parent / "datasets"))
 
 VARIANTS = METHODS["lilium"].variants
 

@@ -22,6 +22,7 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import itertools  # noqa: E402
+import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -33,6 +34,9 @@ from lilium.io.case import read_photo, read_skull  # noqa: E402
 from lilium.io.jsonio import read_json  # noqa: E402
 from lilium.io.truth import read_ground_truth  # noqa: E402
 from lilium.methods import SfoOptions, run_sfo  # noqa: E402
+
+#: The data tools (benchmarks/datasets) this script imports: ``real_size``.
+sys.path.insert(0, str(Path(__file__).resolve().parent / "datasets"))
 from real_size import photo_at, skull_at  # noqa: E402
 
 

@@ -1,7 +1,7 @@
-"""The Cranium real-anatomy case (benchmarks/cranium_case.py).
+"""The Cranium real-anatomy case (benchmarks/datasets/cranium_case.py).
 
 Slow; skips where ``Cranium.inv3`` is absent (``LILIUM_CRANIUM``, ``../shared/data/cranium``
-or the Debian ``invesalius-examples`` path; ``python benchmarks/cranium_ct.py --fetch DIR``
+or the Debian ``invesalius-examples`` path; ``python benchmarks/datasets/cranium_ct.py --fetch DIR``
 gets it). Never downloads.
 """
 
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT / "benchmarks" / "datasets"))
 import cranium_case  # noqa: E402
 import cranium_ct  # noqa: E402
 

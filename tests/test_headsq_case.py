@@ -1,4 +1,4 @@
-"""The headsq real-anatomy case (benchmarks/headsq_case.py, issue 27).
+"""The headsq real-anatomy case (benchmarks/datasets/headsq_case.py, issue 27).
 
 Skips where ``../shared/data/headsq`` (the CT beside the repository) is absent.
 """
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT / "benchmarks" / "datasets"))
 import headsq_case  # noqa: E402
 import headsq_ct  # noqa: E402
 

@@ -1,4 +1,4 @@
-"""benchmarks/lookalikes.py: the equal error rate that bounds any calibration's misleading
+"""benchmarks/studies/lookalikes.py: the equal error rate that bounds any calibration's misleading
 evidence, and the skulls' likeness."""
 
 import json
@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT / "benchmarks" / "studies"))
 import lookalikes  # noqa: E402
 
 

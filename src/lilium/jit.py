@@ -15,7 +15,7 @@ A kernel is compiled one of two ways, from the same source:
 
 - **ahead of time**, when the package was installed: ``pip install`` builds the extension module
   ``lilium._kernels_aot`` with numba's ``pycc`` (``setup.py``, :mod:`lilium.jit_aot`) for the
-  argument types listed in :mod:`lilium.jit_signatures` (recorded from the demo, ``lilium sfo``
+  argument types listed in ``lilium/jit_signatures.json`` (recorded from the demo, ``lilium sfo``
   and ``lilium case``, whose SFOs ``lineup`` and ``experiment`` run too). A call whose arguments
   have exactly one of those types runs it, and a process that needs nothing else never imports
   numba (numba's import and its registries cost about 0.5 s per process; the module loads in
@@ -27,11 +27,12 @@ A kernel is compiled one of two ways, from the same source:
 - **just in time**, for every other call: numba (``cache=True``, so only the first run on a
   machine pays the compile time, cached in the package's ``__pycache__`` folders).
 
-numba is a pinned dependency (``pyproject.toml``); should it be missing, or fail to import (a
-numba built against another numpy), Lilium still runs, on the numpy path, only slower (a failed
-import warns once). ``LILIUM_KERNELS=numpy`` in the environment forces the numpy path (the
-benchmarks' reference timings), ``LILIUM_KERNELS=jit`` numba's JIT without the ahead-of-time
-module; :func:`kernels` switches them inside a process (tests).
+numba is a dependency (``pyproject.toml``: the minor release the build uses; its exact version in
+``requirements.lock``); should it be missing, or fail to import (a numba built against another
+numpy), Lilium still runs, on the numpy path, only slower (a failed import warns once).
+``LILIUM_KERNELS=numpy`` in the environment forces the numpy path (the benchmarks' reference
+timings), ``LILIUM_KERNELS=jit`` numba's JIT without the ahead-of-time module; :func:`kernels`
+switches them inside a process (tests).
 """
 
 import contextlib
@@ -39,6 +40,7 @@ import functools
 import hashlib
 import importlib
 import importlib.util
+import json
 import os
 import platform
 import warnings
@@ -195,16 +197,28 @@ def kernels(name):
 
 # --- the ahead-of-time module -------------------------------------------------------------------
 
+#: The argument types the kernels are built for ahead of time, a data file written by
+#: ``python -m lilium.jit_aot record`` (:mod:`lilium.jit_aot` says why it is data).
+SIGNATURES_FILE = _PACKAGE / "jit_signatures.json"
+
+
+@functools.cache
+def signature_table():
+    """``(modules, signatures)`` of :data:`SIGNATURES_FILE`: the modules that define kernels,
+    and ``{kernel key: [[argument specs, return spec], ...]}``."""
+    table = json.loads(SIGNATURES_FILE.read_text(encoding="utf-8"))
+    return tuple(table["modules"]), table["signatures"]
+
 
 def source_hash():
     """A 63-bit hash of the kernels' sources and of their signature list (what the ahead-of-time
     module was built from: a module whose hash differs is stale and not used)."""
-    from .jit_signatures import MODULES
-
+    modules, _ = signature_table()
     digest = hashlib.sha256()
-    for name in (*MODULES, "lilium.constants", "lilium.jit_signatures"):
+    for name in (*modules, "lilium.constants"):
         path = _PACKAGE.joinpath(*name.split(".")[1:]).with_suffix(".py")
         digest.update(name.encode() + b"\0" + path.read_bytes())
+    digest.update(SIGNATURES_FILE.name.encode() + b"\0" + SIGNATURES_FILE.read_bytes())
     return int.from_bytes(digest.digest()[:8], "little") >> 1
 
 
@@ -236,9 +250,8 @@ def export_name(index):
 
 def aot_signatures():
     """``[(kernel key, argument slots, return slot), ...]`` in the module's export order."""
-    from .jit_signatures import SIGNATURES
-
-    return [(key, args, ret) for key in sorted(SIGNATURES) for args, ret in SIGNATURES[key]]
+    _, signatures = signature_table()
+    return [(key, args, ret) for key in sorted(signatures) for args, ret in signatures[key]]
 
 
 @functools.cache

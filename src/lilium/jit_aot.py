@@ -3,7 +3,7 @@
 Not imported by the package at run time (it imports numba); used by ``setup.py`` when the package
 is installed, and by a developer after a change of a kernel's arguments::
 
-    python -m lilium.jit_aot record    # rewrite lilium/jit_signatures.py from real runs
+    python -m lilium.jit_aot record    # rewrite lilium/jit_signatures.json from real runs
     python -m lilium.jit_aot build     # build lilium/_kernels_aot (as pip install -e . does)
 
 ``record`` runs what a user runs (the demo, ``lilium sfo`` of every Lilium variant and of
@@ -14,8 +14,17 @@ export per signature, for this machine's CPU (``pip install`` builds where it ru
 sources' hash of :func:`lilium.jit.source_hash`, so that a later edit makes the module stale
 instead of wrong. A call with other argument types goes to numba's JIT, so a missing signature
 costs start-up time, never a wrong answer.
+
+The list is data, not source: ``lilium/jit_signatures.json`` (the kernel modules, and per kernel
+its signatures, one per line), written by ``record`` and read by :func:`lilium.jit.signature_table`
+(``build``, and the package at run time to find each export). It was a 550-line generated Python
+module that read like code. Deriving the signatures at build time from declarations beside the
+kernels was the alternative, not taken: the types that count are those real calls produce (array
+layouts, read-only flags, the shapes of tuples), which only a run shows, and 33 hand-written
+declarations could drift from the calls where a recorded list cannot.
 """
 
+import json
 import os
 import sys
 import tempfile
@@ -25,7 +34,7 @@ from pathlib import Path
 MODULE_NAME = "_kernels_aot"
 
 
-# --- numba types <-> the plain literals of lilium/jit_signatures.py ------------------------------
+# --- numba types <-> the plain literals of lilium/jit_signatures.json ----------------------------
 
 
 def type_to_spec(t):
@@ -116,45 +125,44 @@ def record():
     return modules, signatures
 
 
+#: The first member of ``lilium/jit_signatures.json``: what the file is (JSON has no comments).
+ABOUT = (
+    "The argument types the kernels are built for ahead of time (lilium.jit). Written by "
+    "`python -m lilium.jit_aot record`; do not edit by hand. Each signature is [argument specs, "
+    'return spec], a spec being ["array", dtype, ndim, layout, readonly], '
+    '["tuple", [specs]] or a scalar\'s name.'
+)
+
+
 def write_signatures(modules, signatures, path=None):
-    """Write ``lilium/jit_signatures.py``."""
-    path = Path(path or Path(__file__).with_name("jit_signatures.py"))
-    text = (
-        '"""The argument types the kernels are built for ahead of time (:mod:`lilium.jit`).\n\n'
-        "Written by ``python -m lilium.jit_aot record``; do not edit by hand. Each entry is\n"
-        '``(argument specs, return spec)``: ``("array", dtype, ndim, layout, readonly)``,\n'
-        '``("tuple", [...])`` or a scalar\'s name.\n"""\n\n'
-        f"MODULES = {_literal(modules, 10)}\n\n"
-        f"SIGNATURES = {_literal(dict(sorted(signatures.items())), 13)}\n"
-    )
-    path.write_text(text)
+    """Write ``lilium/jit_signatures.json`` (default: :data:`lilium.jit.SIGNATURES_FILE`): the
+    kernel ``modules``, and ``signatures`` (``{kernel key: [(argument specs, return spec),
+    ...]}``) sorted by key, one signature per line so that a change reads as a one-line diff."""
+    from . import jit
+
+    path = Path(path or jit.SIGNATURES_FILE)
+    compact = {"separators": (", ", ": ")}
+    lines = ["{", f'  "about": {json.dumps(ABOUT)},', '  "modules": [']
+    lines += [f"    {json.dumps(m)}," for m in modules]
+    lines[-1] = lines[-1].rstrip(",")
+    lines += ["  ],", '  "signatures": {']
+    for key, entries in sorted(signatures.items()):
+        lines.append(f"    {json.dumps(key)}: [")
+        lines += [f"      {json.dumps(entry, **compact)}," for entry in entries]
+        lines[-1] = lines[-1].rstrip(",")
+        lines.append("    ],")
+    lines[-1] = lines[-1].rstrip(",")
+    lines += ["  }", "}", ""]
+    path.write_text("\n".join(lines))
+    jit.signature_table.cache_clear()
     return path
-
-
-def _literal(value, column, level=0):
-    """``repr(value)`` starting at ``column``, in lines of at most 99 characters (one member per
-    line, indented by nesting ``level``, where it is longer), as ruff formats it."""
-    text = repr(value).replace("'", '"')  # no quotes inside: kernel and type names
-    if column + len(text) < 99 or not isinstance(value, (list, tuple, dict)):
-        return text
-    pad = "    " * (level + 1)
-    if isinstance(value, dict):
-        items = [
-            f'{pad}"{k}": {_literal(v, len(pad) + len(k) + 4, level + 1)},'
-            for k, v in value.items()
-        ]
-        opening, closing = "{", "}"
-    else:
-        items = [f"{pad}{_literal(v, len(pad), level + 1)}," for v in value]
-        opening, closing = ("[", "]") if isinstance(value, list) else ("(", ")")
-    return "\n".join([opening, *items, pad[:-4] + closing])
 
 
 # --- build --------------------------------------------------------------------------------------
 
 
 def build(output_dir, output_file=None, verbose=False):
-    """Compile every signature of :mod:`lilium.jit_signatures` into one extension module in
+    """Compile every signature of ``lilium/jit_signatures.json`` into one extension module in
     ``output_dir`` (file name ``output_file``, default numba's for this Python); returns its
     path."""
     from numba.core import types
@@ -185,16 +193,17 @@ def _import_kernels():
     import importlib
     import types
 
-    from .jit_signatures import MODULES
+    from .jit import signature_table
 
+    modules, _ = signature_table()
     root = Path(__file__).parent
-    for name in MODULES:
+    for name in modules:
         package = name.rsplit(".", 1)[0]
         if package not in sys.modules:
             stub = types.ModuleType(package)
             stub.__path__ = [str(root / package.split(".")[1])]
             sys.modules[package] = stub
-    for name in MODULES:
+    for name in modules:
         importlib.import_module(name)
 
 

@@ -209,8 +209,17 @@ def cmc_table(rows):
     return table
 
 
-def plot_cmc(cmc, path):
-    """Cumulative match curves, one panel per experiment: frontal solid, lateral dashed.
+#: The CMC plot's y label for :func:`cmc_table`'s curves.
+CMC_YLABEL = "share of photos with the true skull in the r best"
+
+#: Line style and marker of each view group in :func:`plot_cmc` (``"all"``: views pooled).
+_VIEW_STYLES = (("frontal", "-", "o"), ("lateral", "--", "s"), ("all", "-.", "D"))
+
+
+def plot_cmc(cmc, path, ylabel=CMC_YLABEL):
+    """Cumulative match curves, one panel per experiment: frontal solid, lateral dashed, both
+    views pooled (view ``"all"``) dash-dotted. The experiment report's two cumulative rank plots
+    (``cmc.png``, and ``rank_distribution.png`` of :mod:`lilium.experiments.report`) both use it.
 
     The curve is defined at the integer ranks (markers); each method is shifted by a few
     hundredths of a rank so that equal curves stay visible.
@@ -218,8 +227,11 @@ def plot_cmc(cmc, path):
     Parameters
     ----------
     cmc : list of dict
-        :func:`cmc_table`.
+        ``method`` (its label), ``experiment``, ``view``, ``rank``, ``rate``, as
+        :func:`cmc_table` gives them.
     path : path of the PNG to write
+    ylabel : str
+        What the rate is.
 
     Returns
     -------
@@ -238,7 +250,7 @@ def plot_cmc(cmc, path):
         colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
         max_rank = max((c["rank"] for c in items), default=1)
         for i, method in enumerate(methods):
-            for view, style in (("frontal", "-"), ("lateral", "--")):
+            for view, style, marker in _VIEW_STYLES:
                 curve = [c for c in items if c["method"] == method and c["view"] == view]
                 if not curve:
                     continue
@@ -246,7 +258,7 @@ def plot_cmc(cmc, path):
                     [c["rank"] + 0.04 * (i - (len(methods) - 1) / 2) for c in curve],
                     [c["rate"] for c in curve],
                     linestyle=style,
-                    marker="o" if view == "frontal" else "s",
+                    marker=marker,
                     markersize=4,
                     color=colours[i % len(colours)],
                     label=f"{method}, {view}",
@@ -257,7 +269,7 @@ def plot_cmc(cmc, path):
         ax.set_ylim(0.0, 1.02)
         ax.set_xticks(range(1, max_rank + 1, max(1, max_rank // 10)))
         ax.grid(alpha=0.3)
-    axes[0][0].set_ylabel("share of photos with the true skull in the r best")
+    axes[0][0].set_ylabel(ylabel)
     if axes[0][-1].get_legend_handles_labels()[0]:  # no curve, no legend (and no warning)
         axes[0][-1].legend(fontsize=7, loc="lower right")
     fig.tight_layout()

@@ -42,6 +42,7 @@ from .identification import (
     identification_markdown,
     identification_table,
     photo_matches,
+    plot_cmc,
     write_identification,
 )
 from .lr_report import SCORE_FITNESS, lr_identification
@@ -309,38 +310,45 @@ def write_csv(path, table, columns=()):
     return path
 
 
-def plot_rank_distribution(ranks, path):
-    """Cumulative rank distribution (fraction of photo-runs with rank <= r), per experiment."""
-    import matplotlib
+def rank_distribution(ranks):
+    """Cumulative rank distribution: per experiment and method, the fraction of photo-runs
+    (both views) whose true skull ranks r or better (``rank`` of :func:`photo_ranks`: ties at
+    their mean rank), r = 1 .. the experiment's number of skulls.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    exps = [e for e in EXPERIMENTS if any(r["experiment"] == e for r in ranks)] or ["A"]
-    fig, axes = plt.subplots(1, len(exps), figsize=(4.5 * len(exps), 3.8), squeeze=False)
-    for ax, exp in zip(axes[0], exps, strict=True):
+    Returns
+    -------
+    list of dict
+        ``method`` (its label), ``experiment``, ``view`` (``"all"``), ``rank``, ``rate``: the
+        rows of :func:`~lilium.experiments.identification.plot_cmc`.
+    """
+    out = []
+    for exp in EXPERIMENTS:
         items = [r for r in ranks if r["experiment"] == exp]
-        pairs = method_order({(r["method"], r["variant"]) for r in items})
         k = max((r["n_skulls"] for r in items), default=1)
-        grid = np.arange(1, k + 1)
-        for method, variant in pairs:
+        for method, variant in method_order({(r["method"], r["variant"]) for r in items}):
             values = np.array(
                 [r["rank"] for r in items if (r["method"], r["variant"]) == (method, variant)]
             )
-            frac = [(values <= g).mean() for g in grid]
-            ax.step(grid, frac, where="post", label=method_label(method, variant))
-        ax.set_title(f"Exp. {exp}")
-        ax.set_xlabel("rank of the true skull")
-        ax.set_ylim(0, 1.02)
-        ax.set_xticks(grid)
-        ax.grid(alpha=0.3)
-    axes[0][0].set_ylabel("fraction of photos (all runs) with rank <= r")
-    if axes[0][-1].get_legend_handles_labels()[0]:  # no curve, no legend (and no warning)
-        axes[0][-1].legend(fontsize=8, loc="lower right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+            label = method_label(method, variant)
+            out += [
+                {
+                    "method": label,
+                    "experiment": exp,
+                    "view": "all",
+                    "rank": g,
+                    "rate": float((values <= g).mean()),
+                }
+                for g in range(1, k + 1)
+            ]
+    return out
+
+
+def plot_rank_distribution(ranks, path):
+    """The cumulative rank distribution (:func:`rank_distribution`), drawn by
+    :func:`~lilium.experiments.identification.plot_cmc`."""
+    return plot_cmc(
+        rank_distribution(ranks), path, ylabel="fraction of photos (all runs) with rank <= r"
+    )
 
 
 def plot_bpe(rows, path):

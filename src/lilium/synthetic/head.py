@@ -15,7 +15,7 @@ the front, so the facial chin-jaw curve would be a flat line whatever the jaw's 
 bony chin's outline is a U: the true skull's own P_pll was then large (issue 20, measured in
 docs/decisions/0011-generator-chin-jaw-curve.md); following the bone keeps the skin's chin outline
 as curved as the real one
-(``benchmarks/chin_profile.py``).
+(``benchmarks/studies/chin_profile.py``).
 
 The *face mask* keeps the upper neck too: its cut lies :data:`NECK_SKULL_CLEARANCE_MM` below the
 whole skull, so that, as in a real photo of a head, the true skull projects inside the mask from
@@ -39,8 +39,8 @@ NECK_CUT_MARGIN_MM = 4.0
 #: vertex (within ``JAW_BELOW_ANGLE_DEG`` of straight down) and farther from it than the
 #: subject's own chin depth (facial gnathion to the nearest bone vertex, ``JAW_DEPTH_FALLBACK_MM``
 #: without a facial gnathion) plus ``JAW_CUT_MARGIN_MM``: the outline then follows the bone, as
-#: in a real head (``benchmarks/chin_profile.py``), one chin depth below it under the midline and
-#: up to the margin deeper at the sides.
+#: in a real head (``benchmarks/studies/chin_profile.py``), one chin depth below it under the
+#: midline and up to the margin deeper at the sides.
 #: The 4 mm margin: closer, the cut runs through the chin's own skin and its triangles leave a
 #: ragged outline (at 2 mm the true skull had P_int > 0 at its true camera on 3 of 8 frontal
 #: photos of seed 0, at 1 mm on 2; none at 4 mm).

@@ -3,7 +3,7 @@
 :func:`measure` takes the classic measurements (Martin's numbers, Howells' codes) from a
 subject's skull mesh and cranial landmarks; :data:`PUBLISHED` holds the adult means and SDs the
 generator's shape priors (:data:`~.shape.SHAPE_PRIORS`) are tuned to, with their sources in
-``docs/population.md``. ``benchmarks/population.py`` prints the two side by side.
+``docs/population.md``. ``benchmarks/studies/population.py`` prints the two side by side.
 
 Skull frame (mm): x = the subject's left, y = up, z = anterior; the midsagittal plane is x = 0
 and y = 0 lies at porion height.

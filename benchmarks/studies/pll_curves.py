@@ -1,6 +1,6 @@
 """Pictures of P_pll's curves: a photo's true skull against its best-scoring wrong skull.
 
-Run: ``.venv/bin/python benchmarks/pll_curves.py DB PHOTO [--variant skof+pll] [--out PNG]``
+Run: ``.venv/bin/python benchmarks/studies/pll_curves.py DB PHOTO [--variant skof+pll] [--out PNG]``
 on a database of :mod:`benchmarks.bench_identification` (or of any ``lilium experiment`` whose
 generated dataset lies in ``dataset/`` beside the database; ``--axes-set`` and ``--repetition`` pick
 the run, default the first of Exp. C). For the photo, three panels on the photo's chin-jaw (frontal)

@@ -4,13 +4,14 @@ A script and a module: other benchmarks import :func:`build_cranium_dataset` (a 
 dataset of the Cranium subject) or :func:`ensure_dataset`; both return None when the CT is
 absent. Run::
 
-    python benchmarks/cranium_case.py --fetch ../shared/data/cranium   # once: apt-get download
-    python benchmarks/cranium_case.py --out cranium-case --photos 3
+    # once: apt-get download
+    python benchmarks/datasets/cranium_case.py --fetch ../shared/data/cranium
+    python benchmarks/datasets/cranium_case.py --out cranium-case --photos 3
 
-The subject comes from ``benchmarks/cranium_ct.py`` (the CT and where it is found, the volume
-edits, ``lilium.ct.import_ct`` and the turn into the generator's skull frame), its landmarks
-from the rules of ``benchmarks/cranium_landmarks.py``. Built here exactly as
-``benchmarks/headsq_case.py`` builds the headsq case, with the generator's own code
+The subject comes from ``benchmarks/datasets/cranium_ct.py`` (the CT and where it is found, the
+volume edits, ``lilium.ct.import_ct`` and the turn into the generator's skull frame), its
+landmarks from the rules of ``benchmarks/datasets/cranium_landmarks.py``. Built here exactly as
+``benchmarks/datasets/headsq_case.py`` builds the headsq case, with the generator's own code
 (``lilium.synthetic.dataset``: cameras drawn from ``CameraRanges``, the render, visibility, face
 mask, face curves, Exp. B/C noise and the five perturbed axes sets): the photos (frontal and
 lateral), the subject folder and ``dataset.json``.
@@ -49,12 +50,12 @@ def _write_subject(root, n_photos, seed, experiments, path):
     task = (str(root), SUBJECT_ID, seq, n_photos, tuple(experiments), CameraRanges(), factory)
     task += (write_subject, False, 0.0)
     entry, photo_entries = _dataset._generate_subject(task)
-    entry["source"] = "Cranium CT (benchmarks/cranium_case.py)"
+    entry["source"] = "Cranium CT (benchmarks/datasets/cranium_case.py)"
     write_json(
         Path(root) / entry["path"] / "cranium.json",
         {
             "source": "InVesalius example Cranium.inv3 (Debian invesalius-examples), "
-            "benchmarks/cranium_case.py (rules: cranium_landmarks.py)",
+            "benchmarks/datasets/cranium_case.py (rules: cranium_landmarks.py)",
             "frame": "mm; x = subject's left, y = up, z = anterior",
             "skull_frame_from_lps": {
                 "rotation": LPS_TO_SKULL,
@@ -100,7 +101,8 @@ def build_cranium_dataset(out_dir, n_photos=3, seed=0, experiments=("A", "B", "C
     index = dataset_index(seed, n_photos, experiments, [entry], photo_entries)
     index["cranium"] = {
         "subjects": [SUBJECT_ID],
-        "note": "real-anatomy case from InVesalius' Cranium CT (benchmarks/cranium_case.py); "
+        "note": "real-anatomy case from InVesalius' Cranium CT "
+        "(benchmarks/datasets/cranium_case.py); "
         "the skull has no mandible (never scanned) and a defect of the right frontal bone",
     }
     index["incomplete"] = {

@@ -6,7 +6,7 @@ Martin / Howells measurements) and prints, per measurement, the generated mean, 
 beside the published pooled-sex adult mean and SD (:data:`~.craniometry.PUBLISHED`; sources in
 docs/population.md), with the z-score of the generated mean and the SD ratio::
 
-    .venv/bin/python benchmarks/population.py --subjects 40 --seed 0
+    .venv/bin/python benchmarks/studies/population.py --subjects 40 --seed 0
 """
 
 import argparse

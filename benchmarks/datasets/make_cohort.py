@@ -3,7 +3,7 @@ landmarks and soft-tissue axes of generated people no calibration database conta
 own seed), the skulls a photo's landmark fit is read against
 (:mod:`lilium.identification.cohort`).
 
-    python benchmarks/make_cohort.py [--skulls 20] [--seed 2027] [--out PATH]
+    python benchmarks/datasets/make_cohort.py [--skulls 20] [--seed 2027] [--out PATH]
 """
 
 import argparse

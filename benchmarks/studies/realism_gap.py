@@ -13,12 +13,12 @@ is measured is the landmarks, not an optimiser), and this prints, per view and p
 
 Run::
 
-    PYTHONPATH=src python benchmarks/realism_gap.py --generated DATASET [--real DATASET ...]
+    PYTHONPATH=src python benchmarks/studies/realism_gap.py --generated DATASET [--real DATASET ...]
 
 ``--generated`` is a generated dataset folder (``lilium synth`` or ``bench_identification``'s
 ``OUT/seed-K/dataset``); ``--real`` the real-anatomy datasets (default: the headsq case,
-``benchmarks/headsq_case.py``, built under ``--work`` when the CT is there, and the Cranium
-case, ``benchmarks/cranium_case.py``, when its file is there).
+``benchmarks/datasets/headsq_case.py``, built under ``--work`` when the CT is there, and the Cranium
+case, ``benchmarks/datasets/cranium_case.py``, when its file is there).
 """
 
 import argparse
@@ -41,6 +41,9 @@ from lilium.inputs import correspondences
 from lilium.io.calibration import shipped_cohort
 from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
+
+#: The data tools (benchmarks/datasets) this study imports: ``headsq_case``, ``cranium_case``.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "datasets"))
 
 
 def true_pairs(root, experiment="C", axes_set=1):

@@ -4,7 +4,7 @@ For lateral offsets ``x = -25, -20, ..., +25`` mm from the midline it measures, 
 source's head frame, how far the mandible's inferior border rises sideways (``bone_rise_mm``),
 the soft tissue depth from that border to the skin (``depth_mm``) and how far the skin under it
 rises (``skin_rise_mm``); the definitions, the chin regions and the frames are in
-``benchmarks/chin_profile_geometry.py``. This script reads the head CT and the generated
+``benchmarks/studies/chin_profile_geometry.py``. This script reads the head CT and the generated
 subjects, prints the tables and draws the figure.
 
 Output: the profile table (ray along the normal, as defined there), then a second table from
@@ -19,7 +19,7 @@ Run (about 20 s; the CT part is skipped with a message when ``../shared/data/hea
 absent; ``--png`` writes a figure of frontal and sagittal views with the border points and
 rays, for the CT and the first subject)::
 
-    PYTHONPATH=src .venv/bin/python benchmarks/chin_profile.py [--png chin.png] [--ct DIR]
+    PYTHONPATH=src .venv/bin/python benchmarks/studies/chin_profile.py [--png chin.png] [--ct DIR]
         [--ct-bone-iso 1150] [--subjects 8] [--seed 0]
 """
 
@@ -47,7 +47,7 @@ CT_SKIN_ISO = 500.0
 #: The two depth rays: along the bone normal (straight down where unreliable), straight down.
 RAYS = ("normal", "down")
 
-DEFAULT_CT = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "headsq"
+DEFAULT_CT = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "headsq"
 
 
 # --- I/O: reading, printing, plotting ------------------------------------------------------

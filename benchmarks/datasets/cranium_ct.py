@@ -1,14 +1,15 @@
 """The InVesalius "Cranium" CT: where to find it, how to read it, its volume edits, its meshes
 and its subject in the skull frame.
 
-:func:`cranium_subject` gives the subject ``cr`` of ``benchmarks/cranium_case.py`` (which renders
-its photos and writes the dataset); :func:`data_path` finds the CT, :func:`fetch` gets it.
+:func:`cranium_subject` gives the subject ``cr`` of ``benchmarks/datasets/cranium_case.py`` (which
+renders its photos and writes the dataset); :func:`data_path` finds the CT, :func:`fetch` gets
+it.
 
 Data: ``Cranium.inv3`` of the Debian package ``invesalius-examples`` (InVesalius' example
 project, GPL-2; installed as ``/usr/share/doc/invesalius-examples/examples/Cranium.inv3``).
 Looked for at the ``--data`` argument, the environment variable ``LILIUM_CRANIUM``,
 ``../shared/data/cranium/Cranium.inv3`` beside the repository, then the installed path.
-``python benchmarks/cranium_ct.py --fetch CACHE_DIR`` runs ``apt-get download
+``python benchmarks/datasets/cranium_ct.py --fetch CACHE_DIR`` runs ``apt-get download
 invesalius-examples`` in ``CACHE_DIR`` and extracts ``Cranium.inv3`` there (a development
 step: the project's tests skip without the file and never download it).
 
@@ -89,7 +90,7 @@ from headsq_ct import true_soft_tissue
 
 #: The CT beside the repository; ``LILIUM_CRANIUM`` (a file or its folder) overrides it.
 FILE_NAME = "Cranium.inv3"
-DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "cranium"
+DEFAULT_DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "cranium"
 INSTALLED = Path("/usr/share/doc/invesalius-examples/examples") / FILE_NAME
 PACKAGE = "invesalius-examples"
 

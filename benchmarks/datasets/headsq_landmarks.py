@@ -1,9 +1,9 @@
 """Landmark placement on the headsq meshes (issue 27): one written rule per landmark.
 
 :func:`place_landmarks` places the cranial landmarks on the complete skull and the facial ones on
-the skin of the headsq CT (``benchmarks/headsq_ct.py`` extracts the meshes, ``headsq_case.py``
-writes the dataset). Frame: the generator's skull frame, mm (x = the subject's left, y = up,
-z = anterior; the origin at the centre of the complete skull's bounding box).
+the skin of the headsq CT (``benchmarks/datasets/headsq_ct.py`` extracts the meshes,
+``headsq_case.py`` writes the dataset). Frame: the generator's skull frame, mm (x = the subject's
+left, y = up, z = anterior; the origin at the centre of the complete skull's bounding box).
 
 Landmark placement rules (frame above; "frontal height map": the skull rendered by the
 project's rasteriser from straight in front, 1 mm per pixel, the height of a pixel the z of the

@@ -4,15 +4,16 @@ A script and a module: other benchmarks import :func:`build_headsq_dataset` (a s
 dataset of the headsq subjects) or :func:`add_headsq_subjects` (the headsq subjects appended
 to an existing generated dataset); both return None when the CT is absent. Run::
 
-    PYTHONPATH=src .venv/bin/python benchmarks/headsq_case.py --out headsq-case --photos 3
+    PYTHONPATH=src .venv/bin/python benchmarks/datasets/headsq_case.py --out headsq-case --photos 3
 
-The subjects come from ``benchmarks/headsq_ct.py`` (the CT and its data folder, the volume
-edits, ``lilium.ct.import_ct`` and the turn into the generator's skull frame), their landmarks
-from the rules of ``benchmarks/headsq_landmarks.py``. Built here, with the generator's own code
-(``lilium.synthetic.dataset``: cameras drawn from ``CameraRanges``, the render, visibility, face
-mask, chin-jaw curve, Exp. B/C noise and the five perturbed axes sets): the photos, the same for
-the complete and the mandible-less variant (the same person and seed: identical photos), so
-each headsq photo is solved against both skulls; the subject folders and ``dataset.json``.
+The subjects come from ``benchmarks/datasets/headsq_ct.py`` (the CT and its data folder, the
+volume edits, ``lilium.ct.import_ct`` and the turn into the generator's skull frame), their
+landmarks from the rules of ``benchmarks/datasets/headsq_landmarks.py``. Built here, with the
+generator's own code (``lilium.synthetic.dataset``: cameras drawn from ``CameraRanges``, the
+render, visibility, face mask, chin-jaw curve, Exp. B/C noise and the five perturbed axes sets):
+the photos, the same for the complete and the mandible-less variant (the same person and seed:
+identical photos), so each headsq photo is solved against both skulls; the subject folders and
+``dataset.json``.
 
 Subjects: ``hq`` (complete skull) and ``hq_nm`` (the same head, skull without its mandible;
 ``"mandible": false`` in ``dataset.json`` and ``subject.json``, the mandible's landmarks under
@@ -63,11 +64,12 @@ def _write_subjects(root, n_photos, seed, experiments, variants, path):
         task = (str(root), sid, seq, n_photos, tuple(experiments), CameraRanges(), factory)
         task += (write_subject, VARIANTS[sid], 0.0)
         entry, photo_entries = _dataset._generate_subject(task)
-        entry["source"] = "headsq CT (benchmarks/headsq_case.py)"
+        entry["source"] = "headsq CT (benchmarks/datasets/headsq_case.py)"
         write_json(
             Path(root) / entry["path"] / "headsq.json",
             {
-                "source": "headsq CT, benchmarks/headsq_case.py (rules: headsq_landmarks.py)",
+                "source": "headsq CT, benchmarks/datasets/headsq_case.py "
+                "(rules: headsq_landmarks.py)",
                 "frame": "mm; x = subject's left, y = up, z = anterior",
                 "skull_frame_from_lps": {
                     "rotation": LPS_TO_SKULL,
@@ -156,7 +158,8 @@ def dataset_index(seed, n_photos, experiments, subjects, photo_entries):
 def _index_note(variants):
     return {
         "subjects": list(variants),
-        "note": "real-anatomy case from the headsq CT (benchmarks/headsq_case.py); hq and hq_nm "
+        "note": "real-anatomy case from the headsq CT (benchmarks/datasets/headsq_case.py); "
+        "hq and hq_nm "
         "are one person (same photos), so one is a negative pair of the other's photos",
     }
 

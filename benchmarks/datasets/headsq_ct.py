@@ -1,7 +1,8 @@
 """The headsq CT (issue 27): its volume edits, its meshes and its two subjects in the skull frame.
 
-:func:`headsq_subjects` gives the subjects ``hq`` and ``hq_nm`` of ``benchmarks/headsq_case.py``
-(which renders their photos and writes the dataset); :func:`data_dir` finds the CT.
+:func:`headsq_subjects` gives the subjects ``hq`` and ``hq_nm`` of
+``benchmarks/datasets/headsq_case.py`` (which renders their photos and writes the dataset);
+:func:`data_dir` finds the CT.
 
 Data: ``../shared/data/headsq`` beside the repository (override with ``--data`` or the
 environment variable ``LILIUM_HEADSQ``): VTK's quarter-resolution head CT, 64 x 64 x 93 int16
@@ -38,7 +39,7 @@ import numpy as np
 from headsq_landmarks import place_landmarks
 
 #: The CT beside the repository (``../shared/data/headsq``); ``LILIUM_HEADSQ`` overrides it.
-DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "headsq"
+DEFAULT_DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "headsq"
 HEADER = "quarter.nhdr"
 BONE_ISO = 1150.0
 SKIN_ISO = 500.0

@@ -1,4 +1,4 @@
-"""The chin-jaw profile's measurement (the geometry of ``benchmarks/chin_profile.py``).
+"""The chin-jaw profile's measurement (the geometry of ``benchmarks/studies/chin_profile.py``).
 
 :func:`chin_profile` measures one head in the chin region of :func:`subject_region` (a generated
 subject) or :func:`ct_region` (the head CT), from the mesh geometry below it (plane sections,

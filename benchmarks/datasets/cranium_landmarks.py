@@ -1,7 +1,7 @@
 """Landmark placement on the Cranium meshes: one written rule per landmark.
 
 :func:`place_landmarks` places the cranial landmarks on the skull and the facial ones on the
-skin of the InVesalius Cranium CT (``benchmarks/cranium_ct.py`` extracts the meshes,
+skin of the InVesalius Cranium CT (``benchmarks/datasets/cranium_ct.py`` extracts the meshes,
 ``cranium_case.py`` writes the dataset); :func:`sanity_figures` measures them against adult
 norms. Frame: the generator's skull frame, mm (x = the subject's left, y = up, z = anterior;
 the origin at the centre of the skull's bounding box). The CT has about 1 mm voxels, so the
@@ -89,7 +89,7 @@ from the bone outwards, the outermost one for rays from inside the face (``heads
   columella-lip junction);
 - not placed: the cheilia (below the scan; so the frontal photos have no chin-jaw curve).
 
-Sanity figures (:func:`sanity_figures`, ``python benchmarks/cranium_ct.py``) against adult
+Sanity figures (:func:`sanity_figures`, ``python benchmarks/datasets/cranium_ct.py``) against adult
 norms, measured on this CT (distances in 3D, mm):
 
 - biorbital breadth ec-ec 94.8 (norm 93-100);
