@@ -1,4 +1,5 @@
-"""The pure geometry of benchmarks/studies/chin_profile_geometry.py on shapes with a known answer."""
+"""The pure geometry of benchmarks/studies/chin_profile_geometry.py on shapes with known
+answers."""
 
 import importlib.util
 from pathlib import Path

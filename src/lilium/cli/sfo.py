@@ -9,8 +9,8 @@ list, with ``OUT/overlay_<photo id>.png`` per photo.
 
 import sys
 
-from ..casework.single import joint_sfo, single_sfo
 from ..casework.identify import conclusion_line
+from ..casework.single import joint_sfo, single_sfo
 from .options import PHOTO_FILES, SFO, add_options, case_request
 
 #: The method ``lilium sfo`` runs without ``--method``: the baseline.
