@@ -1,12 +1,31 @@
 """Case workflows: from the user's files to written results (what the ``lilium`` commands call).
 
-- :mod:`~lilium.casework.folders`: one SFO on docs/contract.md folders (``lilium sfo``);
-- :mod:`~lilium.casework.inputs`: a user's skull and photos from folders or plain files, with
-  the precedence of priors (command line, ``photo.json``, EXIF);
-- :mod:`~lilium.casework.prepared`: photo folders of ``lilium photo`` in a case (landmarks'
-  origin, automatic priors paired with the skull) and ``lilium case --auto-landmarks``;
-- :mod:`~lilium.casework.case`: every SFO of a case and its HTML report (``lilium case``).
+- :mod:`~lilium.casework.request`: what a user asks to run, one frozen
+  :class:`~lilium.casework.request.CaseRequest` (built by ``lilium.cli.options`` or a script);
+- :mod:`~lilium.casework.read`: the request's inputs read and checked once
+  (:func:`~lilium.casework.read.read_case`), through :mod:`~lilium.casework.inputs` (a user's
+  skull and photos from folders or plain files, with the precedence of priors: command line,
+  ``photo.json``, EXIF) and :mod:`~lilium.casework.prepared` (photo folders of ``lilium photo``
+  in a case, ``--auto-landmarks``);
+- :mod:`~lilium.casework.single`: one SFO without a report (``lilium sfo``);
+- :mod:`~lilium.casework.case`: every SFO of a case and its HTML report (``lilium case``);
+- :mod:`~lilium.casework.lineup`: one skull against several candidates (``lilium lineup``);
+- :mod:`~lilium.casework.folders`: the output folders' machinery (resume, lock, joint files);
+- :mod:`~lilium.casework.identify`: the calibration file read once, each result's
+  identification.
 
 The flow runs down once: cli -> casework -> methods (:func:`lilium.methods.run_sfo`) -> pose /
 fitness -> geometry; reading and writing files is :mod:`lilium.io`'s job.
+
+Example (a script's case, as ``lilium case`` runs it)::
+
+    from pathlib import Path
+    from lilium.casework.case import run_case
+    from lilium.casework.request import CaseRequest, PhotoSource, SkullSource
+
+    request = CaseRequest(
+        SkullSource(Path("subject")), Path("case"),
+        photos=(PhotoSource(Path("front.jpg"), landmarks=Path("front.csv")),),
+    )
+    entries = run_case(request)
 """
