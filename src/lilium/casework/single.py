@@ -11,7 +11,7 @@ from .identify import with_identification
 from .read import read_case
 
 
-def single_sfo(request):
+def single_sfo(request, log=None):
     """One SFO: read the skull and the photo, check them, run the method, write ``request.out``.
 
     The photo's priors come from the request, ``photo.json``, or its focal prior from the
@@ -23,9 +23,11 @@ def single_sfo(request):
     Parameters
     ----------
     request : CaseRequest
-        One photo and one method (``request.methods[0]``); its axes, depth table (replaces
-        ``options.depth_table``), calibration (default: the shipped one,
+        One photo and one method (``request.methods[0]``); its axes, priors, depth table
+        (replaces ``options.depth_table``), calibration (default: the shipped one,
         :mod:`lilium.casework.identify`) and ``overlay`` (write ``overlay.png`` too).
+    log : callable, optional
+        Receives one line per sidecar file found beside a mesh or an image.
 
     Returns
     -------
@@ -39,7 +41,7 @@ def single_sfo(request):
     """
     (method,) = request.methods
     check_method(method, request.options.variant)
-    inputs = read_case(request)
+    inputs = read_case(request, log=log)
     skull, (photo,) = inputs.skull, inputs.photos
     result = run_sfo(method, skull, photo, inputs.options, request.seed)
     result = with_identification(result, skull, [photo], inputs.calibrations)
@@ -48,7 +50,7 @@ def single_sfo(request):
     return result
 
 
-def joint_sfo(request):
+def joint_sfo(request, log=None):
     """One joint SFO of the request's two or more photos of the same person (one soft tissue
     shared by the photos, one camera each): read, check, run, write ``request.out``.
 
@@ -70,7 +72,7 @@ def joint_sfo(request):
     if len(request.photos) < 2:
         raise ValueError("a joint SFO needs two or more --photo folders")
     check_distinct_photos([source.path for source in request.photos])
-    inputs = read_case(request)
+    inputs = read_case(request, log=log)
     skull, photos = inputs.skull, inputs.photos
     result = run_joint_sfo(method, skull, photos, inputs.options, request.seed)
     result = with_identification(result, skull, photos, inputs.calibrations)

@@ -204,8 +204,11 @@ def photo_sources(args):
     return tuple(sources)
 
 
-def case_request(args, default_method="lilium"):
+def case_request(args):
     """The :class:`CaseRequest` of ``lilium sfo``, ``case`` or ``lineup``'s arguments.
+
+    Without ``--method``, the command's default (``args.default_method``, set by its parser;
+    Lilium when unset).
 
     Raises
     ------
@@ -230,7 +233,7 @@ def case_request(args, default_method="lilium"):
         out=args.out,
         photos=photo_sources(args) if getattr(args, "photo", None) else (),
         candidates=candidates,
-        methods=tuple(dict.fromkeys(args.method)) or (default_method,),
+        methods=tuple(dict.fromkeys(args.method)) or (getattr(args, "default_method", "lilium"),),
         options=sfo_options(args),
         seed=args.seed,
         priors=priors,

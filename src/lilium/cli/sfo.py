@@ -11,7 +11,7 @@ import sys
 
 from ..casework.identify import conclusion_line
 from ..casework.single import joint_sfo, single_sfo
-from .options import PHOTO_FILES, SFO, add_options, case_request
+from .options import PHOTO_FILES, PRIORS, SFO, add_options, case_request
 
 #: The method ``lilium sfo`` runs without ``--method``: the baseline.
 DEFAULT_METHOD = "posest-sfo"
@@ -29,16 +29,16 @@ def register(subparsers):
         ),
     )
     add_options(
-        p, "skull", "landmarks", "axes", "photo", *PHOTO_FILES, "out", *SFO, "depth_table",
+        p, "skull", "landmarks", "axes", "photo", *PHOTO_FILES, "out", *SFO, *PRIORS, "depth_table",
         required=("skull", "photo", "out"), shown={"method": DEFAULT_METHOD},
     )
     p.add_argument("--no-overlay", action="store_true", help="skip overlay.png")
     add_options(p, "calibration")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, default_method=DEFAULT_METHOD)
 
 
 def _request(args):
-    request = case_request(args, default_method=DEFAULT_METHOD)
+    request = case_request(args)
     if len(request.methods) > 1:
         raise ValueError(
             f"--method given {len(request.methods)} times: lilium sfo runs one method; use "
@@ -51,7 +51,7 @@ def run(args):
     request = _request(args)
     if len(request.photos) > 1:
         return run_joint(request)
-    result = single_sfo(request)
+    result = single_sfo(request, log=print)
     for warning in result.warnings:
         print(f"warning {warning.code}: {warning.message}", file=sys.stderr)
     if not result:
@@ -79,7 +79,7 @@ def run_joint(request):
             f"--method {method}: a joint SFO of {len(request.photos)} photos runs with --method "
             "lilium only; give one --photo for each SFO, or --method lilium"
         )
-    result = joint_sfo(request)
+    result = joint_sfo(request, log=print)
     for single in result.photos:
         for warning in single.warnings:
             print(f"warning {warning.code} ({single.photo_id}): {warning.message}", file=sys.stderr)
