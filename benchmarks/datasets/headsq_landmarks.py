@@ -72,6 +72,16 @@ import numpy as np
 HEIGHT_MAP_PX_MM = 1.0
 CLOSING_RADIUS_MM = 20.0
 DEEP_MM = 8.0
+#: Orbit candidates: deep regions whose centroid lies this far off the bounding box's centre.
+ORBIT_OFF_MIDLINE_MM = 12.0
+#: Gonion: the hull edges of the ramus' posterior border have an outward normal within
+#: acos(this) of -z; the bisector ray's half-width; the vertices within this distance (y, z)
+#: of the angle's outline point.
+GONION_RAMUS_COS = 0.9
+GONION_RAY_MM = 1.5
+GONION_NEAR_MM = 3.0
+#: Exo- and endocanthion rays (as ``cranium_landmarks``).
+CANTHUS_RAY_MM = 60.0
 
 
 def _height_map(vertices, faces):
@@ -152,72 +162,89 @@ def _over(skin, point, direction, radius_mm=2.0, max_t_mm=35.0, outermost=True):
     raise ValueError(f"no skin over {point} along {d}")
 
 
-def place_landmarks(skull, skull_faces, skin, mandible_mask):
+def _orbit_regions(m):
+    """The two orbits' regions (u, v) on the map ``m`` of the complete skull and the midline x
+    (see the module notes)."""
+    rows_in = np.flatnonzero(np.isfinite(m.height).any(axis=1))
+    top_row, mid_row = rows_in[0], 0.5 * (rows_in[0] + rows_in[-1])
+    regions = []
+    for lab in range(1, m.n + 1):
+        u, v = m.region(lab)
+        if v.min() > top_row + 2:  # not the open bowl of the cut vault
+            regions.append((u, v))
+    centre_x = 0.5 * (m.skull[:, 0].min() + m.skull[:, 0].max())
+    orbits = {}
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        cands = [
+            (u, v)
+            for u, v in regions
+            if sign * (m.xy(u.mean(), 0)[0] - centre_x) > ORBIT_OFF_MIDLINE_MM
+            and v.mean() < mid_row
+        ]
+        orbits[side] = max(cands, key=lambda r: len(r[0]))
+    x_mid = float(np.mean([m.xy(u.mean(), 0)[0] for u, _ in orbits.values()]))
+    return orbits, x_mid
+
+
+def _gonion(mandible, x_mid, sign):
+    """The gonion of one side (see the module notes)."""
+    from scipy.spatial import ConvexHull
+
+    side = mandible[sign * (mandible[:, 0] - x_mid) > 0]
+    yz = side[:, 1:]
+    hull = ConvexHull(yz)
+    inside = yz[hull.vertices].mean(axis=0)
+    edges = []
+    for a, b in hull.simplices:
+        d = yz[b] - yz[a]
+        n = np.array([d[1], -d[0]]) / np.linalg.norm(d)  # (y, z) normal
+        n = n if n @ (yz[a] - inside) > 0 else -n  # outward
+        edges.append((np.linalg.norm(d), n, yz[a]))
+    posterior = [e for e in edges if e[1][1] < -GONION_RAMUS_COS]
+    ramus = sum(e[0] * e[1] for e in posterior)
+    ramus /= np.linalg.norm(ramus)
+    ramus_c = max(yz[hull.vertices] @ ramus)  # the support line n . p = c
+    lower = [e for e in edges if e[1][0] < 0 and e[1][1] < 0 and e[1][1] >= -GONION_RAMUS_COS]
+    _, base, on_base = max(lower, key=lambda e: e[0])
+    apex = np.linalg.solve(np.array([ramus, base]), [ramus_c, base @ on_base])
+    inward = -(ramus + base) / np.linalg.norm(ramus + base)
+    rel = yz - apex
+    t = rel @ inward
+    perp = np.abs(rel @ np.array([inward[1], -inward[0]]))
+    on_ray = (t > 0) & (perp < GONION_RAY_MM)
+    corner = yz[on_ray][np.argmin(t[on_ray])]
+    near = side[np.linalg.norm(yz - corner, axis=1) < GONION_NEAR_MM]
+    return near[np.argmax(sign * (near[:, 0] - x_mid))].copy()
+
+
+def place_landmarks(skull, skull_faces, skin, skin_faces, mandible_mask):
     """Cranial and facial landmarks by the rules of the module notes (skull frame, mm).
 
     Parameters
     ----------
-    skull : ndarray (V, 3), skull_faces : ndarray (F, 3)
+    skull : ndarray of shape (V, 3)
         The complete skull.
-    skin : ndarray (V', 3)
-    mandible_mask : ndarray (V,), bool
+    skull_faces : ndarray of shape (F, 3)
+    skin : ndarray of shape (V', 3)
+    skin_faces : ndarray of shape (F', 3)
+    mandible_mask : ndarray of shape (V,), bool
         Which skull vertices are the mandible's.
 
     Returns
     -------
-    cranial, facial : dict of str -> ndarray (3,)
+    cranial, facial : dict of str -> ndarray of shape (3,)
+    x_mid : float
+        The midline's x (between the orbits).
     """
+    from cranium_landmarks import _alare, _aperture, _Map, _orbit_landmarks
     from lilium.softtissue.normals import landmark_normals
 
-    height, index, xy = _height_map(skull, skull_faces)
-    labels, n = _deep_regions(height)
-    H, W = height.shape
-    centre_u = int(np.argmin([abs(xy(u, 0)[0]) for u in range(W)]))
-    rows_in = np.flatnonzero(np.isfinite(height).any(axis=1))
-    top_row, mid_row = rows_in[0], 0.5 * (rows_in[0] + rows_in[-1])
-    regions = []
-    for lab in range(1, n + 1):
-        v, u = np.nonzero(labels == lab)
-        if v.min() > top_row + 2:  # not the open bowl of the cut vault
-            regions.append((lab, u, v))
-    orbits = {}
-    for side, sign in (("l", 1.0), ("r", -1.0)):
-        cands = [
-            r for r in regions if sign * xy(r[1].mean(), 0)[0] > 12.0 and r[2].mean() < mid_row
-        ]
-        orbits[side] = max(cands, key=lambda r: len(r[1]))
-    orbit_v = max(o[2].mean() for o in orbits.values())
-    x_mid = float(np.mean([xy(o[1].mean(), 0)[0] for o in orbits.values()]))
-    centre_u = int(np.argmin([abs(xy(u, 0)[0] - x_mid) for u in range(W)]))
-    crossing = [r for r in regions if (r[1] == centre_u).any() and r[2].mean() > orbit_v]
-    aperture = min(crossing, key=lambda r: r[2].mean())
-    cranial = {}
-
-    def vertex(u, v):
-        return _pixel_vertex(skull, skull_faces, index, xy, int(u), int(v))
-
-    for side, sign in (("l", 1.0), ("r", -1.0)):
-        lab, u, v = orbits[side]
-        row = int(round(v.mean()))
-        on_row = u[v == row]
-        outer = on_row.max() if sign * (xy(1, 0)[0] - xy(0, 0)[0]) > 0 else on_row.min()
-        inner = on_row.min() if outer == on_row.max() else on_row.max()
-        step = 1 if outer == on_row.max() else -1
-        cranial[f"ectoconchion_{side}"] = vertex(outer + step, row)
-        cranial[f"dacryon_{side}"] = vertex(inner - step, row)
-        col = int(round(u.mean()))
-        bottom = v[u == col].max()
-        cranial[f"orbitale_{side}"] = vertex(col, bottom + 1)
-        # aperture margin on its widest row
-        au, av = aperture[1], aperture[2]
-        rows = np.unique(av)
-        widths = [np.ptp(au[av == r]) for r in rows]
-        wrow = int(rows[int(np.argmax(widths))])
-        line = au[av == wrow]
-        edge = line.max() if step == 1 else line.min()
-        cranial[f"alare_{side}"] = vertex(edge + step, wrow)
-    ap_bottom_y = xy(0, aperture[2].max())[1]
-    orbit_axis_y = 0.5 * (cranial["ectoconchion_l"][1] + cranial["ectoconchion_r"][1])
+    m = _Map(skull, skull_faces)
+    orbits, x_mid = _orbit_regions(m)
+    cranial, _, orbit_axis_y = _orbit_landmarks(m, orbits, x_mid)
+    aperture = _aperture(m, x_mid, orbit_axis_y)
+    cranial.update(_alare(m, aperture, x_mid))
+    ap_bottom_y = m.xy(0, aperture[1].max())[1]
 
     cranium = skull[~mandible_mask]
     mandible = skull[mandible_mask]
@@ -239,14 +266,8 @@ def place_landmarks(skull, skull_faces, skin, mandible_mask):
     cranial["pogonion"] = chin[np.argmax((chin[:, 1:] - menton[1:]) @ normal)]
     arc = mprof[(mprof[:, 1] < cranial["pogonion"][1]) & (mprof[:, 1] >= menton[1])]
     cranial["gnathion"] = arc[len(arc) // 2]  # midway (in profile steps) to menton
-    z_lo, z_hi = mandible[:, 2].min(), mandible[:, 2].max()
     for side, sign in (("l", 1.0), ("r", -1.0)):
-        m = mandible[
-            (sign * (mandible[:, 0] - x_mid) > 0) & (mandible[:, 2] < z_lo + 0.35 * (z_hi - z_lo))
-        ]
-        corner = -m[:, 2] - m[:, 1]
-        m = m[corner > corner.max() - 3.0]  # the angle; its outer (lateral) surface
-        cranial[f"gonion_{side}"] = m[np.argmax(sign * (m[:, 0] - x_mid))]
+        cranial[f"gonion_{side}"] = _gonion(mandible, x_mid, sign)
         o, e = cranial[f"orbitale_{side}"], cranial[f"ectoconchion_{side}"]
         c = cranium[
             (cranium[:, 1] > o[1] - 20.0)
@@ -271,9 +292,9 @@ def place_landmarks(skull, skull_faces, skin, mandible_mask):
         facial[key] = _over(skin, cranial[key], d, outermost=False)
         facial[f"alare_{side}"] = _over(skin, cranial[f"alare_{side}"], z_axis)
         e = cranial[f"ectoconchion_{side}"] - np.array([sign * 5.0, 0.0, -15.0])
-        facial[f"exocanthion_{side}"] = _over(skin, e, z_axis)
+        facial[f"exocanthion_{side}"] = _over(skin, e, z_axis, max_t_mm=CANTHUS_RAY_MM)
         d = cranial[f"dacryon_{side}"] + np.array([sign * 3.0, 0.0, -15.0])
-        facial[f"endocanthion_{side}"] = _over(skin, d, z_axis)
+        facial[f"endocanthion_{side}"] = _over(skin, d, z_axis, max_t_mm=CANTHUS_RAY_MM)
     sprof = _profile(skin, 2.0, 1.5, x_mid)
     window = (sprof[:, 1] < cranial["subspinale"][1] + 5.0) & (
         sprof[:, 1] > cranial["prosthion"][1] + 5.0
