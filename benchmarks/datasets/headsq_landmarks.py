@@ -5,22 +5,28 @@ the skin of the headsq CT (``benchmarks/datasets/headsq_ct.py`` extracts the mes
 ``headsq_case.py`` writes the dataset). Frame: the generator's skull frame, mm (x = the subject's
 left, y = up, z = anterior; the origin at the centre of the complete skull's bounding box).
 
-Landmark placement rules (frame above; "frontal height map": the skull rendered by the
-project's rasteriser from straight in front, 1 mm per pixel, the height of a pixel the z of the
-triangle seen there; "depth": how far a pixel lies behind a grey closing of the height map with
-a disk of radius 20 mm, so orbits and the nasal aperture are the connected regions deeper than
-8 mm; a chosen pixel gives the vertex of its triangle nearest to it in x, y):
+Landmark placement rules (frame above). The orbits' and the aperture's landmarks follow the
+craniometric definitions with the rules of ``cranium_landmarks`` (its "frontal height map",
+"deep region", "rim edge" and pixel-to-vertex conversion; its helpers are called): before,
+ectoconchion, dacryon and alare were the first bone pixel beside a deep region, i.e. 8 mm
+behind the rim inside the orbit or the aperture (ec-ec 84.8 mm, soft tissue 20 mm at
+ectoconchion, 20.5 mm at alare).
 
-- orbits: the largest deep region on each side (|x| > 12 mm from the bounding-box centre)
-  in the upper half; the midline is x = the mean of their centroids' x (the frame is shifted
-  so that it is x = 0); an orbit's transverse axis is the row of its centroid;
-- ``ectoconchion``: the first bone pixel lateral of the orbit on its transverse axis;
-- ``dacryon``: the first bone pixel medial of the orbit on its transverse axis (the medial
-  margin: the true dacryon lies a few mm behind it on the medial wall, which the coarse mesh
-  does not resolve);
-- ``orbitale``: the first bone pixel below the orbit's lowest pixel, in its centroid column;
-- nasal aperture: the deep region crossing the midline column nearest below the orbits;
-  ``alare``: the first bone pixel lateral of the aperture on its widest row, each side;
+- orbits: the largest deep region on each side whose centroid lies more than 12 mm off the
+  bounding box's centre in x, in the upper half of the map and not open to the cut vault; the
+  midline is x = the mean of their centroids' x (the frame is shifted so that it is x = 0);
+  the superior and inferior margins, the transverse axis: as ``cranium_landmarks``;
+- ``ectoconchion``: on the transverse axis, the most anterior point of the lateral border
+  (the crest of the lateral scan, ``cranium_landmarks``);
+- ``dacryon``: the medial margin (rim edge of the scan to the midline) and the skull vertex
+  nearest to 4 mm behind it (``cranium_landmarks``). At 3.2 mm the medial margins on the
+  transverse axis lie 35-38 mm apart on the mesh itself (the height map drops from 67-73 to
+  33-39 mm at x = +17 and -21), so d-d stays above the adult norm: the CT's, not the rule's;
+- ``orbitale``: the lowest rim edge of the scans down the orbit's middle columns
+  (``cranium_landmarks``);
+- nasal aperture: the deep region holding the midline column nearest below the orbits'
+  transverse axis; ``alare``: the most lateral rim edge (at 0.9) of the scans from the midline
+  outwards (``cranium_landmarks``);
 - midsagittal profile: vertices within 2.5 mm of the midline, the front-most one per 1.5 mm
   of height (the slice spacing); the cranium's (no mandible vertex) and the mandible's apart
   (mandible vertices: those of the complete skull more than 2 mm from the mandible-less one);
@@ -35,9 +41,15 @@ a disk of radius 20 mm, so orbits and the nasal aperture are the connected regio
   point (more than 3 mm above menton) farthest in front of the chord infradentale-menton (this
   chin recedes, so "most anterior" alone would give infradentale); ``gnathion``: the profile
   point midway (in profile steps) between pogonion and menton;
-- ``gonion``: among the mandible vertices of that side in the posterior 35 % of the mandible's
-  depth, those within 3 mm of the largest ``-y - z`` (the posterior-inferior corner), the most
-  lateral one (the outer surface of the angle);
+- ``gonion`` (Martin's construction): in the side view (y, z) of one side's mandible vertices,
+  the ramus tangent is the support line of the convex hull along the length-weighted mean
+  outward normal of the hull edges facing back (normal within 26 degrees of -z), the base
+  tangent the longest hull edge facing down and back (outside those); the angle's point is the
+  first vertex (within 1.5 mm) along the bisector of the two tangents from their intersection
+  into the bone; gonion the most lateral vertex within 3 mm (y, z) of it (the outer surface of
+  the angle). Before, "the largest -y - z in the posterior 35 %" fell on the body's lower
+  border (go-go 67.4 mm): in this CT's frame the head is bent forward and the lower border
+  runs 40 degrees from the horizontal;
 - ``zygion``: the cranium vertex of largest |x| at most 20 mm below and 5 mm above
   ``orbitale``, 5-50 mm behind ``ectoconchion``.
 
@@ -52,10 +64,12 @@ for rays from inside the face, which cross airway surfaces first:
   along the bisector of its bone normal and the lateral direction (the normal alone points
   down and back into the neck, where the skin is more than 35 mm away);
 - ``alare``: outermost over the cranial one along +z (the ala in front of the aperture
-  margin);
-- ``exocanthion``: outermost along +z from 5 mm medial of and 15 mm behind ``ectoconchion``;
-  ``endocanthion``: the same from 3 mm lateral of and 15 mm behind ``dacryon`` (the eyes are
-  closed in this CT: these are the lid line's ends, about);
+  margin; ``cranium_landmarks``' outline rule finds no ala on this 3.2 mm skin: its largest
+  step across a row is 3 mm, as large as the noise);
+- ``exocanthion``: outermost along +z (up to 60 mm) from 5 mm medial of and 15 mm behind
+  ``ectoconchion``; ``endocanthion``: the same from 3 mm lateral of and 15 mm behind
+  ``dacryon`` (as ``cranium_landmarks``; the eyes are closed in this CT: these are the lid
+  line's ends, about);
 - skin profile: skin vertices within 2 mm of the midline, the front-most per 1.5 mm of height;
   ``subnasale``: its most posterior point from 5 mm above ``subspinale`` down to 5 mm above
   ``prosthion`` (the columella-lip junction; the nose of this head is short and flat);
@@ -65,6 +79,16 @@ for rays from inside the face, which cross airway surfaces first:
   (|x| of exocanthion + |x| of endocanthion), about the pupils' columns (an estimate: the mouth
   corners do not show on a 3.2 mm skin; used only to cut the chin-jaw region). On the
   pictures they fall on the mouth corners.
+
+Sanity figures (``cranium_landmarks.sanity_figures``; distances in 3D, mm; before these rules
+in brackets): ec-ec 90.5 (84.8; norm 93-100: the lateral rim's crest is a 6 mm plateau here,
+its most medial point is taken), d-d 34.9 (37.5; 20-25: the CT's, see ``dacryon``), al-al 26.8
+(23.0; 23-26), zy-zy 129.6 (128.7; 120-135), go-go 95.2 (67.4; 90-100), n-pr 70.2 (65-72),
+n-ss 49.2 (52-58). Soft tissue ``|F - C|`` against ``lilium.softtissue.depths`` (mean +- SD):
+ectoconchion 17.2 / 16.6 (20.2 / 19.4; 10.5 +- 2.0: the closed lids lie 15 mm in front of the
+rim), dacryon 14.3 / 12.9 (13.2 / 6.0; 9.0 +- 2.0), alare 15.5 / 18.0 (20.5 / 20.5; 12.0 +-
+2.5), gonion 17.5 / 13.5 (15.4 / 15.0; 13.5 +- 4.0), zygion 6.7 / 6.0 (7.0 +- 2.0); the
+midline ones are unchanged.
 """
 
 import numpy as np
