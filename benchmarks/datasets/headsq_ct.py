@@ -169,7 +169,7 @@ def headsq_subjects(path=None, work_dir=None):
     # mandible vertices: complete-skull vertices with no cranium vertex within 2 mm
     mandible_mask = cKDTree(nm).query(skull)[0] > 2.0
     mandible_mask &= skull[:, 1] < np.percentile(skull[:, 1], 60)
-    cranial, facial, x_mid = place_landmarks(skull, skull_f, skin, mandible_mask)
+    cranial, facial, x_mid = place_landmarks(skull, skull_f, skin, skin_f, mandible_mask)
     shift = np.array([x_mid, 0.0, 0.0])  # x = 0 on the midline (between the orbits)
     skull, skin, nm = skull - shift, skin - shift, nm - shift
     cranial = {k: v - shift for k, v in cranial.items()}

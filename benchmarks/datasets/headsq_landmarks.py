@@ -5,22 +5,28 @@ the skin of the headsq CT (``benchmarks/datasets/headsq_ct.py`` extracts the mes
 ``headsq_case.py`` writes the dataset). Frame: the generator's skull frame, mm (x = the subject's
 left, y = up, z = anterior; the origin at the centre of the complete skull's bounding box).
 
-Landmark placement rules (frame above; "frontal height map": the skull rendered by the
-project's rasteriser from straight in front, 1 mm per pixel, the height of a pixel the z of the
-triangle seen there; "depth": how far a pixel lies behind a grey closing of the height map with
-a disk of radius 20 mm, so orbits and the nasal aperture are the connected regions deeper than
-8 mm; a chosen pixel gives the vertex of its triangle nearest to it in x, y):
+Landmark placement rules (frame above). The orbits' and the aperture's landmarks follow the
+craniometric definitions with the rules of ``cranium_landmarks`` (its "frontal height map",
+"deep region", "rim edge" and pixel-to-vertex conversion; its helpers are called): before,
+ectoconchion, dacryon and alare were the first bone pixel beside a deep region, i.e. 8 mm
+behind the rim inside the orbit or the aperture (ec-ec 84.8 mm, soft tissue 20 mm at
+ectoconchion, 20.5 mm at alare).
 
-- orbits: the largest deep region on each side (|x| > 12 mm from the bounding-box centre)
-  in the upper half; the midline is x = the mean of their centroids' x (the frame is shifted
-  so that it is x = 0); an orbit's transverse axis is the row of its centroid;
-- ``ectoconchion``: the first bone pixel lateral of the orbit on its transverse axis;
-- ``dacryon``: the first bone pixel medial of the orbit on its transverse axis (the medial
-  margin: the true dacryon lies a few mm behind it on the medial wall, which the coarse mesh
-  does not resolve);
-- ``orbitale``: the first bone pixel below the orbit's lowest pixel, in its centroid column;
-- nasal aperture: the deep region crossing the midline column nearest below the orbits;
-  ``alare``: the first bone pixel lateral of the aperture on its widest row, each side;
+- orbits: the largest deep region on each side whose centroid lies more than 12 mm off the
+  bounding box's centre in x, in the upper half of the map and not open to the cut vault; the
+  midline is x = the mean of their centroids' x (the frame is shifted so that it is x = 0);
+  the superior and inferior margins, the transverse axis: as ``cranium_landmarks``;
+- ``ectoconchion``: on the transverse axis, the most anterior point of the lateral border
+  (the crest of the lateral scan, ``cranium_landmarks``);
+- ``dacryon``: the medial margin (rim edge of the scan to the midline) and the skull vertex
+  nearest to 4 mm behind it (``cranium_landmarks``). At 3.2 mm the medial margins on the
+  transverse axis lie 35-38 mm apart on the mesh itself (the height map drops from 67-73 to
+  33-39 mm at x = +17 and -21), so d-d stays above the adult norm: the CT's, not the rule's;
+- ``orbitale``: the lowest rim edge of the scans down the orbit's middle columns
+  (``cranium_landmarks``);
+- nasal aperture: the deep region holding the midline column nearest below the orbits'
+  transverse axis; ``alare``: the most lateral rim edge (at 0.9) of the scans from the midline
+  outwards (``cranium_landmarks``);
 - midsagittal profile: vertices within 2.5 mm of the midline, the front-most one per 1.5 mm
   of height (the slice spacing); the cranium's (no mandible vertex) and the mandible's apart
   (mandible vertices: those of the complete skull more than 2 mm from the mandible-less one);
@@ -35,9 +41,15 @@ a disk of radius 20 mm, so orbits and the nasal aperture are the connected regio
   point (more than 3 mm above menton) farthest in front of the chord infradentale-menton (this
   chin recedes, so "most anterior" alone would give infradentale); ``gnathion``: the profile
   point midway (in profile steps) between pogonion and menton;
-- ``gonion``: among the mandible vertices of that side in the posterior 35 % of the mandible's
-  depth, those within 3 mm of the largest ``-y - z`` (the posterior-inferior corner), the most
-  lateral one (the outer surface of the angle);
+- ``gonion`` (Martin's construction): in the side view (y, z) of one side's mandible vertices,
+  the ramus tangent is the support line of the convex hull along the length-weighted mean
+  outward normal of the hull edges facing back (normal within 26 degrees of -z), the base
+  tangent the longest hull edge facing down and back (outside those); the angle's point is the
+  first vertex (within 1.5 mm) along the bisector of the two tangents from their intersection
+  into the bone; gonion the most lateral vertex within 3 mm (y, z) of it (the outer surface of
+  the angle). Before, "the largest -y - z in the posterior 35 %" fell on the body's lower
+  border (go-go 67.4 mm): in this CT's frame the head is bent forward and the lower border
+  runs 40 degrees from the horizontal;
 - ``zygion``: the cranium vertex of largest |x| at most 20 mm below and 5 mm above
   ``orbitale``, 5-50 mm behind ``ectoconchion``.
 
@@ -52,10 +64,12 @@ for rays from inside the face, which cross airway surfaces first:
   along the bisector of its bone normal and the lateral direction (the normal alone points
   down and back into the neck, where the skin is more than 35 mm away);
 - ``alare``: outermost over the cranial one along +z (the ala in front of the aperture
-  margin);
-- ``exocanthion``: outermost along +z from 5 mm medial of and 15 mm behind ``ectoconchion``;
-  ``endocanthion``: the same from 3 mm lateral of and 15 mm behind ``dacryon`` (the eyes are
-  closed in this CT: these are the lid line's ends, about);
+  margin; ``cranium_landmarks``' outline rule finds no ala on this 3.2 mm skin: its largest
+  step across a row is 3 mm, as large as the noise);
+- ``exocanthion``: outermost along +z (up to 60 mm) from 5 mm medial of and 15 mm behind
+  ``ectoconchion``; ``endocanthion``: the same from 3 mm lateral of and 15 mm behind
+  ``dacryon`` (as ``cranium_landmarks``; the eyes are closed in this CT: these are the lid
+  line's ends, about);
 - skin profile: skin vertices within 2 mm of the midline, the front-most per 1.5 mm of height;
   ``subnasale``: its most posterior point from 5 mm above ``subspinale`` down to 5 mm above
   ``prosthion`` (the columella-lip junction; the nose of this head is short and flat);
@@ -65,6 +79,16 @@ for rays from inside the face, which cross airway surfaces first:
   (|x| of exocanthion + |x| of endocanthion), about the pupils' columns (an estimate: the mouth
   corners do not show on a 3.2 mm skin; used only to cut the chin-jaw region). On the
   pictures they fall on the mouth corners.
+
+Sanity figures (``cranium_landmarks.sanity_figures``; distances in 3D, mm; before these rules
+in brackets): ec-ec 90.5 (84.8; norm 93-100: the lateral rim's crest is a 6 mm plateau here,
+its most medial point is taken), d-d 34.9 (37.5; 20-25: the CT's, see ``dacryon``), al-al 26.8
+(23.0; 23-26), zy-zy 129.6 (128.7; 120-135), go-go 95.2 (67.4; 90-100), n-pr 70.2 (65-72),
+n-ss 49.2 (52-58). Soft tissue ``|F - C|`` against ``lilium.softtissue.depths`` (mean +- SD):
+ectoconchion 17.2 / 16.6 (20.2 / 19.4; 10.5 +- 2.0: the closed lids lie 15 mm in front of the
+rim), dacryon 14.3 / 12.9 (13.2 / 6.0; 9.0 +- 2.0), alare 15.5 / 18.0 (20.5 / 20.5; 12.0 +-
+2.5), gonion 17.5 / 13.5 (15.4 / 15.0; 13.5 +- 4.0), zygion 6.7 / 6.0 (7.0 +- 2.0); the
+midline ones are unchanged.
 """
 
 import numpy as np
@@ -72,6 +96,16 @@ import numpy as np
 HEIGHT_MAP_PX_MM = 1.0
 CLOSING_RADIUS_MM = 20.0
 DEEP_MM = 8.0
+#: Orbit candidates: deep regions whose centroid lies this far off the bounding box's centre.
+ORBIT_OFF_MIDLINE_MM = 12.0
+#: Gonion: the hull edges of the ramus' posterior border have an outward normal within
+#: acos(this) of -z; the bisector ray's half-width; the vertices within this distance (y, z)
+#: of the angle's outline point.
+GONION_RAMUS_COS = 0.9
+GONION_RAY_MM = 1.5
+GONION_NEAR_MM = 3.0
+#: Exo- and endocanthion rays (as ``cranium_landmarks``).
+CANTHUS_RAY_MM = 60.0
 
 
 def _height_map(vertices, faces):
@@ -152,72 +186,89 @@ def _over(skin, point, direction, radius_mm=2.0, max_t_mm=35.0, outermost=True):
     raise ValueError(f"no skin over {point} along {d}")
 
 
-def place_landmarks(skull, skull_faces, skin, mandible_mask):
+def _orbit_regions(m):
+    """The two orbits' regions (u, v) on the map ``m`` of the complete skull and the midline x
+    (see the module notes)."""
+    rows_in = np.flatnonzero(np.isfinite(m.height).any(axis=1))
+    top_row, mid_row = rows_in[0], 0.5 * (rows_in[0] + rows_in[-1])
+    regions = []
+    for lab in range(1, m.n + 1):
+        u, v = m.region(lab)
+        if v.min() > top_row + 2:  # not the open bowl of the cut vault
+            regions.append((u, v))
+    centre_x = 0.5 * (m.skull[:, 0].min() + m.skull[:, 0].max())
+    orbits = {}
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        cands = [
+            (u, v)
+            for u, v in regions
+            if sign * (m.xy(u.mean(), 0)[0] - centre_x) > ORBIT_OFF_MIDLINE_MM
+            and v.mean() < mid_row
+        ]
+        orbits[side] = max(cands, key=lambda r: len(r[0]))
+    x_mid = float(np.mean([m.xy(u.mean(), 0)[0] for u, _ in orbits.values()]))
+    return orbits, x_mid
+
+
+def _gonion(mandible, x_mid, sign):
+    """The gonion of one side (see the module notes)."""
+    from scipy.spatial import ConvexHull
+
+    side = mandible[sign * (mandible[:, 0] - x_mid) > 0]
+    yz = side[:, 1:]
+    hull = ConvexHull(yz)
+    inside = yz[hull.vertices].mean(axis=0)
+    edges = []
+    for a, b in hull.simplices:
+        d = yz[b] - yz[a]
+        n = np.array([d[1], -d[0]]) / np.linalg.norm(d)  # (y, z) normal
+        n = n if n @ (yz[a] - inside) > 0 else -n  # outward
+        edges.append((np.linalg.norm(d), n, yz[a]))
+    posterior = [e for e in edges if e[1][1] < -GONION_RAMUS_COS]
+    ramus = sum(e[0] * e[1] for e in posterior)
+    ramus /= np.linalg.norm(ramus)
+    ramus_c = max(yz[hull.vertices] @ ramus)  # the support line n . p = c
+    lower = [e for e in edges if e[1][0] < 0 and e[1][1] < 0 and e[1][1] >= -GONION_RAMUS_COS]
+    _, base, on_base = max(lower, key=lambda e: e[0])
+    apex = np.linalg.solve(np.array([ramus, base]), [ramus_c, base @ on_base])
+    inward = -(ramus + base) / np.linalg.norm(ramus + base)
+    rel = yz - apex
+    t = rel @ inward
+    perp = np.abs(rel @ np.array([inward[1], -inward[0]]))
+    on_ray = (t > 0) & (perp < GONION_RAY_MM)
+    corner = yz[on_ray][np.argmin(t[on_ray])]
+    near = side[np.linalg.norm(yz - corner, axis=1) < GONION_NEAR_MM]
+    return near[np.argmax(sign * (near[:, 0] - x_mid))].copy()
+
+
+def place_landmarks(skull, skull_faces, skin, skin_faces, mandible_mask):
     """Cranial and facial landmarks by the rules of the module notes (skull frame, mm).
 
     Parameters
     ----------
-    skull : ndarray (V, 3), skull_faces : ndarray (F, 3)
+    skull : ndarray of shape (V, 3)
         The complete skull.
-    skin : ndarray (V', 3)
-    mandible_mask : ndarray (V,), bool
+    skull_faces : ndarray of shape (F, 3)
+    skin : ndarray of shape (V', 3)
+    skin_faces : ndarray of shape (F', 3)
+    mandible_mask : ndarray of shape (V,), bool
         Which skull vertices are the mandible's.
 
     Returns
     -------
-    cranial, facial : dict of str -> ndarray (3,)
+    cranial, facial : dict of str -> ndarray of shape (3,)
+    x_mid : float
+        The midline's x (between the orbits).
     """
+    from cranium_landmarks import _alare, _aperture, _Map, _orbit_landmarks
     from lilium.softtissue.normals import landmark_normals
 
-    height, index, xy = _height_map(skull, skull_faces)
-    labels, n = _deep_regions(height)
-    H, W = height.shape
-    centre_u = int(np.argmin([abs(xy(u, 0)[0]) for u in range(W)]))
-    rows_in = np.flatnonzero(np.isfinite(height).any(axis=1))
-    top_row, mid_row = rows_in[0], 0.5 * (rows_in[0] + rows_in[-1])
-    regions = []
-    for lab in range(1, n + 1):
-        v, u = np.nonzero(labels == lab)
-        if v.min() > top_row + 2:  # not the open bowl of the cut vault
-            regions.append((lab, u, v))
-    orbits = {}
-    for side, sign in (("l", 1.0), ("r", -1.0)):
-        cands = [
-            r for r in regions if sign * xy(r[1].mean(), 0)[0] > 12.0 and r[2].mean() < mid_row
-        ]
-        orbits[side] = max(cands, key=lambda r: len(r[1]))
-    orbit_v = max(o[2].mean() for o in orbits.values())
-    x_mid = float(np.mean([xy(o[1].mean(), 0)[0] for o in orbits.values()]))
-    centre_u = int(np.argmin([abs(xy(u, 0)[0] - x_mid) for u in range(W)]))
-    crossing = [r for r in regions if (r[1] == centre_u).any() and r[2].mean() > orbit_v]
-    aperture = min(crossing, key=lambda r: r[2].mean())
-    cranial = {}
-
-    def vertex(u, v):
-        return _pixel_vertex(skull, skull_faces, index, xy, int(u), int(v))
-
-    for side, sign in (("l", 1.0), ("r", -1.0)):
-        lab, u, v = orbits[side]
-        row = int(round(v.mean()))
-        on_row = u[v == row]
-        outer = on_row.max() if sign * (xy(1, 0)[0] - xy(0, 0)[0]) > 0 else on_row.min()
-        inner = on_row.min() if outer == on_row.max() else on_row.max()
-        step = 1 if outer == on_row.max() else -1
-        cranial[f"ectoconchion_{side}"] = vertex(outer + step, row)
-        cranial[f"dacryon_{side}"] = vertex(inner - step, row)
-        col = int(round(u.mean()))
-        bottom = v[u == col].max()
-        cranial[f"orbitale_{side}"] = vertex(col, bottom + 1)
-        # aperture margin on its widest row
-        au, av = aperture[1], aperture[2]
-        rows = np.unique(av)
-        widths = [np.ptp(au[av == r]) for r in rows]
-        wrow = int(rows[int(np.argmax(widths))])
-        line = au[av == wrow]
-        edge = line.max() if step == 1 else line.min()
-        cranial[f"alare_{side}"] = vertex(edge + step, wrow)
-    ap_bottom_y = xy(0, aperture[2].max())[1]
-    orbit_axis_y = 0.5 * (cranial["ectoconchion_l"][1] + cranial["ectoconchion_r"][1])
+    m = _Map(skull, skull_faces)
+    orbits, x_mid = _orbit_regions(m)
+    cranial, _, orbit_axis_y = _orbit_landmarks(m, orbits, x_mid)
+    aperture = _aperture(m, x_mid, orbit_axis_y)
+    cranial.update(_alare(m, aperture, x_mid))
+    ap_bottom_y = m.xy(0, aperture[1].max())[1]
 
     cranium = skull[~mandible_mask]
     mandible = skull[mandible_mask]
@@ -239,14 +290,8 @@ def place_landmarks(skull, skull_faces, skin, mandible_mask):
     cranial["pogonion"] = chin[np.argmax((chin[:, 1:] - menton[1:]) @ normal)]
     arc = mprof[(mprof[:, 1] < cranial["pogonion"][1]) & (mprof[:, 1] >= menton[1])]
     cranial["gnathion"] = arc[len(arc) // 2]  # midway (in profile steps) to menton
-    z_lo, z_hi = mandible[:, 2].min(), mandible[:, 2].max()
     for side, sign in (("l", 1.0), ("r", -1.0)):
-        m = mandible[
-            (sign * (mandible[:, 0] - x_mid) > 0) & (mandible[:, 2] < z_lo + 0.35 * (z_hi - z_lo))
-        ]
-        corner = -m[:, 2] - m[:, 1]
-        m = m[corner > corner.max() - 3.0]  # the angle; its outer (lateral) surface
-        cranial[f"gonion_{side}"] = m[np.argmax(sign * (m[:, 0] - x_mid))]
+        cranial[f"gonion_{side}"] = _gonion(mandible, x_mid, sign)
         o, e = cranial[f"orbitale_{side}"], cranial[f"ectoconchion_{side}"]
         c = cranium[
             (cranium[:, 1] > o[1] - 20.0)
@@ -271,9 +316,9 @@ def place_landmarks(skull, skull_faces, skin, mandible_mask):
         facial[key] = _over(skin, cranial[key], d, outermost=False)
         facial[f"alare_{side}"] = _over(skin, cranial[f"alare_{side}"], z_axis)
         e = cranial[f"ectoconchion_{side}"] - np.array([sign * 5.0, 0.0, -15.0])
-        facial[f"exocanthion_{side}"] = _over(skin, e, z_axis)
+        facial[f"exocanthion_{side}"] = _over(skin, e, z_axis, max_t_mm=CANTHUS_RAY_MM)
         d = cranial[f"dacryon_{side}"] + np.array([sign * 3.0, 0.0, -15.0])
-        facial[f"endocanthion_{side}"] = _over(skin, d, z_axis)
+        facial[f"endocanthion_{side}"] = _over(skin, d, z_axis, max_t_mm=CANTHUS_RAY_MM)
     sprof = _profile(skin, 2.0, 1.5, x_mid)
     window = (sprof[:, 1] < cranial["subspinale"][1] + 5.0) & (
         sprof[:, 1] > cranial["prosthion"][1] + 5.0
