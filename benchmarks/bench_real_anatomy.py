@@ -195,7 +195,7 @@ def print_outside(rows, file=sys.stdout):
     for r in rows:
         if "outside" not in r:
             continue
-        skull_px, depth, eye_px = r["outside"]
+        depth, skull_px, eye_px = r["outside"]
         deepest = float(depth.max()) if len(depth) else 0.0
         print(f"| {r['photo']} | {r['skull']} | {r['method']} | {skull_px} | {len(depth)} | "
               f"{deepest:.1f} | {deepest / eye_px:.4f} | {int((depth > 2).sum())} | "
