@@ -193,3 +193,55 @@ def review_page(image, landmarks, sources, outline_uv, priors, title, message=""
         "__DATA__": script_json(data),
     }
     return fill_template(_PAGE, values)
+
+
+def read_head_outline(landmarks_path, size_wh):
+    """The head outline the review page saved (``head_outline_px`` of its ``landmarks.json``).
+
+    Parameters
+    ----------
+    landmarks_path : str or Path
+        A landmark file; only a JSON file can hold an outline.
+    size_wh : (int, int)
+        The photo's width and height, pixels.
+
+    Returns
+    -------
+    ndarray of shape (N, 2) or None
+        uv pixels (u = column, v = row); None when the file has no outline.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 3 points, not ``[u, v]`` pairs, or a point outside the photo.
+    """
+    from pathlib import Path
+
+    from ..io.jsonio import read_json
+
+    path = Path(landmarks_path)
+    if path.suffix.lower() != ".json":
+        return None
+    meta = read_json(path)
+    if not isinstance(meta, dict) or "head_outline_px" not in meta:
+        return None
+    w, h = size_wh
+    try:
+        outline = np.asarray(meta["head_outline_px"], dtype=float)
+    except (TypeError, ValueError):
+        outline = np.empty((0,))
+    if outline.ndim != 2 or outline.shape[1] != 2 or len(outline) < 3:
+        raise ValueError(
+            f"{path}: head_outline_px must be a list of at least 3 [u, v] points (pixels), as "
+            "the review page saves it"
+        )
+    inside = np.isfinite(outline).all(axis=1)
+    inside &= (outline >= -0.5).all(axis=1)
+    inside &= (outline[:, 0] <= w - 0.5) & (outline[:, 1] <= h - 0.5)
+    if not inside.all():
+        u, v = outline[np.argmin(inside)]
+        raise ValueError(
+            f"{path}: head_outline_px point ({u:g}, {v:g}) lies outside the {w}x{h} image; u is "
+            "the column and v the row, in pixels"
+        )
+    return outline
