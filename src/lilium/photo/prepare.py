@@ -273,6 +273,15 @@ def prepare_photo(
         )
     else:
         message = f"{image_path}: {analysis.message}"
-    page = review_page(image, meta["landmarks"], sources, outline, priors, image_path.name, message)
+    page = review_page(
+        image,
+        meta["landmarks"],
+        sources,
+        outline,
+        priors,
+        image_path.name,
+        message,
+        faces=meta.get("faces", ()),
+    )
     (out / "review.html").write_text(page, encoding="utf-8")
     return PreparedPhoto(out, bool(analysis), message, view, n_tracked, n_template, tuple(warnings))
