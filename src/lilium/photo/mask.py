@@ -40,7 +40,7 @@ CLAHE_CLIP = 8.0
 CLAHE_TILES = 8
 #: A mask is a head mask (:func:`is_head_mask`) when its part beyond the face outline (mesh
 #: outline plus margin) and above the jaw angles is at least this share of the face outline's
-#: area; the face outline alone gives 0, a head with hair 0.3-1.1 on the measured prints.
+#: area; the face outline alone gives 0, a head with hair 0.26-0.95 on the measured prints.
 HEAD_BEYOND_FACE = 0.2
 
 
