@@ -131,7 +131,12 @@ def head_mask(
     return mask
 
 
-def mask_outline(mask, max_points=200):
+#: Points of the outline the review page draws (each one a handle to drag; about 2x this at
+#: most): enough for hair and ears, few enough to move one by hand.
+OUTLINE_POINTS = 80
+
+
+def mask_outline(mask, max_points=OUTLINE_POINTS):
     """The outer outline of the mask's largest part, ``(N, 2)`` uv pixels (for the review)."""
     contours, _ = cv2.findContours(mask.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     if not contours:
