@@ -20,6 +20,8 @@ pytest.importorskip("ai_edge_litert")
 
 from lilium.cli.main import main  # noqa: E402
 from lilium.io.case import read_photo  # noqa: E402
+from lilium.photo.mask import mask_outline, polygon_mask  # noqa: E402
+from lilium.photo.review import review_page  # noqa: E402
 
 
 @needs_chromium
@@ -50,3 +52,29 @@ def test_drag_save_and_read_back(tmp_path):
     )
     photo = read_photo(again)
     assert photo.landmarks_uv[first] == pytest.approx(saved["landmarks"][first])
+    # The first outline point was dragged too: the saved outline becomes the mask.
+    outline = mask_outline(np.asarray(Image.open(out / "face_mask.png")) > 0)
+    assert np.subtract(saved["head_outline_px"][0], outline[0]) == pytest.approx([10, 5], abs=0.15)
+    assert np.subtract(saved["head_outline_px"][1:], outline[1:]) == pytest.approx(0, abs=0.15)
+    assert json.loads((again / "photo.json").read_text())["face_mask_is_head"] is True
+    rebuilt = np.asarray(Image.open(again / "face_mask.png")) > 0
+    assert (rebuilt == polygon_mask(saved["head_outline_px"], rebuilt.shape[::-1])).all()
+    assert (rebuilt == photo.face_mask).all()
+
+
+@needs_chromium
+def test_every_face_is_drawn_with_its_box_and_number(tmp_path):
+    faces = [
+        {"number": 1, "box_px": [10, 12, 40, 44], "width_px": 30, "score": 0.9},
+        {"number": 2, "box_px": [60, 10, 90, 42], "width_px": 30, "score": 0.8},
+    ]
+    page = review_page(
+        np.zeros((64, 100, 3), np.uint8), {}, {}, np.zeros((0, 2)), {}, "t", faces=faces
+    )
+    (tmp_path / "review.html").write_text(page, encoding="utf-8")
+    dom = run_chromium("--dump-dom", (tmp_path / "review.html").as_uri(), tmp_path=tmp_path).stdout
+    for face in faces:
+        u0, v0, u1, v1 = face["box_px"]
+        box = re.search(rf'<rect[^>]*id="face-{face["number"]}"[^>]*>', dom)[0]
+        assert f'x="{u0}"' in box and f'width="{u1 - u0}"' in box and f'height="{v1 - v0}"' in box
+        assert f"face {face['number']}</text>" in dom

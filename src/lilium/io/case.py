@@ -30,7 +30,12 @@ from .jsonio import read_json
 from .keys import json_type, unknown_key_warnings
 from .mesh import MESH_SUFFIXES, read_mesh
 from .paths import path_id, safe_id
-from .prepared import _without_unconfirmed_templates, landmark_qualities, written_by_lilium_photo
+from .prepared import (
+    _without_unconfirmed_templates,
+    face_only_mask,
+    landmark_qualities,
+    written_by_lilium_photo,
+)
 
 __all__ = [
     "IMAGE_NAMES",
@@ -331,6 +336,10 @@ def read_photo(folder, load_image=True):
     priors = parse_priors(meta_path, meta.get("priors"))
     mask_path = folder / "face_mask.png"
     mask = read_mask(mask_path, size_wh) if mask_path.is_file() else None
+    warnings = unknown_key_warnings(meta_path, meta)
+    if mask is not None and meta.get("face_mask_is_head") is False:  # docs/method/photo.md
+        mask, warning = face_only_mask(mask, landmarks, folder)
+        warnings = (*warnings, warning)
     curve_path = folder / "face_curve.json"
     curve = read_face_curve(curve_path, view, size_wh) if curve_path.is_file() else None
     if curve is None and mask is not None and written_by_lilium_photo(meta):
@@ -347,7 +356,7 @@ def read_photo(folder, load_image=True):
         priors,
         image,
         landmark_sources=sources,
-        warnings=unknown_key_warnings(meta_path, meta),
+        warnings=tuple(warnings),
         mask_file=str(mask_path) if mask is not None else None,
     )
 

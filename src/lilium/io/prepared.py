@@ -14,8 +14,10 @@ from ..validation import is_real
 from .jsonio import read_json
 
 __all__ = [
+    "EYE_LINE_PAIRS",
     "PREPARED_BY",
     "PreparedFacts",
+    "face_only_mask",
     "landmark_qualities",
     "read_prepared",
     "written_by_lilium_photo",
@@ -40,6 +42,66 @@ def written_by_lilium_photo(meta):
         and priors.get("source") == "automatic"
         and isinstance(sources, dict)
         and isinstance(priors.get("sources"), dict)
+    )
+
+
+#: The landmark pairs whose line is the eye-corner line of :func:`face_only_mask`, first found.
+EYE_LINE_PAIRS = (("exocanthion_r", "exocanthion_l"), ("endocanthion_r", "endocanthion_l"))
+
+
+def face_only_mask(mask, landmarks, where):
+    """The mask a case uses when ``lilium photo`` could find only the face
+    (``"face_mask_is_head": false``, warning ``head_mask_face_only``; docs/method/photo.md).
+
+    Such a mask is the face outline without hair, ears or the vault, so the skull above the
+    brows would read as outside the head. The rule: every pixel on the vault's side of the
+    eye-corner line (through exocanthion_r and exocanthion_l, else the endocanthia) counts as
+    inside, so P_skof, the outside fraction, ``skull_outside_head`` and the report's outside
+    figure measure only the face below the eyes. The vault's side is the one away from the
+    mask's centroid (the face outline runs from the upper forehead to the chin, so its centroid
+    lies below the eyes). Without an eye-corner pair there is no line, and the mask is not used
+    (those measures are switched off).
+
+    Parameters
+    ----------
+    mask : ndarray of shape (H, W), bool
+        ``face_mask.png``.
+    landmarks : dict of str -> ndarray of shape (2,)
+        The photo's facial landmarks, uv pixels.
+    where : str
+        The folder, for the sentence.
+
+    Returns
+    -------
+    mask : ndarray of shape (H, W), bool, or None
+    warning : CaseWarning
+        ``head_mask_face_only``, saying what was done.
+    """
+    from ..inputs import CaseWarning
+
+    pair = next((p for p in EYE_LINE_PAIRS if p[0] in landmarks and p[1] in landmarks), None)
+    rows, cols = np.nonzero(mask)
+    if pair is None or len(rows) == 0:
+        return None, CaseWarning(
+            "head_mask_face_only",
+            f"{where}: face_mask.png is the face outline alone (photo.json face_mask_is_head "
+            "false) and no eye corners mark where the vault starts: the mask is not used (no "
+            "P_skof, no skull-outside-the-head measures); draw the head's outline in review.html",
+        )
+    right, left = (np.asarray(landmarks[name], float) for name in pair)
+    across = left - right
+    normal = np.array([-across[1], across[0]]) / max(float(np.linalg.norm(across)), 1e-9)
+    centre = (right + left) / 2
+    if (np.array([cols.mean(), rows.mean()]) - centre) @ normal < 0:
+        normal = -normal  # points down the face
+    h, w = mask.shape
+    vv, uu = np.mgrid[0:h, 0:w]
+    vault = (uu - centre[0]) * normal[0] + (vv - centre[1]) * normal[1] < 0
+    return np.asarray(mask, bool) | vault, CaseWarning(
+        "head_mask_face_only",
+        f"{where}: face_mask.png is the face outline alone (photo.json face_mask_is_head false): "
+        f"the skull above the eye-corner line ({pair[0]}-{pair[1]}) is not counted as outside "
+        "the head; draw the head's outline in review.html for the full check",
     )
 
 

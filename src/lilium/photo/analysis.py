@@ -7,7 +7,7 @@ import numpy as np
 from . import runtime
 from .headpose import euler_deg, face_rotation_face2cam
 from .landmarks import mesh_to_landmarks
-from .mask import head_mask
+from .mask import head_mask, segmentation_input
 
 #: Smallest face (detection box side, pixels) the mesh model is trusted on.
 MIN_FACE_PX = 40
@@ -156,7 +156,7 @@ def analyse_face(image, face=None):
     yaw, pitch, roll = euler_deg(face2cam)
     irises = runtime.iris(image, mesh)
     iris_px = float(np.mean([2 * r for _, r in irises.values()]))
-    mask = head_mask(runtime.person_mask(image), mesh)
+    mask = head_mask(runtime.person_mask(segmentation_input(image)), mesh)
     return FaceAnalysis(
         mesh_xyz=mesh,
         landmarks=landmarks,

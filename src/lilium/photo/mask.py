@@ -3,7 +3,10 @@ upper neck; not shoulders or background.
 
 No open model parses skin and hair, so the mask is built from two models' outputs:
 
-1. the selfie-segmentation *person* probability (head, hair, ears, neck, shoulders, body);
+1. the selfie-segmentation *person* probability (head, hair, ears, neck, shoulders, body), run
+   on :func:`segmentation_input`: the photo with its lightness equalised locally (CLAHE), so a
+   grayscale, sepia or faded print gets the head as a colour portrait does (on a washed-out
+   grayscale print the model otherwise finds no person at all, docs/method/photo.md);
 2. a cut below the chin, perpendicular to the face's vertical axis in the image (nasion ->
    gnathion), :data:`NECK_BELOW_CHIN` face heights below the gnathion: what lies below is
    shoulders and body; below the jaw angles (gonion level) only a band as wide as
@@ -11,7 +14,9 @@ No open model parses skin and hair, so the mask is built from two models' output
 3. the union with the face mesh's outline (dilated by :data:`MESH_MARGIN` face heights), so
    every landmark the mesh gives lies inside even where the person mask misses skin.
 
-Hair makes the mask larger than the skull, as docs/method/photo.md intends.
+Hair makes the mask larger than the skull, as docs/method/photo.md intends. Where the
+segmentation still finds no head the mask is the face outline alone: :func:`is_head_mask` tells
+the two apart, and ``lilium photo`` marks such a folder (``head_mask_face_only``).
 """
 
 import cv2
@@ -27,6 +32,59 @@ NECK_WIDTH = 0.8
 WORK_SIDE_PX = 1024
 #: Margin added around the mesh outline, in face heights.
 MESH_MARGIN = 0.05
+#: CLAHE on the lightness before the segmentation: clip limit and tiles per side (OpenCV's
+#: ``createCLAHE``). Chosen on washed-out grayscale and sepia prints (docs/method/photo.md,
+#: "Head mask"): a plain 1-99 % stretch fails on a print scanned with its white margin, clip 2
+#: on the faintest prints, clip 16 swells the mask into the background.
+CLAHE_CLIP = 8.0
+CLAHE_TILES = 8
+#: A mask is a head mask (:func:`is_head_mask`) when its part beyond the face outline (mesh
+#: outline plus margin) and above the jaw angles is at least this share of the face outline's
+#: area; the face outline alone gives 0, a head with hair 0.26-0.95 on the measured prints.
+HEAD_BEYOND_FACE = 0.2
+
+
+def segmentation_input(image):
+    """The photo as the person segmentation gets it: the lightness (CIE L*) equalised by CLAHE
+    (:data:`CLAHE_CLIP`, :data:`CLAHE_TILES`), hue and chroma kept.
+
+    Parameters
+    ----------
+    image : ndarray of shape (H, W, 3), uint8 RGB
+
+    Returns
+    -------
+    ndarray of shape (H, W, 3), uint8 RGB
+    """
+    lab = cv2.cvtColor(np.ascontiguousarray(image, dtype=np.uint8), cv2.COLOR_RGB2LAB)
+    clahe = cv2.createCLAHE(clipLimit=CLAHE_CLIP, tileGridSize=(CLAHE_TILES, CLAHE_TILES))
+    lab[..., 0] = clahe.apply(lab[..., 0])
+    return cv2.cvtColor(lab, cv2.COLOR_LAB2RGB)
+
+
+def _face_geometry(mesh, nasion_index, gnathion_index):
+    """Face height (nasion to gnathion, pixels) and the unit vector down the face."""
+    top, chin = mesh[nasion_index], mesh[gnathion_index]
+    face_height = float(np.linalg.norm(chin - top))
+    return face_height, (chin - top) / face_height
+
+
+def _face_outline(mesh, face_height, shape_hw):
+    """The mesh outline grown by :data:`MESH_MARGIN` (the hull of the mesh points shifted round a
+    disc), as a bool image."""
+    r = MESH_MARGIN * face_height
+    angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    disc = r * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    grown = (mesh[:, None, :] + disc[None]).reshape(-1, 2)
+    face = np.zeros(shape_hw, np.uint8)
+    cv2.fillConvexPoly(face, cv2.convexHull(np.round(grown).astype(np.int32)), 1)
+    return face.astype(bool)
+
+
+def _working_scale(shape_hw):
+    h, w = shape_hw
+    scale = min(1.0, WORK_SIDE_PX / max(h, w))
+    return scale, (max(1, round(h * scale)), max(1, round(w * scale)))
 
 
 def head_mask(
@@ -47,13 +105,11 @@ def head_mask(
     """
     h, w = person_prob.shape
     # Work at most WORK_SIDE_PX on the long side: the person mask comes from 256 x 256 anyway.
-    scale = min(1.0, WORK_SIDE_PX / max(h, w))
-    hs, ws = max(1, round(h * scale)), max(1, round(w * scale))
+    scale, (hs, ws) = _working_scale((h, w))
     prob = cv2.resize(person_prob.astype(np.float32), (ws, hs), interpolation=cv2.INTER_AREA)
     mesh = np.asarray(mesh_uv, dtype=float)[:, :2] * scale
-    top, chin = mesh[nasion_index], mesh[gnathion_index]
-    face_height = float(np.linalg.norm(chin - top))
-    down = (chin - top) / face_height
+    chin = mesh[gnathion_index]
+    face_height, down = _face_geometry(mesh, nasion_index, gnathion_index)
     cut = chin + NECK_BELOW_CHIN * face_height * down
     vv = np.arange(hs, dtype=np.float32)[:, None]
     uu = np.arange(ws, dtype=np.float32)[None, :]
@@ -63,19 +119,7 @@ def head_mask(
     across = np.abs((uu - chin[0]) * down[1] - (vv - chin[1]) * down[0])
     neck = (along <= jaw_level) | (across <= NECK_WIDTH * np.linalg.norm(gonion_l - gonion_r) / 2)
     mask = (prob > PERSON_THRESHOLD) & (along <= 0) & neck
-    # The mesh outline grown by the margin: the hull of the mesh points shifted round a disc.
-    r = MESH_MARGIN * face_height
-    disc = r * np.stack(
-        [
-            np.cos(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
-            np.sin(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
-        ],
-        axis=1,
-    )
-    grown = (mesh[:, None, :] + disc[None]).reshape(-1, 2)
-    face = np.zeros((hs, ws), np.uint8)
-    cv2.fillConvexPoly(face, cv2.convexHull(np.round(grown).astype(np.int32)), 1)
-    mask |= face.astype(bool)
+    mask |= _face_outline(mesh, face_height, (hs, ws))
     # Keep the connected part holding the face (drops stray person blobs, e.g. a hand).
     n, labels = cv2.connectedComponents(mask.astype(np.uint8))
     if n > 2:
@@ -87,7 +131,12 @@ def head_mask(
     return mask
 
 
-def mask_outline(mask, max_points=200):
+#: Points of the outline the review page draws (each one a handle to drag; about 2x this at
+#: most): enough for hair and ears, few enough to move one by hand.
+OUTLINE_POINTS = 80
+
+
+def mask_outline(mask, max_points=OUTLINE_POINTS):
     """The outer outline of the mask's largest part, ``(N, 2)`` uv pixels (for the review)."""
     contours, _ = cv2.findContours(mask.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     if not contours:
@@ -95,3 +144,60 @@ def mask_outline(mask, max_points=200):
     contour = max(contours, key=cv2.contourArea)[:, 0, :].astype(float)
     step = max(1, len(contour) // max_points)
     return contour[::step]
+
+
+def head_share_beyond_face(
+    mask, mesh_uv, nasion_index=168, gnathion_index=152, gonion_indices=(172, 397)
+):
+    """The mask's part beyond the face outline and above the jaw angles, over the outline's
+    area: 0 for a mask that is the face outline alone (:func:`head_mask`'s fallback).
+
+    Parameters
+    ----------
+    mask : ndarray of shape (H, W), bool
+    mesh_uv : ndarray of shape (468, 2+)
+        Face mesh in image pixels.
+
+    Returns
+    -------
+    float
+    """
+    mask = np.asarray(mask, dtype=bool)
+    scale, (hs, ws) = _working_scale(mask.shape)
+    if scale < 1.0:
+        mask = cv2.resize(mask.astype(np.uint8), (ws, hs), interpolation=cv2.INTER_NEAREST) > 0
+    mesh = np.asarray(mesh_uv, dtype=float)[:, :2] * scale
+    face_height, down = _face_geometry(mesh, nasion_index, gnathion_index)
+    face = _face_outline(mesh, face_height, (hs, ws))
+    jaw = mesh[list(gonion_indices)].mean(axis=0)
+    vv = np.arange(hs, dtype=np.float32)[:, None]
+    uu = np.arange(ws, dtype=np.float32)[None, :]
+    above_jaw = (uu - jaw[0]) * down[0] + (vv - jaw[1]) * down[1] < 0
+    return float(np.count_nonzero(mask & ~face & above_jaw) / max(1, np.count_nonzero(face)))
+
+
+def is_head_mask(mask, mesh_uv):
+    """Whether the mask holds the head as seen (hair, ears) rather than the face outline alone:
+    :func:`head_share_beyond_face` at least :data:`HEAD_BEYOND_FACE`."""
+    return head_share_beyond_face(mask, mesh_uv) >= HEAD_BEYOND_FACE
+
+
+def polygon_mask(outline_uv, size_wh):
+    """The mask inside a closed outline (the review page's ``head_outline_px``).
+
+    Parameters
+    ----------
+    outline_uv : array_like of shape (N, 2)
+        Vertices in image pixels, u = column, v = row (pixel centres at integers).
+    size_wh : (int, int)
+        The photo's width and height.
+
+    Returns
+    -------
+    ndarray of shape (H, W), bool
+    """
+    w, h = size_wh
+    mask = np.zeros((h, w), np.uint8)
+    points = np.round(np.asarray(outline_uv, dtype=float) * 16).astype(np.int32)
+    cv2.fillPoly(mask, [points], 1, lineType=cv2.LINE_8, shift=4)
+    return mask.astype(bool)

@@ -28,8 +28,8 @@ from .analysis import analyse_face, upright_turns
 from .folder import PREPARED_BY, check_image_path, check_photo_not_output, claim_folder
 from .headpose import implausible_distance, iris_distance_mm
 from .landmarks import mesh_face_curves
-from .mask import mask_outline
-from .review import review_page
+from .mask import is_head_mask, mask_outline, polygon_mask
+from .review import read_head_outline, review_page
 
 #: Head-orientation tolerance (degrees) proposed with the automatic orientation.
 HEAD_TOLERANCE_DEG = 15.0
@@ -125,6 +125,16 @@ def _priors(image_path, analysis, sensor_width_mm):
     return priors, warnings
 
 
+def _face_only_warning(image_path):
+    return {
+        "code": "head_mask_face_only",
+        "message": f"{image_path}: no head was found around the face (a faded, tinted or "
+        "low-contrast print?): face_mask.png is the face outline alone, without hair and ears; "
+        "a case does not count the skull above the eye corners as outside it. Draw the head's "
+        "outline in review.html and pass the saved file with --landmarks",
+    }
+
+
 def prepare_photo(
     image_path, out_dir, view=None, landmarks_path=None, sensor_width_mm=None, face=None
 ):
@@ -141,7 +151,8 @@ def prepare_photo(
         Default: from the fitted yaw (frontal under 30 degrees).
     landmarks_path : str or Path, optional
         Reviewed landmarks (the review page's ``landmarks.json``, or any catalogue facial landmark
-        file): they replace the automatic ones and count as confirmed.
+        file): they replace the automatic ones and count as confirmed. Its ``head_outline_px``
+        (the review page's edited mask outline), when present, becomes the mask.
     sensor_width_mm : float, optional
         For the EXIF focal (see :mod:`lilium.io.exif`).
     face : int, optional
@@ -181,6 +192,7 @@ def prepare_photo(
         h, w = image.shape[:2]
         check_photo_not_output(out, image_path)  # a link to the folder's image: turned over it
     reviewed = read_landmarks(landmarks_path, "facial") if landmarks_path else None
+    outline_px = read_head_outline(landmarks_path, (w, h)) if landmarks_path else None
     analysis = analyse_face(image, face)
     view = view or (analysis.view if analysis else "frontal")
     landmarks, sources = dict(analysis.landmarks), dict(analysis.sources)
@@ -213,6 +225,14 @@ def prepare_photo(
                 "(image.png), and its landmarks, mask and curves are in its pixels",
             }
         )
+    head = analysis.mask if analysis else None
+    if outline_px is not None:  # the reviewed outline: the user's head
+        head = polygon_mask(outline_px, (w, h))
+    head_is_head = outline_px is not None or (
+        bool(analysis) and is_head_mask(head, analysis.mesh_xyz)
+    )
+    if head is not None and not head_is_head:
+        warnings.append(_face_only_warning(image_path))
     curves = mesh_face_curves(analysis.mesh_xyz, (w, h)) if analysis else {}
     meta = {
         "prepared_by": PREPARED_BY,
@@ -221,8 +241,9 @@ def prepare_photo(
         "landmark_sources": sources,
         "priors": priors,
     }
-    if analysis:
-        meta["face_mask_is_head"] = True  # never a source of facial curves (docs/method/photo.md)
+    if head is not None:
+        # Never a source of facial curves; False: the face outline alone (docs/method/photo.md).
+        meta["face_mask_is_head"] = head_is_head
     if warnings:
         meta["warnings"] = warnings
     out.mkdir(parents=True, exist_ok=True)
@@ -231,11 +252,11 @@ def prepare_photo(
     write_json(out / "photo.json", meta)
     _copy_image(image_path, image, out, turned=bool(turns))
     outline = np.zeros((0, 2))
-    if analysis:
+    if head is not None:
         from PIL import Image
 
-        Image.fromarray(analysis.mask.astype(np.uint8) * 255).save(out / "face_mask.png")
-        outline = mask_outline(analysis.mask)
+        Image.fromarray(head.astype(np.uint8) * 255).save(out / "face_mask.png")
+        outline = mask_outline(head)
     if curves:
         source = {"source": "automatic", "quality": "template", "from": "face mesh outline"}
         curve_file = {k: np.round(c, 2).tolist() for k, c in curves.items()}
@@ -252,6 +273,15 @@ def prepare_photo(
         )
     else:
         message = f"{image_path}: {analysis.message}"
-    page = review_page(image, meta["landmarks"], sources, outline, priors, image_path.name, message)
+    page = review_page(
+        image,
+        meta["landmarks"],
+        sources,
+        outline,
+        priors,
+        image_path.name,
+        message,
+        faces=meta.get("faces", ()),
+    )
     (out / "review.html").write_text(page, encoding="utf-8")
     return PreparedPhoto(out, bool(analysis), message, view, n_tracked, n_template, tuple(warnings))

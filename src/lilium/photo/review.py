@@ -6,9 +6,16 @@ as a download, ``landmarks.json`` (a ``data:`` link): ``{"landmarks": {name: [u,
 "landmark_sources": {name: {"source": "reviewed", "quality": ..., "confirmed": true}}}``,
 the contract's landmark file that ``lilium case --landmarks`` and ``lilium photo --landmarks``
 read. Only the points switched on are saved; template points start switched off, so saving
-without looking confirms none of them. Opened with ``?test``, the page drags the first
-landmark by (+10, +5) px with pointer events, presses Save and shows the file in
-``<pre id="saved">`` (for the headless-browser test).
+without looking confirms none of them.
+
+The mask's outline is drawn as draggable points too; once one is moved, Save adds the edited
+outline, ``"head_outline_px": [[u, v], ...]``, which ``lilium photo --landmarks`` turns into
+the mask (:func:`read_head_outline`). Every face the detector found (``photo.json``'s
+``"faces"``) is drawn with its box and number, the ``--face K`` to prepare another.
+
+Opened with ``?test``, the page drags the first landmark and the first outline point by
+(+10, +5) px with pointer events, presses Save and shows the file in ``<pre id="saved">``
+(for the headless-browser test).
 """
 
 import base64
@@ -25,17 +32,20 @@ _PAGE = """<!DOCTYPE html>
 body{font-family:sans-serif;margin:0;display:flex;gap:1em}
 #view{flex:1;min-width:0} svg{width:100%;height:auto;max-height:96vh;touch-action:none}
 #side{width:22em;padding:.5em;font-size:90%} .lm{cursor:move} .off{opacity:.25}
-.tracked{fill:#f33} .template{fill:#39f} text{font-size:__FONT__px;fill:#ff0;paint-order:stroke;
+.tracked{fill:#f33} .template{fill:#39f} .ol{fill:#0f0;cursor:move} .face{fill:none;
+stroke:#ff0} text{font-size:__FONT__px;fill:#ff0;paint-order:stroke;
 stroke:#000;stroke-width:2px;pointer-events:none} pre{white-space:pre-wrap;font-size:80%}
 </style></head><body>
 <div id="view"><svg id="svg" viewBox="-0.5 -0.5 __W__ __H__">
 <image href="__IMAGE__" x="-0.5" y="-0.5" width="__W__" height="__H__"
 preserveAspectRatio="none"/>
-<polygon id="outline" points="__OUTLINE__" fill="none" stroke="#0f0" stroke-width="__STROKE__"/>
-<g id="points"></g></svg></div>
+<g id="faces"></g>
+<polygon id="outline" points="" fill="none" stroke="#0f0" stroke-width="__STROKE__"/>
+<g id="handles"></g><g id="points"></g></svg></div>
 <div id="side"><h3>__TITLE__</h3><p>__MESSAGE__</p>
 <p>Drag a point to move it; untick it to leave it out. <b>Template</b> points (blue) are the
-face model's guess: tick them only once you have checked them.</p>
+face model's guess: tick them only once you have checked them. Drag the green points to
+correct the head's outline (face, hair, ears, down to the neck): Save then keeps it too.</p>
 <div id="list"></div><p><button id="save">Save landmarks.json</button>
 <a id="download" download="landmarks.json" href="#" hidden>landmarks.json</a></p>
 <h4>Priors</h4><pre id="priors"></pre><pre id="saved"></pre></div>
@@ -79,6 +89,41 @@ for (const [name, uv] of Object.entries(DATA.landmarks)) {
   dot.addEventListener("pointerup", () => { state[name].drag = false; });
   place(name);
 }
+const outline = DATA.outline.map((p) => p.slice()), poly = document.getElementById("outline");
+const handles = [];
+let outlineEdited = false;
+function drawOutline() {
+  poly.setAttribute("points", outline.map((p) => p[0] + "," + p[1]).join(" "));
+  outline.forEach((p, i) => {
+    handles[i].setAttribute("cx", p[0]); handles[i].setAttribute("cy", p[1]);
+  });
+}
+outline.forEach((p, i) => {
+  const dot = document.createElementNS("http://www.w3.org/2000/svg", "circle");
+  dot.setAttribute("r", DATA.r * 0.6); dot.setAttribute("class", "ol"); dot.id = "ol-" + i;
+  document.getElementById("handles").append(dot); handles.push(dot);
+  let drag = false;
+  dot.addEventListener("pointerdown", (e) => {
+    dot.setPointerCapture(e.pointerId); drag = true; e.preventDefault();
+  });
+  dot.addEventListener("pointermove", (e) => {
+    if (!drag) return;
+    const q = toSvg(e); outline[i] = [q.x, q.y]; outlineEdited = true; drawOutline();
+  });
+  dot.addEventListener("pointerup", () => { drag = false; });
+});
+if (outline.length) drawOutline();
+for (const face of DATA.faces) {
+  const [u0, v0, u1, v1] = face.box_px;
+  const box = document.createElementNS("http://www.w3.org/2000/svg", "rect");
+  box.setAttribute("x", u0); box.setAttribute("y", v0); box.setAttribute("width", u1 - u0);
+  box.setAttribute("height", v1 - v0); box.setAttribute("class", "face");
+  box.setAttribute("stroke-width", DATA.r / 2); box.id = "face-" + face.number;
+  const label = document.createElementNS("http://www.w3.org/2000/svg", "text");
+  label.setAttribute("x", u0); label.setAttribute("y", v0 - DATA.r);
+  label.textContent = "face " + face.number;
+  document.getElementById("faces").append(box, label);
+}
 document.getElementById("priors").textContent = JSON.stringify(DATA.priors, null, 1);
 function saved() {
   const out = {landmarks: {}, landmark_sources: {}};
@@ -86,6 +131,10 @@ function saved() {
     if (!s.on) continue;
     out.landmarks[name] = [Math.round(s.uv[0] * 100) / 100, Math.round(s.uv[1] * 100) / 100];
     out.landmark_sources[name] = {source: "reviewed", quality: s.quality, confirmed: true};
+  }
+  if (outlineEdited) {
+    const r2 = (x) => Math.round(x * 100) / 100;
+    out.head_outline_px = outline.map((p) => [r2(p[0]), r2(p[1])]);
   }
   return JSON.stringify(out, null, 1);
 }
@@ -104,6 +153,15 @@ if (new URLSearchParams(location.search).has("test")) {
   dot.dispatchEvent(new PointerEvent("pointerdown", start));
   dot.dispatchEvent(new PointerEvent("pointermove", end));
   dot.dispatchEvent(new PointerEvent("pointerup", end));
+  if (handles.length) {
+    const p0 = outline[0];
+    const near = (du, dv) => ({clientX: m.a * (p0[0] + du) + m.e, clientY: m.d * (p0[1] + dv) + m.f,
+                               pointerId: 1, bubbles: true});
+    const from = near(0, 0), to = near(10, 5);
+    handles[0].dispatchEvent(new PointerEvent("pointerdown", from));
+    handles[0].dispatchEvent(new PointerEvent("pointermove", to));
+    handles[0].dispatchEvent(new PointerEvent("pointerup", to));
+  }
   document.getElementById("save").onclick();
 }
 </script></body></html>
@@ -158,7 +216,7 @@ def fill_template(template, values):
     return pattern.sub(lambda match: values[match.group(0)], template)
 
 
-def review_page(image, landmarks, sources, outline_uv, priors, title, message=""):
+def review_page(image, landmarks, sources, outline_uv, priors, title, message="", faces=()):
     """The review page as a string.
 
     Parameters
@@ -172,6 +230,9 @@ def review_page(image, landmarks, sources, outline_uv, priors, title, message=""
     priors : dict
         Shown as written to ``photo.json``.
     title, message : str
+    faces : sequence of dict
+        ``photo.json``'s ``"faces"``: ``{"number", "box_px": [u0, v0, u1, v1], "width_px",
+        "score"}`` for every face found; each is drawn with its box and number.
     """
     h, w = image.shape[:2]
     data = {
@@ -179,8 +240,11 @@ def review_page(image, landmarks, sources, outline_uv, priors, title, message=""
         "sources": sources,
         "priors": priors,
         "r": max(1.5, max(h, w) / 250),
+        "outline": np.round(np.asarray(outline_uv, dtype=float).reshape(-1, 2), 1).tolist(),
+        "faces": [
+            {"number": int(f["number"]), "box_px": [float(x) for x in f["box_px"]]} for f in faces
+        ],
     }
-    outline = " ".join(f"{u:.1f},{v:.1f}" for u, v in np.asarray(outline_uv).reshape(-1, 2))
     values = {
         "__TITLE__": html.escape(title),
         "__MESSAGE__": html.escape(message),
@@ -188,8 +252,59 @@ def review_page(image, landmarks, sources, outline_uv, priors, title, message=""
         "__H__": str(h),
         "__FONT__": f"{max(8, max(h, w) / 60):.0f}",
         "__STROKE__": f"{max(1, max(h, w) / 400):.1f}",
-        "__OUTLINE__": outline,
         "__IMAGE__": _data_url(image),
         "__DATA__": script_json(data),
     }
     return fill_template(_PAGE, values)
+
+
+def read_head_outline(landmarks_path, size_wh):
+    """The head outline the review page saved (``head_outline_px`` of its ``landmarks.json``).
+
+    Parameters
+    ----------
+    landmarks_path : str or Path
+        A landmark file; only a JSON file can hold an outline.
+    size_wh : (int, int)
+        The photo's width and height, pixels.
+
+    Returns
+    -------
+    ndarray of shape (N, 2) or None
+        uv pixels (u = column, v = row); None when the file has no outline.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 3 points, not ``[u, v]`` pairs, or a point outside the photo.
+    """
+    from pathlib import Path
+
+    from ..io.jsonio import read_json
+
+    path = Path(landmarks_path)
+    if path.suffix.lower() != ".json":
+        return None
+    meta = read_json(path)
+    if not isinstance(meta, dict) or "head_outline_px" not in meta:
+        return None
+    w, h = size_wh
+    try:
+        outline = np.asarray(meta["head_outline_px"], dtype=float)
+    except (TypeError, ValueError):
+        outline = np.empty((0,))
+    if outline.ndim != 2 or outline.shape[1] != 2 or len(outline) < 3:
+        raise ValueError(
+            f"{path}: head_outline_px must be a list of at least 3 [u, v] points (pixels), as "
+            "the review page saves it"
+        )
+    inside = np.isfinite(outline).all(axis=1)
+    inside &= (outline >= -0.5).all(axis=1)
+    inside &= (outline[:, 0] <= w - 0.5) & (outline[:, 1] <= h - 0.5)
+    if not inside.all():
+        u, v = outline[np.argmin(inside)]
+        raise ValueError(
+            f"{path}: head_outline_px point ({u:g}, {v:g}) lies outside the {w}x{h} image; u is "
+            "the column and v the row, in pixels"
+        )
+    return outline
