@@ -17,8 +17,9 @@ concavities are soft-tissue landmarks. The rules, in the *face frame* of the sil
 4. **nasion**: on the line's stretch from pronasale up to :data:`FOREHEAD_ROWS` head lengths
    above it, the point deepest behind the stretch's anterior convex hull (the nasal root);
    **glabella**: the most anterior point within :data:`GLABELLA_ROWS` face heights above nasion;
-5. **cervical point** (throat): the most posterior point of the line within
-   :data:`THROAT_DEPTH` head lengths below pronasale;
+5. **cervical point** (throat): on the line from pronasale down to its lowest point within
+   :data:`THROAT_DEPTH` head lengths below pronasale, the point deepest behind the stretch's
+   anterior convex hull, and at least :data:`THROAT_MIN` head lengths below pronasale;
 6. **gnathion**: between pronasale and the throat, the point furthest along the bisector of
    anterior and inferior (``a + b``), the lowest-most-anterior chin point;
 7. **subnasale, labiale superius, stomion, labiale inferius**: behind the chord pronasale -
@@ -55,11 +56,13 @@ CROP_MARGIN = 0.15
 #: Window (head lengths) of the protrusion that finds the nose (rule 1).
 SPIKE_WINDOW = 0.06
 #: The profile line ends this many head lengths below the top of the head (rule 2).
-PROFILE_DEPTH = 1.6
+PROFILE_DEPTH = 1.8
 #: Pronasale is searched between these depths below the top, in head lengths (rule 3).
 NOSE_ROWS = (0.35, 1.1)
 #: The throat is searched this far below pronasale, in head lengths (rule 4).
-THROAT_DEPTH = 0.8
+THROAT_DEPTH = 0.9
+#: ... and at least this far below it (the lips' concavities lie above).
+THROAT_MIN = 0.3
 #: Nasion is searched this far above pronasale, in head lengths (rule 7).
 FOREHEAD_ROWS = 0.45
 #: Pogonion is the lowest extreme within CHIN_ROWS face heights above gnathion; without one (a
@@ -371,7 +374,10 @@ def _read_profile(line_uv, view, length, down):
     depth = np.zeros(len(a))
     depth[start : pn + 1] = _envelope_depth(a[start : pn + 1], b[start : pn + 1])
     na = int(np.argmax(depth))
-    cv = pn + int(np.argmin(a[pn : end + 1]))
+    end = pn + int(np.argmax(b[pn : end + 1]))  # the front only, not round a cut neck
+    throat = _envelope_depth(a[pn : end + 1], b[pn : end + 1])
+    throat[b[pn : end + 1] < b[pn] + THROAT_MIN * length] = -1.0  # not the lips
+    cv = pn + int(np.argmax(throat))
     gn = pn + int(np.argmax((a + b)[pn : cv + 1]))
     face_height = float(np.linalg.norm(ab[gn] - ab[na]))
     if gn - pn < 3 or face_height < 1:
