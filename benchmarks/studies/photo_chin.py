@@ -30,7 +30,10 @@ def folders(roots):
     for root in roots:
         root = Path(root)
         base = root / "photos" / "A" if (root / "photos" / "A").is_dir() else root
-        yield from sorted(p for p in base.iterdir() if p.is_dir() and "_f" in p.name)
+        # ``*_nm_*``: the same photos of the head without its mandible, left out.
+        yield from sorted(
+            p for p in base.iterdir() if p.is_dir() and "_f" in p.name and "_nm_" not in p.name
+        )
 
 
 def main(argv=None):
