@@ -36,16 +36,18 @@ import pytest
 pytest.importorskip("ai_edge_litert")
 
 from lilium.photo.analysis import analyse_face  # noqa: E402
-from lilium.photo.landmarks import MESH_LANDMARKS, TRACKED  # noqa: E402
+from lilium.photo.landmarks import MESH_LANDMARKS, TEMPLATE, TRACKED  # noqa: E402
 
 #: Median and worst error of the tracked landmarks, over the eye-corner distance (issue 19).
 MEDIAN_TRACKED = 0.05
 WORST_TRACKED = 0.10
 #: A template point is promoted to tracked when it lies within this fraction of the
-#: eye-corner distance of the hand-placed point on every portrait where it is visible, and it
-#: is visible on at least PROMOTE_MIN_PORTRAITS of them (issue 25, item 6).
+#: eye-corner distance of the hand-placed point on every face where it is visible, and it is
+#: measured on at least PROMOTE_MIN_FACES faces (issue 25 item 6 asked two portraits; issue 55
+#: ten faces, real renders and portraits with hand marks: two portraits here, and MediaPipe
+#: finds no usable face on the renders, benchmarks/studies/photo_chin.py).
 PROMOTE_BOUND = 0.05
-PROMOTE_MIN_PORTRAITS = 2
+PROMOTE_MIN_FACES = 10
 
 HAND = {
     "astronaut": {
@@ -131,7 +133,8 @@ def test_tracked_landmarks_match_the_hand_placed_ones(tables, name):
 
 
 def test_only_points_within_the_bound_on_every_portrait_are_tracked(tables):
-    """Issue 25 item 6: the chin points are promoted, the others (measured) stay template."""
+    """Issues 25 and 55: no point beyond the eyes, nose and mouth is measured on ten faces, so all
+    stay template, the chin points included (within the bound on both portraits, not on ten)."""
     measured = {}
     for table in tables.values():
         for k, (_, rel, _) in table.items():
@@ -140,6 +143,6 @@ def test_only_points_within_the_bound_on_every_portrait_are_tracked(tables):
     for k, rels in measured.items():
         if not k.startswith(beyond_eyes_nose_mouth):
             continue
-        within = len(rels) >= PROMOTE_MIN_PORTRAITS and max(rels) <= PROMOTE_BOUND
+        within = len(rels) >= PROMOTE_MIN_FACES and max(rels) <= PROMOTE_BOUND
         assert (MESH_LANDMARKS[k][1] == TRACKED) == within, (k, [round(100 * r, 1) for r in rels])
-    assert MESH_LANDMARKS["pogonion"][1] == MESH_LANDMARKS["gnathion"][1] == TRACKED
+    assert MESH_LANDMARKS["pogonion"][1] == MESH_LANDMARKS["gnathion"][1] == TEMPLATE

@@ -180,14 +180,14 @@ def test_auto_landmarks_prepares_a_bare_photo_in_the_output_folder(
     assert sorted(p.name for p in portrait.parent.iterdir()) == before  # nothing beside it
     prepared = out / "astronaut" / "prepared"
     assert (prepared / "photo.json").is_file() and (prepared / "review.html").is_file()
-    assert "astronaut: lilium photo: 12 tracked and 9 template landmarks" in stdout
+    assert "astronaut: lilium photo: 10 tracked and 11 template landmarks" in stdout
     result = _result(out, "astronaut", "posest-sfo")
     assert {v["source"] for v in result["priors"].values()} == {"automatic"}
     sources = json.loads((prepared / "photo.json").read_text())["landmark_sources"]
     used = result["landmark_error"]["per_landmark_px"]
     assert all(sources[k]["quality"] == "tracked" for k in used)
     text = (out / "report.html").read_text()
-    line = "facial landmarks automatic, unreviewed: all 12 placed by lilium photo"
+    line = "facial landmarks automatic, unreviewed: all 10 placed by lilium photo"
     assert f"Photo <b>astronaut</b>: {line}" in text
     assert "check them in astronaut/prepared/review.html" in text  # relative: the folder moves
     assert '<a href="astronaut/prepared/review.html">review page</a>' in text
@@ -252,9 +252,9 @@ def test_the_landmark_line_says_what_was_reviewed(tmp_path):
 def test_an_sfo_without_a_chin_pair_or_curve_says_the_chin_is_unconstrained(
     standin, prepared, tmp_path, capsys
 ):
-    """Issue 25 item 6: with only the midface points (the chin points left unconfirmed, as
-    before they were tracked) the overlay's chin can lie anywhere: result.json, the console
-    and the report say so; P_pll's chin-jaw curve or a chin pair lifts it."""
+    """Issue 25 item 6: with only the midface points (the chin points left unconfirmed: template
+    since issue 55) the overlay's chin can lie anywhere: result.json, the console and the
+    report say so; P_pll's chin-jaw curve or a confirmed chin pair lifts it."""
     midface = tmp_path / "midface"
     shutil.copytree(prepared, midface)
 
@@ -292,12 +292,20 @@ def test_an_sfo_without_a_chin_pair_or_curve_says_the_chin_is_unconstrained(
     pll = _result(out, "midface", "lilium-pll")
     assert pll["terms"]["p_pll"] is not None
     assert "chin_unconstrained" not in [w["code"] for w in pll["warnings"]]
-    # The folder as lilium photo wrote it: pogonion and gnathion are tracked and pair.
+    # Pogonion and gnathion confirmed in the review: they pair.
+    confirmed = tmp_path / "confirmed"
+    shutil.copytree(prepared, confirmed)
+
+    def chin_confirmed(data):
+        for name in ("pogonion", "gnathion"):
+            data["landmark_sources"][name].update(source="reviewed", confirmed=True)
+
+    _edit_json(confirmed / "photo.json", chin_confirmed)
     out = tmp_path / "out2"
-    argv = ["case", "--skull", skull, "--photo", prepared, "--method", "posest-sfo"]
+    argv = ["case", "--skull", skull, "--photo", confirmed, "--method", "posest-sfo"]
     code, stdout, err = _run(argv + ["--out", out], capsys)
     assert code == 0, err
-    result = _result(out, "astro", "posest-sfo")
+    result = _result(out, "confirmed", "posest-sfo")
     assert {"pogonion", "gnathion"} <= set(result["landmark_error"]["per_landmark_px"])
     assert "chin_unconstrained" not in [w["code"] for w in result["warnings"]]
     assert "chin_unconstrained" not in stdout

@@ -29,10 +29,23 @@ from .folder import PREPARED_BY, check_image_path, check_photo_not_output, claim
 from .headpose import implausible_distance, iris_distance_mm
 from .landmarks import mesh_face_curves
 from .mask import is_head_mask, mask_outline, polygon_mask
+from .profile import profile_of_photo
 from .review import read_head_outline, review_page
 
 #: Head-orientation tolerance (degrees) proposed with the automatic orientation.
 HEAD_TOLERANCE_DEG = 15.0
+#: Beyond this yaw (degrees) the face mesh no longer follows the face: the profile is read.
+MESH_MAX_YAW_DEG = 60.0
+
+
+def _profile_fallback(image, analysis, view):
+    """The profile (:mod:`.profile`) and its head mask when the face mesh found no face or one
+    turned beyond :data:`MESH_MAX_YAW_DEG`, and no frontal view was given; else ``(None, None)``.
+    """
+    if view == "frontal" or (analysis and abs(analysis.angles_deg["yaw"]) < MESH_MAX_YAW_DEG):
+        return None, None
+    profile, mask = profile_of_photo(image, view=view)
+    return (profile, mask) if profile else (None, None)
 
 
 @dataclass(frozen=True)
@@ -194,8 +207,19 @@ def prepare_photo(
     reviewed = read_landmarks(landmarks_path, "facial") if landmarks_path else None
     outline_px = read_head_outline(landmarks_path, (w, h)) if landmarks_path else None
     analysis = analyse_face(image, face)
+    profile, profile_mask = _profile_fallback(image, analysis, view)
+    if profile:  # a lateral photo: the silhouette's profile line (docs/method/photo.md)
+        why = (
+            analysis.message.split(";")[0]
+            if not analysis
+            else (f"the face mesh is turned {analysis.angles_deg['yaw']:.0f} deg, beyond its range")
+        )
+        analysis = type(analysis)(message=why)  # nothing of the mesh is used
+        view = view or profile.view
     view = view or (analysis.view if analysis else "frontal")
     landmarks, sources = dict(analysis.landmarks), dict(analysis.sources)
+    if profile:
+        landmarks, sources = dict(profile.landmarks), dict(profile.sources)
     if reviewed is not None:
         for name, uv in reviewed.items():
             u, v = uv
@@ -225,10 +249,10 @@ def prepare_photo(
                 "(image.png), and its landmarks, mask and curves are in its pixels",
             }
         )
-    head = analysis.mask if analysis else None
+    head = analysis.mask if analysis else (profile_mask if profile else None)
     if outline_px is not None:  # the reviewed outline: the user's head
         head = polygon_mask(outline_px, (w, h))
-    head_is_head = outline_px is not None or (
+    head_is_head = outline_px is not None or bool(profile) or (
         bool(analysis) and is_head_mask(head, analysis.mesh_xyz)
     )
     if head is not None and not head_is_head:
@@ -271,6 +295,12 @@ def prepare_photo(
             f"{yaw:.0f} pitch {pitch:.0f} roll {roll:.0f} deg; review them in "
             f"{out / 'review.html'}"
         )
+    elif profile:
+        message = (
+            f"{analysis.message}: read the profile of the head's silhouette instead (profile "
+            f"path), view {view}, {n_tracked} tracked and {n_template} "
+            f"template landmarks; review them in {out / 'review.html'}"
+        )
     else:
         message = f"{image_path}: {analysis.message}"
     page = review_page(
@@ -284,4 +314,5 @@ def prepare_photo(
         faces=meta.get("faces", ()),
     )
     (out / "review.html").write_text(page, encoding="utf-8")
-    return PreparedPhoto(out, bool(analysis), message, view, n_tracked, n_template, tuple(warnings))
+    found = bool(analysis) or bool(profile)
+    return PreparedPhoto(out, found, message, view, n_tracked, n_template, tuple(warnings))
