@@ -158,7 +158,7 @@ def fill_template(template, values):
     return pattern.sub(lambda match: values[match.group(0)], template)
 
 
-def review_page(image, landmarks, sources, outline_uv, priors, title, message=""):
+def review_page(image, landmarks, sources, outline_uv, priors, title, message="", faces=()):
     """The review page as a string.
 
     Parameters
@@ -172,6 +172,8 @@ def review_page(image, landmarks, sources, outline_uv, priors, title, message=""
     priors : dict
         Shown as written to ``photo.json``.
     title, message : str
+    faces : sequence of dict
+        ``photo.json``'s ``faces`` (not drawn yet).
     """
     h, w = image.shape[:2]
     data = {
