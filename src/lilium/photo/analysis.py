@@ -2,6 +2,7 @@
 
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 
 from . import runtime
@@ -212,6 +213,12 @@ def upright_turns(image, faces=None):
     faces = find_faces(image) if faces is None else faces
     own = max((f.score for f in faces), default=0.0)
     best_k, best = 0, max(own + TURN_SCORE_MARGIN, TURN_MIN_SCORE)
+    # The whole-photo search shows the photo 128 px long: turn that, not the full photo.
+    h, w = image.shape[:2]
+    scale = runtime.DETECTOR_INPUT_PX / max(h, w)
+    if scale < 1:
+        size = (max(1, round(w * scale)), max(1, round(h * scale)))
+        image = cv2.resize(image, size, interpolation=cv2.INTER_AREA)
     for k in (1, 2, 3):
         turned = runtime.detect_faces(np.ascontiguousarray(np.rot90(image, k)), pyramid=False)
         if turned and turned[0][0] > best:
