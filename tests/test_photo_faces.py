@@ -116,3 +116,14 @@ def test_a_large_portrait_reaches_the_meprocs_resolution(tmp_path, capsys):
     assert meta["resolution"]["interpupillary_px"] >= 90
     assert meta["resolution"]["head_width_px"] >= 180
     assert all(w["code"] != "low_resolution" for w in meta.get("warnings", []))
+
+
+@pytest.mark.parametrize("shape", [(32, 10400), (10400, 32), (32, 32), (385, 400)])
+def test_the_pyramid_holds_thin_and_tiny_photos(shape):
+    from lilium.photo import runtime
+
+    image = np.random.default_rng(0).integers(0, 255, (*shape, 3), np.uint8)
+    levels = list(runtime.image_pyramid(image))
+    assert all(level.shape[0] >= 1 and level.shape[1] >= 1 for level, _ in levels)
+    assert max(levels[-1][0].shape[:2]) == runtime.DETECTOR_INPUT_PX  # the whole photo, last
+    assert runtime.detect_faces(image) == []

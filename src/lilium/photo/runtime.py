@@ -274,7 +274,11 @@ def image_pyramid(image, levels=True):
     factor = int(round(SMALL_FACE_PX / SMALL_FACE_INPUT_PX))
     factor = max(factor, int(np.ceil(np.sqrt(h * w / MAX_LEVEL_PIXELS))))
     source, total = image, 1
-    while levels and max(h, w) // (total * factor) > DETECTOR_INPUT_PX:
+    while (
+        levels
+        and max(h, w) // (total * factor) > DETECTOR_INPUT_PX
+        and min(h, w) // (total * factor) >= 1
+    ):
         source, total = _shrink(source, factor), total * factor
         factor = LEVEL_STEP
         yield source, np.array([total, total], float)
