@@ -96,6 +96,14 @@ class FaceAnalysis:
         Mean of both eyes.
     mask : ndarray of shape (H, W), bool, or None
     detection_score : float
+    faces : tuple of Face
+        Every face found (:func:`find_faces`), also when the one taken could not be analysed.
+    face_number : int
+        The face taken (``Face.number``); 0 when none was.
+    interpupillary_px : float or None
+        Distance between the iris centres.
+    head_width_px : float or None
+        The face mesh's width (:func:`mesh_width_px`).
     """
 
     message: str = ""

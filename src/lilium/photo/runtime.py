@@ -127,7 +127,7 @@ def _anchors(height=DETECTOR_INPUT_PX, width=DETECTOR_INPUT_PX):
     return np.concatenate(rows)
 
 
-@lru_cache(maxsize=8)
+@lru_cache(maxsize=4)  # a 1024-px input holds about 200 MB
 def _detector(height, width):
     """The face detector with its input resized to ``height x width`` (multiples of 16): the
     network is fully convolutional, so a large input is many 128-px tiles at once."""
