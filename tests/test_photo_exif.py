@@ -119,6 +119,7 @@ def test_a_focal_that_puts_the_camera_far_away_is_implausible(tmp_path, capfd):
     from lilium.photo import runtime
 
     runtime._model.cache_clear()  # load the models inside this test: their logging is checked
+    runtime._detector.cache_clear()
     # A consistent 1000 mm equivalent (crop factor 5): the iris puts the camera ~15 m away.
     image = _with_exif(tmp_path / "astronaut.jpg", data.astronaut(), focal_mm=200.0, f35=1000)
     out = tmp_path / "photo"
@@ -127,8 +128,9 @@ def test_a_focal_that_puts_the_camera_far_away_is_implausible(tmp_path, capfd):
     assert "XNNPACK" not in err and "INFO:" not in err
     meta = json.loads((out / "photo.json").read_text())
     assert "focal_px" not in meta["priors"] and "scd_mm" not in meta["priors"]
-    (warning,) = meta["warnings"]
-    assert warning["code"] == "implausible_prior"
+    # The astronaut's pupils are 43 px apart: low_resolution too.
+    assert [w["code"] for w in meta["warnings"]] == ["implausible_prior", "low_resolution"]
+    warning = meta["warnings"][0]
     assert "outside the 0.3-10 m of a portrait" in warning["message"]
     assert "warning implausible_prior:" in err
 

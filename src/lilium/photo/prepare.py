@@ -24,7 +24,7 @@ from ..constants import MIN_PHOTO_SIDE_PX
 from ..io.case import read_image
 from ..io.formats import read_landmarks
 from ..io.jsonio import write_json
-from .analysis import analyse_face, upright_turns
+from .analysis import analyse_face, find_faces, upright_turns
 from .folder import PREPARED_BY, check_image_path, check_photo_not_output, claim_folder
 from .headpose import implausible_distance, iris_distance_mm
 from .landmarks import mesh_face_curves
@@ -193,8 +193,10 @@ def prepare_photo(
             f"{image_path}: the photo is {w}x{h} px, too small to prepare or superimpose (at "
             f"least {MIN_PHOTO_SIDE_PX} px a side); use the original photograph"
         )
-    turns = upright_turns(image)
+    faces = find_faces(image)
+    turns = upright_turns(image, faces)
     if turns:
+        faces = None
         if image_path.resolve().parent == out.resolve():
             raise ValueError(
                 f"{image_path}: the face is upright only with the photo turned by "
@@ -206,7 +208,7 @@ def prepare_photo(
         check_photo_not_output(out, image_path)  # a link to the folder's image: turned over it
     reviewed = read_landmarks(landmarks_path, "facial") if landmarks_path else None
     outline_px = read_head_outline(landmarks_path, (w, h)) if landmarks_path else None
-    analysis = analyse_face(image, face)
+    analysis = analyse_face(image, face, faces)
     profile, profile_mask = _profile_fallback(image, analysis, view)
     if profile:  # a lateral photo: the silhouette's profile line (docs/method/photo.md)
         why = (
@@ -214,7 +216,7 @@ def prepare_photo(
             if not analysis
             else (f"the face mesh is turned {analysis.angles_deg['yaw']:.0f} deg, beyond its range")
         )
-        analysis = type(analysis)(message=why)  # nothing of the mesh is used
+        analysis = type(analysis)(message=why, faces=analysis.faces)  # nothing of the mesh
         view = view or profile.view
     view = view or (analysis.view if analysis else "frontal")
     landmarks, sources = dict(analysis.landmarks), dict(analysis.sources)
@@ -235,9 +237,13 @@ def prepare_photo(
             for k in reviewed
         }
     priors, warnings = _priors(image_path, analysis, sensor_width_mm)
-    if analysis and analysis.several_faces:
+    if analysis.several_faces:
         warnings.append(
             {"code": "several_faces", "message": f"{image_path}: {analysis.several_faces}"}
+        )
+    if analysis.low_resolution:
+        warnings.append(
+            {"code": "low_resolution", "message": f"{image_path}: {analysis.low_resolution}"}
         )
     if turns:
         meta_turn = 90 * turns
@@ -264,7 +270,10 @@ def prepare_photo(
         "landmarks": {k: [round(float(x), 2) for x in v] for k, v in landmarks.items()},
         "landmark_sources": sources,
         "priors": priors,
+        "faces": [f.to_json() for f in analysis.faces],
     }
+    if analysis:
+        meta["resolution"] = analysis.resolution
     if head is not None:
         # Never a source of facial curves; False: the face outline alone (docs/method/photo.md).
         meta["face_mask_is_head"] = head_is_head
@@ -292,7 +301,9 @@ def prepare_photo(
         yaw, pitch, roll = (analysis.angles_deg[k] for k in ("yaw", "pitch", "roll"))
         message = (
             f"{n_tracked} tracked and {n_template} template landmarks, view {view}, head yaw "
-            f"{yaw:.0f} pitch {pitch:.0f} roll {roll:.0f} deg; review them in "
+            f"{yaw:.0f} pitch {pitch:.0f} roll {roll:.0f} deg, "
+            f"{analysis.interpupillary_px:.0f} px between the pupils, "
+            f"{analysis.head_width_px:.0f} px across the head; review them in "
             f"{out / 'review.html'}"
         )
     elif profile:
@@ -311,7 +322,7 @@ def prepare_photo(
         priors,
         image_path.name,
         message,
-        faces=meta.get("faces", ()),
+        faces=meta["faces"],
     )
     (out / "review.html").write_text(page, encoding="utf-8")
     found = bool(analysis) or bool(profile)
