@@ -101,4 +101,5 @@ def test_lilium_photo_says_when_it_found_only_the_face(tmp_path, monkeypatch, ca
     monkeypatch.setattr(runtime, "person_mask", real)
     assert main(["photo", str(tmp_path / "a.png"), "--out", str(out)]) == 0
     meta = json.loads((out / "photo.json").read_text())
-    assert meta["face_mask_is_head"] is True and "warnings" not in meta
+    assert meta["face_mask_is_head"] is True
+    assert "head_mask_face_only" not in [w["code"] for w in meta.get("warnings", ())]
