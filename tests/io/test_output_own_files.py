@@ -106,7 +106,7 @@ def test_lilium_photo_refuses_its_own_face_mask_as_the_photo(tmp_path, capsys):
 
 @pytest.fixture
 def rows():
-    from test_report import make_rows
+    from report_rows import make_rows
 
     return make_rows()
 

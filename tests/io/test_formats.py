@@ -306,3 +306,8 @@ def test_lilium_case_reads_slicer_frames_as_import_ct_does(case, tmp_path, capsy
             (tmp_path / name / "standin_frontal" / "posest-sfo" / "result.json").read_text()
         )
         assert result["camera"] is not None and result["landmark_error"]["mean_px"] < 5
+
+
+def test_a_landmark_folder_is_not_reported_missing(tmp_path):
+    with pytest.raises(ValueError, match="is a folder, not a landmark file"):
+        read_landmarks(tmp_path, "facial")

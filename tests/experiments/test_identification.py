@@ -13,7 +13,7 @@ from lilium.experiments.identification import (
 )
 from lilium.experiments.report import photo_ranks, write_report
 from lilium.experiments.store import ResultStore
-from test_report import _row
+from report_rows import report_row as _row
 
 SKULLS = ("s1", "s2", "s3", "s4")
 P1 = ("p1", "s1", "frontal")

@@ -8,6 +8,7 @@ import shutil
 import sqlite3
 
 import pytest
+from test_experiments import db_keys, write_config
 
 from lilium.cli.main import main
 from lilium.experiments import runner
@@ -18,7 +19,6 @@ from lilium.synthetic import dataset as ds
 from lilium.synthetic.incomplete import curve_kept
 from lilium.synthetic.toyhead import make_toy_subject, write_toy_subject
 from standin_case import toy_dataset
-from test_experiments import db_keys, write_config
 
 #: POSEST-SFO only (deterministic, fast).
 POSEST_ONLY = ('methods = ["posest-sfo", "lilium:base"]', 'methods = ["posest-sfo"]')

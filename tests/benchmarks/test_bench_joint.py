@@ -9,7 +9,7 @@ import numpy as np
 from lilium.fitness.camera_penalty import CameraPriors
 from lilium.inputs import Photo
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import bench_joint  # noqa: E402
 

@@ -12,7 +12,7 @@ from lilium.ct import Volume, import_ct, read_landmark_file, read_volume, volume
 
 SPACING = (1.5, 2.0, 2.5)  # x, y, z (mm)
 SHAPE_ZYX = (24, 30, 36)
-HEADSQ = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "headsq"
+HEADSQ = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "headsq"
 
 
 def _phantom():

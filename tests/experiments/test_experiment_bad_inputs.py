@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
+from test_experiments import db_keys, write_config
 
 from lilium.cli.main import main
 from lilium.experiments.config import MAX_SEED, config_from_dict, load_config
@@ -22,7 +23,6 @@ from lilium.experiments.store import KEY_COLUMNS, ResultStore
 from lilium.io.locks import RunLock
 from lilium.optimisation.de import DEOptions
 from standin_case import toy_dataset
-from test_experiments import db_keys, write_config
 
 
 def _generate(out, seed):

@@ -272,7 +272,7 @@ def test_library_warnings_stay_off_the_console(case, tmp_path, capsys, monkeypat
 @pytest.fixture
 def report_db(tmp_path):
     from lilium.experiments.store import ResultStore
-    from test_report import make_rows
+    from report_rows import make_rows
 
     path = tmp_path / "results.sqlite"
     with ResultStore(path) as store:

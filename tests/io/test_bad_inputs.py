@@ -410,7 +410,7 @@ def test_bad_third_photo_fails_before_any_sfo(case, tmp_path, capsys, monkeypatc
         photos += ["--photo", folder]
     # Three landmarks left: fewer than four pairs, the one case no term set can run. (A term
     # the variant asks for that cannot apply, P_skof without the mask of photo 0, say, is
-    # switched off, not an error: SPEC section 5, tests/test_incomplete.py.)
+    # switched off, not an error: SPEC section 5, tests/methods/test_incomplete.py.)
     _edit_json(
         tmp_path / "photo2" / "photo.json",
         lambda d: d.update(landmarks=dict(list(d["landmarks"].items())[:3])),

@@ -8,7 +8,7 @@ import pytest
 
 from lilium.ct.mesh import volume_to_mesh
 
-_PATH = Path(__file__).resolve().parents[1] / "benchmarks" / "chin_profile_geometry.py"
+_PATH = Path(__file__).resolve().parents[2] / "benchmarks" / "chin_profile_geometry.py"
 _SPEC = importlib.util.spec_from_file_location("chin_profile_geometry", _PATH)
 chin = importlib.util.module_from_spec(_SPEC)
 _SPEC.loader.exec_module(chin)

@@ -13,7 +13,7 @@ from lilium.cli.main import main
 from lilium.io.mesh import read_mesh
 
 SPACING = (1.5, 2.0, 2.5)  # x, y, z (mm)
-HEADSQ = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "headsq"
+HEADSQ = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "headsq"
 
 
 def _phantom(shape_zyx=(24, 30, 36), dtype=np.int16):

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import lookalikes  # noqa: E402
 
@@ -39,9 +39,7 @@ def test_disparity_is_shape_only(tmp_path):
         names = {f"l{i}": p.tolist() for i, p in enumerate(pts)}
         (folder / "cranial_landmarks.json").write_text(json.dumps({"landmarks": names}))
         subjects.append({"id": sid, "path": f"subjects/{sid}"})
-    (root / "dataset.json").write_text(
-        json.dumps({"subjects": subjects, "photos": []})
-    )
+    (root / "dataset.json").write_text(json.dumps({"subjects": subjects, "photos": []}))
     shapes = lookalikes.SkullShapes([])
     shapes.inputs["0"] = lookalikes.DatasetInputs(root)
     assert shapes.disparity("0:a", "0:b") < 1e-12
