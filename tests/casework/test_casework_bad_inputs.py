@@ -1,4 +1,4 @@
-"""Hostile inputs of the newer entry points (issue 28, benchmarks/probe_hostile_casework.py):
+"""Hostile inputs of the newer entry points (issue 28, tests/acceptance/hostile_casework.py):
 a calibration file with NaN, text or impossible counts, a results database given twice, empty,
 damaged or about to be overwritten, a lineup or joint SFO given one photo twice (by path or as
 a copy), and a resumed lineup under another calibration; each a one-line error naming the

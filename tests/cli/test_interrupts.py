@@ -1,4 +1,4 @@
-"""Ctrl-C (benchmarks/probe_hostile_scenarios.py): one line and exit status 130 whenever it comes,
+"""Ctrl-C (tests/acceptance/hostile_scenarios.py): one line and exit status 130 whenever it comes,
 never a traceback, and never lost inside a library's import."""
 
 import subprocess

@@ -1,5 +1,5 @@
 """What a report or a calibration computes from stored SFOs does not depend on the order the
-rows were stored in or the databases are given in (benchmarks/probe_hostile_determinism.py)."""
+rows were stored in or the databases are given in (tests/acceptance/hostile_determinism.py)."""
 
 import json
 import sqlite3

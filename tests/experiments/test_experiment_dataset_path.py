@@ -1,4 +1,4 @@
-"""Fixes found by the hostile-input probes of the runs (benchmarks/probe_hostile_runs.py)."""
+"""Fixes found by the hostile-input probes of the runs (tests/acceptance/hostile_runs.py)."""
 
 import pytest
 

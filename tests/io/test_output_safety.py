@@ -1,4 +1,4 @@
-"""Where the commands write (benchmarks/probe_hostile_outputs.py): never through a link left in
+"""Where the commands write (tests/acceptance/hostile_outputs.py): never through a link left in
 the output folder, one folder per photo whatever the photos are called, names the file system
 refuses and file names that are not UTF-8 as one-line errors or reports, not tracebacks."""
 

@@ -1,4 +1,4 @@
-"""Degenerate or damaged geometry (the probes of benchmarks/probe_hostile_geometry.py): parts of
+"""Degenerate or damaged geometry (the probes of tests/acceptance/hostile_geometry.py): parts of
 a skull mesh apart from the skull, unreferenced vertices, coarse meshes, bilateral twins at one
 place, too few or planar landmarks for POSEST, masks of (nearly) every pixel or of one pixel."""
 

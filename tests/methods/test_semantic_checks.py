@@ -1,5 +1,5 @@
 """Files that pass their own checks but do not belong together (the semantic probes of
-benchmarks/probe_hostile_semantic.py): landmarks off the face mask, implausible soft-tissue
+tests/acceptance/hostile_semantic.py): landmarks off the face mask, implausible soft-tissue
 depths, the curve of the other view."""
 
 import subprocess

@@ -1,4 +1,4 @@
-"""The damage of the geometric degeneracy probes of ``probe_hostile_geometry.py``: set-ups
+"""The damage of the geometric degeneracy probes of ``hostile_geometry.py``: set-ups
 that leave every file valid in its format but its geometry degenerate or damaged, as real scans
 and real hand annotations are.
 
@@ -19,9 +19,8 @@ to another.
 """
 
 import numpy as np
-
-from probe_hostile_fixtures import _edit_json
-from probe_hostile_machinery import _then
+from hostile_fixtures import _edit_json
+from hostile_machinery import _then
 
 # -- set-ups: meshes --------------------------------------------------------------------------
 

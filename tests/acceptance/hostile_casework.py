@@ -1,9 +1,9 @@
-"""Hostile-input probes of the newer entry points, run by ``probe_hostile.py`` (issue 28):
+"""Hostile-input probes of the newer entry points, tested (issue 28):
 ``lilium lineup`` (one skull against several candidates), ``lilium calibrate DB...``, the
 ``--calibration FILE`` of ``lilium sfo``/``case``/``lineup`` and the joint SFO (``lilium sfo``
 with several ``--photo``, ``lilium case --joint``).
 
-Each probe runs on the stand-in case of ``probe_hostile.py`` (``in/subjects/standin``,
+Each probe runs on the stand-in case of the campaign (``in/subjects/standin``,
 ``in/photos/standin_frontal``), with POSEST-SFO or a tiny Lilium budget; the results databases
 are generated here, with every SFO's identification terms stored, so ``lilium calibrate`` fits
 a model in a second or two. A second photo of the stand-in is its image at half size with its
@@ -16,7 +16,7 @@ import json
 import shutil
 import sqlite3
 
-from probe_hostile_machinery import Probe, _write
+from hostile_machinery import Probe, _write
 
 #: The Lilium budget of the joint probes (DE/rand/1 needs 4 members).
 TINY = ("--generations", "2", "--population", "5")

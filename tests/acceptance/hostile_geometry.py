@@ -13,18 +13,18 @@ error naming the file, or a result that is right (the camera of the clean input 
 truth, the same conclusion) unless a warning names the damage; a result that differs from the
 clean one without a word is ``silently wrong``.
 
-Inputs: the stand-in case of ``probe_hostile.py`` (an ellipsoidal skull without porion or
+Inputs: the stand-in case of the campaign (an ellipsoidal skull without porion or
 mandible landmarks; its photo's head-rotation prior is dropped where a probe tests what the
-landmarks alone determine) and the generated dataset of ``probe_hostile_fixtures.py`` (``_syn``,
+landmarks alone determine) and the generated dataset of ``hostile_fixtures.py`` (``_syn``,
 with mandible landmarks and face curves, for P_pll and the lineup). Budgets: POSEST-SFO, or
 Lilium at 5 x 2 with a fixed seed (a probe compares it with the clean input's SFO at the same
 seed and budget, so the DE need not converge).
 
 Here: the command lines, the checks (against the clean input's SFO at the same seed, or the
 known truth of a generated photo) and the probes; the set-ups that damage the meshes, the
-landmark sets and the masks are in ``probe_hostile_geometry_damage.py``. ::
+landmark sets and the masks are in ``hostile_geometry_damage.py``. ::
 
-    python benchmarks/probe_hostile_geometry.py --work /tmp/geometry [--only TEXT] [--limit-s 60]
+    python -m pytest -m slow tests/acceptance/test_hostile_geometry.py [-k TEXT]
 """
 
 import json
@@ -35,8 +35,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from probe_hostile_casework import TINY, _quiet_main  # noqa: E402
-from probe_hostile_fixtures import (  # noqa: E402
+from hostile_casework import TINY, _quiet_main  # noqa: E402
+from hostile_fixtures import (  # noqa: E402
     _codes,
     _edit_json,
     _in,
@@ -45,7 +45,7 @@ from probe_hostile_fixtures import (  # noqa: E402
     _rot_err_deg,
     _syn,
 )
-from probe_hostile_geometry_damage import (  # noqa: E402
+from hostile_geometry_damage import (  # noqa: E402
     MIDLINE_FACE,
     MIDLINE_SKULL,
     _all_but_corner,
@@ -76,10 +76,10 @@ from probe_hostile_geometry_damage import (  # noqa: E402
     _stray_triangle,
     _unreferenced_vertex,
 )
-from probe_hostile_machinery import Probe, _then  # noqa: E402
+from hostile_machinery import Probe, _then  # noqa: E402
 
 SEED = ("--seed", "1")
-#: Warnings of the clean inputs (see probe_hostile_semantic.CLEAN_CODES).
+#: Warnings of the clean inputs (see hostile_semantic.CLEAN_CODES).
 CLEAN_CODES = {"outside_prior", "no_focal_prior", "no_scd_prior", "focal_cap"}
 
 # -- where things are -------------------------------------------------------------------------
@@ -410,14 +410,3 @@ def geometry_probes():
 
 
 # fmt: on
-
-
-def main(argv=None):
-    """Run this group alone (the same verdicts as ``probe_hostile.py``)."""
-    from probe_hostile_machinery import run_group
-
-    return run_group(geometry_probes, "geometry", __doc__, argv)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

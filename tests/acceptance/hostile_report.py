@@ -1,4 +1,4 @@
-"""Report-consistency probes, run by ``probe_hostile.py``: what the HTML report (``lilium case``'s
+"""Report-consistency probes, tested: what the HTML report (``lilium case``'s
 ``report.html``, ``lilium lineup``'s), the console and ``lineup.json`` show must be what the
 ``result.json`` files hold. "Pictures they can judge and a conclusion they can sign": a report
 that shows another conclusion, another LR, another camera, hides a cap, a warning or a term
@@ -10,8 +10,8 @@ on inputs that reach different states (success, a failed SFO, warnings ``view_mi
 ``outside_prior``, ``landmark_outside_mask``, ``mesh_part_left_out``, a term switched off, the
 caps of the conclusion, a skull outside the head) and checks, from the files alone, that the
 report's SFO sections, overlays, pictures and conclusion rows and the console's lines say what
-the ``result.json`` files say (those checks are in ``probe_hostile_reportcheck.py``; how the
-page and the console are read, in ``probe_hostile_reportpage.py``). This module holds the
+the ``result.json`` files say (those checks are in ``hostile_reportcheck.py``; how the
+page and the console are read, in ``hostile_reportpage.py``). This module holds the
 probes, their set-ups and command lines, and the checks of one command:
 
 - a lineup's order follows its LRs (ties broken as documented: the views' log10 LRs added, then
@@ -21,7 +21,7 @@ probes, their set-ups and command lines, and the checks of one command:
 
 Budgets: POSEST-SFO, or Lilium with 5 x 2. ::
 
-    python benchmarks/probe_hostile_report.py --work /tmp/report-probes [--only TEXT]
+    python -m pytest -m slow tests/acceptance/test_hostile_report.py [-k TEXT]
 """
 
 import re
@@ -32,16 +32,16 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from probe_hostile_casework import TINY, _calibration, _only_models, _quiet_main  # noqa: E402
-from probe_hostile_fixtures import _edit_json, _in, _json, _syn  # noqa: E402
-from probe_hostile_machinery import Probe, _then  # noqa: E402
-from probe_hostile_reportcheck import (  # noqa: E402
+from hostile_casework import TINY, _calibration, _only_models, _quiet_main  # noqa: E402
+from hostile_fixtures import _edit_json, _in, _json, _syn  # noqa: E402
+from hostile_machinery import Probe, _then  # noqa: E402
+from hostile_reportcheck import (  # noqa: E402
     _conclusion_problems,
     _console_problems,
     _report_consistent,
 )
-from probe_hostile_reportpage import _arm, _console, _install  # noqa: E402
-from probe_hostile_semantic import _invert_mask, _view  # noqa: E402
+from hostile_reportpage import _arm, _console, _install  # noqa: E402
+from hostile_semantic import _invert_mask, _view  # noqa: E402
 
 # -- lineups ----------------------------------------------------------------------------------
 
@@ -237,7 +237,7 @@ MIDLINE_FACE = ("glabella", "nasion", "metopion", "bregma", "subnasale", "labial
 def _failing_photo(name="fail"):
     """``in/photos/<name>``: another photo of the stand-in (:func:`_other_photo`) with its
     midline landmarks only and no head-rotation prior (POSEST: no 4-point sample of points on
-    one plane gives a real camera: the SFO fails, as probe_hostile_geometry.py's)."""
+    one plane gives a real camera: the SFO fails, as hostile_geometry.py's)."""
 
     def no_rotation(d):
         for k in ("head_rotation_skull2cam", "head_tolerance_deg"):
@@ -416,14 +416,3 @@ def report_probes():
 
 
 # fmt: on
-
-
-def main(argv=None):
-    """Run this group alone (the same verdicts as ``probe_hostile.py``)."""
-    from probe_hostile_machinery import run_group
-
-    return run_group(report_probes, "report", __doc__, argv, limit_s=120)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

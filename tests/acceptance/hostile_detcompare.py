@@ -1,4 +1,4 @@
-"""The comparisons of the determinism probes (``probe_hostile_determinism.py``): the stored
+"""The comparisons of the determinism probes (``hostile_determinism.py``): the stored
 rows of two databases key by key (every stored value, the timing columns and the cohort terms
 aside; the cohort terms measured apart, against docs/method.md's bound), two report or
 calibration folders file by file (CSV cell by cell, JSON parsed, some keys or columns left
@@ -13,7 +13,7 @@ import math
 import sqlite3
 from pathlib import Path
 
-from probe_hostile_detcampaign import (
+from hostile_detcampaign import (
     COHORT_BOUND,
     COHORT_TERMS,
     MEASURED,
@@ -24,7 +24,7 @@ from probe_hostile_detcampaign import (
     _keep,
     _ref_db,
 )
-from probe_hostile_runs import _in
+from hostile_runs import _in
 
 # -- comparisons ------------------------------------------------------------------------------
 

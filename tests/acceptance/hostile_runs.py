@@ -1,4 +1,4 @@
-"""Hostile-input probes of the protocol's runs, run by ``probe_hostile.py`` (issue 28):
+"""Hostile-input probes of the protocol's runs, tested (issue 28):
 ``lilium experiment`` (config types, unknown keys, counts, methods, the dataset path, a resume
 against another config's database, ``--workers 0``, ``--scheduler``), ``lilium report`` (a
 folder that is no database, joint-only rows, one photo only, ``--out`` the database's folder)
@@ -13,7 +13,7 @@ import os
 import shutil
 import sqlite3
 
-from probe_hostile_machinery import Probe, _then, _write
+from hostile_machinery import Probe, _then, _write
 
 #: One subject, a frontal and a lateral photo, POSEST-SFO, Exp. A: 2 SFOs, a few seconds.
 BASE = """name = "runs"
@@ -88,7 +88,7 @@ def _prior_run(text):
     """Set-up: ``out/r.sqlite`` written by a run of the config ``text`` (another config)."""
 
     def setup(ws):
-        from probe_hostile_casework import _quiet_main
+        from hostile_casework import _quiet_main
 
         _in(ws, "prior.toml").write_text(text)
         ws.out.mkdir(exist_ok=True)
@@ -104,8 +104,9 @@ def _report_db(where="in", change=None):
     """Set-up: ``<where>/r.sqlite`` holding ``change(rows)`` of the report tests' rows."""
 
     def setup(ws):
-        from lilium.experiments.store import ResultStore
         from test_report import make_rows
+
+        from lilium.experiments.store import ResultStore
 
         folder = ws.root / where
         folder.mkdir(exist_ok=True)

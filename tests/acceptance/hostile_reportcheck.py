@@ -1,6 +1,6 @@
-"""The checks of the report probes (``probe_hostile_report.py``): one report page against the
+"""The checks of the report probes (``hostile_report.py``): one report page against the
 ``result.json`` files it links and the console of its command, from the files alone (read by
-``probe_hostile_reportpage.py``):
+``hostile_reportpage.py``):
 
 - every SFO section of the report links its ``result.json``, shows its photo and method, its
   failure (the same message), every warning code beside it (section and summary, the same
@@ -18,16 +18,15 @@
   report's row of that decision) says.
 
 :func:`_report_consistent` makes a probe's check of all this (a command's own checks added,
-as the lineup's of ``probe_hostile_report.py``).
+as the lineup's of ``hostile_report.py``).
 """
 
 import re
 from pathlib import Path
 
 import numpy as np
-
-from probe_hostile_fixtures import _json
-from probe_hostile_reportpage import (
+from hostile_fixtures import _json
+from hostile_reportpage import (
     _box_close,
     _console,
     _cranial_points,

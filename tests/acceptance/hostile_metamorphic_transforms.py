@@ -1,4 +1,4 @@
-"""The transformations of the metamorphic probes (``probe_hostile_metamorphic.py``): set-ups
+"""The transformations of the metamorphic probes (``hostile_metamorphic.py``): set-ups
 that change a case without changing its answer. Photos: resampled with their landmarks, mask,
 focal prior and ground truth, a canvas padded or cropped, the landmark entries permuted or
 renamed by their aliases, the mask in another PNG mode, a JPEG with or without an EXIF focal,
@@ -15,8 +15,7 @@ import re
 import shutil
 
 import numpy as np
-
-from probe_hostile_fixtures import _dump, _in, _json
+from hostile_fixtures import _dump, _in, _json
 
 # -- transformations: photos -------------------------------------------------------------------
 

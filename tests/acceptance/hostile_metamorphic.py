@@ -9,16 +9,16 @@ another order. A change beyond the tolerance is a silently wrong answer (``silen
 the same evidence gives another camera or another identification.
 
 How the answers are compared, the tolerances and the probe factory are in
-``probe_hostile_metamorphic_compare.py``; the transformations in
-``probe_hostile_metamorphic_transforms.py``; here are the checks of multi-photo and lineup
+``hostile_metamorphic_compare.py``; the transformations in
+``hostile_metamorphic_transforms.py``; here are the checks of multi-photo and lineup
 results, the probes, and the seed spread the tolerances come from (``--spread``).
 
-Inputs: the stand-in case of ``probe_hostile.py`` and the generated dataset of
-``probe_hostile_fixtures.py`` (``_syn``: subjects s01, s02, frontal and lateral photos).
+Inputs: the stand-in case of the campaign and the generated dataset of
+``hostile_fixtures.py`` (``_syn``: subjects s01, s02, frontal and lateral photos).
 83 probes, about 4 minutes on a loaded 2-core machine (most of it the Lilium probes' eight
 seeds a side). Run alone::
 
-    python benchmarks/probe_hostile_metamorphic.py --work /tmp/meta [--only TEXT] [--spread]
+    python -m pytest -m slow tests/acceptance/test_hostile_metamorphic.py [-k TEXT]
 """
 
 import re
@@ -28,9 +28,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from probe_hostile_fixtures import _dump, _in, _json, _syn  # noqa: E402
-from probe_hostile_machinery import ROOT, Probe, Workspace, _then  # noqa: E402
-from probe_hostile_metamorphic_compare import (  # noqa: E402
+from hostile_fixtures import _dump, _in, _json, _syn  # noqa: E402
+from hostile_machinery import ROOT, Probe, Workspace, _then  # noqa: E402
+from hostile_metamorphic_compare import (  # noqa: E402
     IDENTITY,
     LIL,
     LIL_FLOOR,
@@ -50,7 +50,7 @@ from probe_hostile_metamorphic_compare import (  # noqa: E402
     metrics,
     tolerances,
 )
-from probe_hostile_metamorphic_transforms import (  # noqa: E402
+from hostile_metamorphic_transforms import (  # noqa: E402
     MOTION,
     _alias_names,
     _axes_copy,
@@ -328,7 +328,9 @@ def metamorphic_probes():
 
 
 def spread(work, base):
-    """Print the seed spread of the references (Lilium, seeds 1-3, the unchanged cases)."""
+    """Print the seed spread of the references (Lilium, seeds 1-3, the unchanged cases): how the
+    tolerances of the metamorphic checks were set (``work`` a scratch folder, ``base`` the
+    stand-in case)."""
     ws = Workspace(work / "spread", base)
     _syn(ws)
     S, P = _standin_skull, _standin_photo
@@ -355,36 +357,3 @@ def spread(work, base):
         )
         for s in ws.root.glob("seed*"):
             shutil.rmtree(s)
-
-
-def _note(probe, ws, verdict, verbose):
-    """What a passing probe measured, for ``--verbose``."""
-    last = NOTES.pop("last", "")
-    return f" {last}" if verdict == "pass" and verbose and last else ""
-
-
-def _spread_first(args, base):
-    if args.spread:
-        spread(args.work, base)
-        return 0
-    return None
-
-
-def main(argv=None):
-    """Run this group alone (the same verdicts as ``probe_hostile.py``); ``--spread`` prints
-    the seed spread the tolerances come from and stops."""
-    from probe_hostile_machinery import run_group
-
-    hooks = {
-        "arguments": lambda p: p.add_argument(
-            "--spread", action="store_true", help="print the seed spread and stop"
-        ),
-        "before": _spread_first,
-    }
-    return run_group(
-        metamorphic_probes, "metamorphic", __doc__, argv, limit_s=120, note=_note, hooks=hooks
-    )
-
-
-if __name__ == "__main__":
-    sys.exit(main())

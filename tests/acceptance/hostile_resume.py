@@ -3,15 +3,15 @@ experiment``, ``lineup``, ``case`` (several photos, ``--joint``), ``synth`` and 
 
 Two kinds of probes:
 
-- :func:`resume_probes`, here, run by ``probe_hostile.py`` in its own process: a run is resumed
+- :func:`resume_probes`, here, checked by ``test_hostile_resume.py``: a run is resumed
   after what a crash leaves behind (a ``result.json`` cut in the middle, an ``overlay.png`` of 0
   bytes or missing, a WAL left over, a stale lock file) or after its inputs changed (a photo's
   landmarks, the skull's landmarks, the DE budget, the experiments). A resumed run must end as
   an uninterrupted run of the same command would (its outputs are compared with a fresh run's
   in another folder), or refuse in one line; silently keeping a stale result is ``silently
   wrong``.
-- the subprocess scenarios of ``probe_hostile_scenarios.py``, run by this file (``python
-  benchmarks/probe_hostile_resume.py --work /tmp/probesB [--only TEXT]``): subprocesses killed
+- the subprocess scenarios of ``hostile_scenarios.py``, run by this file (``python
+  benchmarks/hostile_resume.py --work /tmp/probesB [--only TEXT]``): subprocesses killed
   with SIGKILL mid-run and rerun, interrupted with SIGINT (Ctrl-C: one line, no traceback, also
   from worker processes), two runs on one ``--out`` or ``--db`` at once, and a file-size limit
   (``ulimit -f``) while writing. One line per scenario: ``pass`` or ``defect`` and why.
@@ -19,18 +19,15 @@ Two kinds of probes:
 Budgets: POSEST-SFO, or Lilium with DE 5 x 2 (in-process) and 8 x 40 (to be killed mid-run).
 """
 
-import argparse
 import json
 import shutil
 import sqlite3
-import sys
-import time
 from pathlib import Path
 
-from probe_hostile_casework import TINY, _quiet_main, _second_photo
-from probe_hostile_fixtures import SFO_FIELDS, _png_ok, _results, _sfo_fields
-from probe_hostile_machinery import Probe
-from probe_hostile_runs import BASE, _config, _exp, _in, _prior_run, _stored, _then
+from hostile_casework import TINY, _quiet_main, _second_photo
+from hostile_fixtures import SFO_FIELDS, _png_ok, _results, _sfo_fields
+from hostile_machinery import Probe
+from hostile_runs import BASE, _config, _exp, _in, _prior_run, _stored, _then
 
 # -- comparing a resumed run with a fresh one ---------------------------------------------------
 
@@ -259,33 +256,3 @@ def resume_probes():
 
 
 # fmt: on
-
-
-def main(argv=None):
-    # Imported here: the scenarios compare results with this module's functions.
-    from probe_hostile_scenarios import SCENARIOS, Scenarios
-
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--work", type=Path, required=True, help="scratch folder (emptied)")
-    parser.add_argument("--only", help="run the scenarios whose name holds this text")
-    args = parser.parse_args(argv)
-    s = Scenarios(args.work)
-    s.prepare()
-    bad = 0
-    for name, scenario in SCENARIOS:
-        if args.only and args.only not in name:
-            continue
-        start = time.monotonic()
-        try:
-            problem = scenario(s)
-        except Exception as exc:  # noqa: BLE001 - the scenario's own set-up failed
-            problem = f"scenario set-up failed: {exc!r}"
-        bad += problem is not None
-        verdict = "pass" if problem is None else f"defect: {problem}"
-        print(f"[{time.monotonic() - start:5.1f} s] {name}: {verdict}", flush=True)
-    print(f"{len(SCENARIOS)} scenarios, {bad} not passed")
-    return 1 if bad else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

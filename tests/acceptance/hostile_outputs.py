@@ -1,4 +1,4 @@
-"""Hostile-output probes, run by ``probe_hostile.py`` (issue 28): what the commands write and
+"""Hostile-output probes, tested (issue 28): what the commands write and
 where, for ``lilium case``, ``lineup``, ``sfo``, ``report`` and ``photo`` (its review page).
 
 - Hostile text reaching the HTML pages: a ``--title``, candidate names, photo folder and file
@@ -24,8 +24,8 @@ import re
 import shutil
 from html.parser import HTMLParser
 
-from probe_hostile_casework import TINY, _inputs_kept, _quiet_main, _second_photo
-from probe_hostile_machinery import Probe, _then
+from hostile_casework import TINY, _inputs_kept, _quiet_main, _second_photo
+from hostile_machinery import Probe, _then
 
 #: Runs in a browser it is loaded in: marks ``<body>`` (checked with Chromium's ``--dump-dom``).
 PWN = "<img src=x onerror=document.body.setAttribute('data-pwned',1)>"
@@ -235,8 +235,8 @@ def _exif_photo(ws):
 
 def _astronaut(name, folder=("in",)):
     def setup(ws):
-        from probe_hostile_inputs import _astronaut as face
-        from probe_hostile_inputs import _pil
+        from hostile_inputs import _astronaut as face
+        from hostile_inputs import _pil
 
         path = ws.root.joinpath(*folder, name)
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -293,7 +293,7 @@ def _swap_photo(ws):
 
 
 def _report_db(ws):
-    from probe_hostile_runs import _report_db as make
+    from hostile_runs import _report_db as make
 
     make()(ws)
 

@@ -1,4 +1,4 @@
-"""Semantic probes, run by ``probe_hostile.py`` (SPEC section 10): valid files that do not
+"""Semantic probes, tested (SPEC section 10): valid files that do not
 belong together. Every file passes its own checks (names, sizes, ranges); what is wrong is
 their relation: a landmark file of another photo, the mask of another photo or an inverted
 one, a lateral photo declared frontal (or the other side), the cranial landmarks of another
@@ -13,8 +13,8 @@ result that is right; a result is compared with the known camera of the stand-in
 generated photo (``ground_truth`` in ``photo.json``) or with the SFO of the clean input, and a
 wrong camera without a warning is ``silently wrong``.
 
-Inputs: the stand-in case of ``probe_hostile.py`` and the generated dataset of
-``probe_hostile_fixtures.py`` (``_syn``: two subjects with one frontal and one lateral photo
+Inputs: the stand-in case of the campaign and the generated dataset of
+``hostile_fixtures.py`` (``_syn``: two subjects with one frontal and one lateral photo
 each, experiment A, made once per campaign, about 5 s). Budgets: POSEST-SFO, or Lilium with
 5 x 2 where the check does not need a converged SFO.
 """
@@ -22,9 +22,8 @@ each, experiment A, made once per campaign, about 5 s). Budgets: POSEST-SFO, or 
 import shutil
 
 import numpy as np
-
-from probe_hostile_casework import TINY, _quiet_main
-from probe_hostile_fixtures import (
+from hostile_casework import TINY, _quiet_main
+from hostile_fixtures import (
     _codes,
     _dump,
     _edit_json,
@@ -41,7 +40,7 @@ from probe_hostile_fixtures import (
     _subject,
     _syn,
 )
-from probe_hostile_machinery import Probe, _then
+from hostile_machinery import Probe, _then
 
 # -- checks -----------------------------------------------------------------------------------
 

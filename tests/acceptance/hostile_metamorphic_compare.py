@@ -1,4 +1,4 @@
-"""How a metamorphic probe judges (``probe_hostile_metamorphic.py``): the command line of a
+"""How a metamorphic probe judges (``hostile_metamorphic.py``): the command line of a
 probe (:class:`Run`), the reference it is compared with, what is compared, the tolerances, and
 the probe factory :func:`metamorphic`.
 
@@ -10,7 +10,7 @@ back-projection error (BPE, mm) against the generator's ground truth of the untr
 LR and conclusion, the warnings' codes, and, for the lineups, the ranking.
 
 Tolerances, measured (2-core machine under load, 2026-12; ``--spread`` of
-``probe_hostile_metamorphic.py`` prints them again):
+``hostile_metamorphic.py`` prints them again):
 
 - POSEST-SFO is deterministic (fixed RANSAC seed): run twice, the unchanged case gives the same
   numbers to the last digit, so its "seed spread" is 0. A transformation that keeps the
@@ -46,9 +46,8 @@ import shutil
 from dataclasses import dataclass
 
 import numpy as np
-
-from probe_hostile_fixtures import _dump, _json
-from probe_hostile_machinery import Probe, Workspace, _then
+from hostile_fixtures import _dump, _json
+from hostile_machinery import Probe, Workspace, _then
 
 #: Lilium's budget in these probes (about 0.3 s an SFO here).
 LIL = ("--generations", "100", "--population", "30")

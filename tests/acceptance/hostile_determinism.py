@@ -28,24 +28,20 @@ LR-based report files (``calibration.csv``, ``tippett.png``, the LR rows of
 Budgets: 3 subjects x (2 frontal + 2 lateral) photos of Exp. A, POSEST-SFO and
 Lilium+P_skof+P_pll at DE 5 x 2 with 2 repetitions (36 + 72 SFOs a run); the campaign (its
 experiment, dataset and reference run, made once under ``det-cache/``, and the set-ups) is in
-``probe_hostile_detcampaign.py``, the comparisons of rows, report files and datasets in
-``probe_hostile_detcompare.py``; this module holds the probes, their command lines and the runs
+``hostile_detcampaign.py``, the comparisons of rows, report files and datasets in
+``hostile_detcompare.py``; this module holds the probes, their command lines and the runs
 later probes compare. ::
 
-    python benchmarks/probe_hostile_determinism.py --work /tmp/probesD [--only SUBSTRING]
+    python -m pytest -m slow tests/acceptance/test_hostile_determinism.py [-k TEXT]
 
-prints one line per probe (``--verbose``: with what was measured), the counts per verdict, and
-exits 1 when a probe did not pass.
 """
 
 import shutil
-import sys
 from pathlib import Path
 
-from probe_hostile_casework import _quiet_main
-from probe_hostile_detcampaign import (
+from hostile_casework import _quiet_main
+from hostile_detcampaign import (
     CONFIG,
-    MEASURED,
     SYNTH,
     _cache,
     _close_clusters,
@@ -61,7 +57,7 @@ from probe_hostile_detcampaign import (
     _ref_db,
     _reverse,
 )
-from probe_hostile_detcompare import (
+from hostile_detcompare import (
     ALL_BUT_TIME,
     FITNESS_FILES,
     _cohort_known_limit,
@@ -71,10 +67,10 @@ from probe_hostile_detcompare import (
     _same_outputs,
     _same_rows,
 )
-from probe_hostile_machinery import Probe, Workspace, _then
-from probe_hostile_runs import _in
+from hostile_machinery import Probe, Workspace, _then
+from hostile_runs import _in
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 # -- command lines ------------------------------------------------------------------------------
@@ -236,29 +232,3 @@ def determinism_probes():
 
 
 # fmt: on
-
-
-def _measured(probe, ws, verdict, verbose):
-    """What a probe measured: always for the known limit, for every probe with --verbose."""
-    measured = MEASURED.get(ws.root.name)
-    return f" -- {measured}" if measured and (verbose or "known limit" in probe.name) else ""
-
-
-def main(argv=None):
-    """Run this group alone (the same verdicts as ``probe_hostile.py``)."""
-    from probe_hostile_machinery import run_group
-
-    return run_group(
-        determinism_probes,
-        "determinism",
-        __doc__,
-        argv,
-        limit_s=120,
-        base=lambda folder: folder.mkdir(parents=True),  # the probes bring their own inputs
-        note=_measured,
-        hooks={"after": _close_clusters},
-    )
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,4 @@
-"""What the report probes (``probe_hostile_report.py``) read, and how: the console of the
+"""What the report probes (``hostile_report.py``) read, and how: the console of the
 ``lilium`` command a probe runs, the HTML report page (``lilium case``'s ``report.html``,
 ``lilium lineup``'s) parsed into its SFO sections, summary and conclusion rows, tables and
 pictures, and what the files of a run imply (the skull mesh projected with a ``result.json``'s
@@ -18,8 +18,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 import numpy as np
-
-from probe_hostile_fixtures import _json
+from hostile_fixtures import _json
 
 # -- the console ------------------------------------------------------------------------------
 

@@ -1,4 +1,4 @@
-"""The campaign the determinism probes (``probe_hostile_determinism.py``) share: its experiment
+"""The campaign the determinism probes (``hostile_determinism.py``) share: its experiment
 and dataset, the columns and keys that say when rather than what, the dataset and reference
 run made once, and the set-ups that copy, reorder, cut short or schedule otherwise a run.
 
@@ -13,15 +13,15 @@ the report and calibrate probes that compare them.
 import atexit
 import hashlib
 import json
-import os
 import shutil
 import sqlite3
 import subprocess
 import sys
 from pathlib import Path
 
-from probe_hostile_casework import _quiet_main
-from probe_hostile_runs import _in
+from hostile_casework import _quiet_main
+from hostile_machinery import _lilium_env
+from hostile_runs import _in
 
 #: The campaign's experiment: 3 subjects x 4 photos x 3 skulls, POSEST-SFO once and
 #: Lilium+P_skof+P_pll twice per pair (108 SFOs), no wall-clock cap.
@@ -109,7 +109,6 @@ def _ref_db(ws):
         data = _dataset_ref(ws)
         cfg = db.parent / "c.toml"
         cfg.write_text(CONFIG.format(data=data.as_posix()))
-        env = {k: v for k, v in os.environ.items() if k != "LILIUM_DEBUG"}
         proc = subprocess.run(
             [
                 sys.executable,
@@ -124,7 +123,7 @@ def _ref_db(ws):
                 "1",
             ],
             cwd=db.parent,
-            env=env,
+            env=_lilium_env(),
             capture_output=True,
             text=True,
             timeout=600,

@@ -1,13 +1,13 @@
 """Hostile-input probes of ``lilium sfo``, ``case``, ``experiment``, ``report``, ``synth``,
-``demo``, ``photo`` and ``import-ct``, run by ``probe_hostile.py`` (issue 28): broken
+``demo``, ``photo`` and ``import-ct``, tested (issue 28): broken
 ``photo.json`` files, subject folders and meshes; broken images, masks and face curves; bad
 options of ``lilium sfo`` and ``lilium case`` (depth tables, priors on the command line);
 experiment configs and result databases; bad options of ``synth`` and ``demo``; and the
 probes of ``lilium photo`` and ``lilium import-ct`` (owners ``"photo"`` and ``"ct"``: their
-fixes belong to the photo/CT work of issue 28, and ``probe_hostile.py`` counts them apart).
+fixes belong to the photo/CT work of issue 28, and the campaign counts them apart).
 
-Each probe runs on the stand-in case of ``probe_hostile.py`` (``in/subjects/standin``,
-``in/photos/standin_frontal``), with the verdicts of :func:`probe_hostile.run_probe`.
+Each probe runs on the stand-in case of the campaign (``in/subjects/standin``,
+``in/photos/standin_frontal``), with the verdicts of :func:`hostile_machinery.run_probe`.
 """
 
 import json
@@ -15,7 +15,7 @@ import sqlite3
 import struct
 import zlib
 
-from probe_hostile_machinery import Probe, _write
+from hostile_machinery import Probe, _write
 
 
 def _png_header(width, height):
@@ -267,8 +267,9 @@ generations = 2
 
 def _rows_db(change=None):
     def setup(ws):
-        from lilium.experiments.store import ResultStore
         from test_report import make_rows
+
+        from lilium.experiments.store import ResultStore
 
         path = ws.root / "in" / "r.sqlite"
         with ResultStore(path) as store:

@@ -1,5 +1,5 @@
 """The inputs and result readers the hostile probes share. For the probes of a generated case
-(the semantic, geometry, metamorphic and report groups of ``probe_hostile.py``): ``_syn``, a
+(the semantic, geometry, metamorphic and report groups of the campaign): ``_syn``, a
 copy of the campaign's generated dataset (two subjects, ``s01`` and ``s02``, with one frontal
 and one lateral photo each: experiment A, made once per campaign in ``WORK/semantic-dataset``,
 about 5 s); paths into a probe's ``in/`` folder and the stand-in case; set-ups that edit a JSON

@@ -1,5 +1,5 @@
 """Hostile-input probes of ``lilium photo``, ``lilium import-ct`` and ``lilium synth``, run by
-``probe_hostile.py`` (issue 28).
+the campaign (issue 28).
 
 Every input is generated in the probe's set-up: photos from scikit-image's astronaut (a real,
 public-domain face) with EXIF tags that lie, in every image mode, turned by each EXIF
@@ -13,8 +13,7 @@ import json
 from functools import cache
 
 import numpy as np
-
-from probe_hostile_machinery import Probe
+from hostile_machinery import Probe
 
 # -- photos -----------------------------------------------------------------------------------
 

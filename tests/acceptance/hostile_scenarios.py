@@ -1,6 +1,6 @@
-"""The subprocess scenarios of ``probe_hostile_resume.py`` (issue 28), run by it (``python
-benchmarks/probe_hostile_resume.py --work /tmp/probesB [--only TEXT]``): ``lilium experiment``,
-``lineup``, ``case`` (several photos, ``--joint``), ``synth`` and ``calibrate`` run as
+"""The subprocess scenarios of the resume campaign (issue 28), run by ``test_hostile_resume.py``
+(``python -m pytest -m slow tests/acceptance/test_hostile_resume.py -k scenario``): ``lilium
+experiment``, ``lineup``, ``case`` (several photos, ``--joint``), ``synth`` and ``calibrate`` run as
 subprocesses, killed with SIGKILL mid-run and rerun (the rerun must end as an uninterrupted
 run), interrupted with SIGINT (Ctrl-C: one line, no traceback, also from worker processes), two
 runs on one ``--out`` or ``--db`` at once, and a file-size limit (``ulimit -f``) while writing.
@@ -21,12 +21,12 @@ import sys
 import time
 from pathlib import Path
 
-from probe_hostile_fixtures import _png_ok, _results, _sfo_fields
+from hostile_fixtures import _png_ok, _results, _sfo_fields
+from hostile_machinery import _lilium_env
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 PY = sys.executable
-ENV = {k: v for k, v in os.environ.items() if k != "LILIUM_DEBUG"}
 
 
 def _lilium(args, cwd, limit_fsize=None):
@@ -36,7 +36,7 @@ def _lilium(args, cwd, limit_fsize=None):
 
         def pre():
             resource.setrlimit(resource.RLIMIT_FSIZE, (limit_fsize, limit_fsize))
-    return subprocess.Popen([PY, "-m", "lilium", *map(str, args)], cwd=cwd, env=ENV,
+    return subprocess.Popen([PY, "-m", "lilium", *map(str, args)], cwd=cwd, env=_lilium_env(),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True, preexec_fn=pre)
 
