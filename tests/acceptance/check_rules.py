@@ -13,10 +13,11 @@ the subject's true axes, and for Exp. C every perturbed axis set too):
 
 ::
 
-    python benchmarks/check_rules.py /tmp/rules-ds
+    python tests/acceptance/check_rules.py /tmp/rules-ds
 
 prints how many cases tripped each rule (errors must be 0; ``view_mismatch`` should be 0) and
-the extreme angles measured. Exits 1 when an error rule was tripped.
+the extreme angles measured. Exits 1 when an error rule was tripped. ``test_check_rules.py``
+runs it on a small generated dataset.
 """
 
 import argparse
