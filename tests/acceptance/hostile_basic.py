@@ -267,9 +267,8 @@ generations = 2
 
 def _rows_db(change=None):
     def setup(ws):
-        from test_report import make_rows
-
         from lilium.experiments.store import ResultStore
+        from report_rows import make_rows
 
         path = ws.root / "in" / "r.sqlite"
         with ResultStore(path) as store:

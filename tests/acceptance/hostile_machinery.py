@@ -184,9 +184,21 @@ def check_probe(probe, ws, limit_s=LIMIT_S):
     assert verdict == "pass", f"[{verdict}] {probe.name} ({seconds:.1f} s): {detail}"
 
 
-def probe_params(*groups):
+def probe_params(*groups, known_limits=None):
     """A ``pytest.param`` of each probe of ``groups`` (lists of :class:`Probe`), its name as
-    its id (``-k`` selects by it)."""
+    its id (``-k`` selects by it); ``known_limits``: ``{probe name: reason}`` of the probes
+    that fail on a limit docs/method.md documents and that is not mended (expected to fail,
+    not strictly: a run may land within the tolerance)."""
     import pytest
 
-    return [pytest.param(p, id=p.name) for group in groups for p in group]
+    known_limits = known_limits or {}
+    params = []
+    for group in groups:
+        for p in group:
+            marks = ()
+            if p.name in known_limits:
+                marks = pytest.mark.xfail(reason=known_limits[p.name], strict=False)
+            params.append(pytest.param(p, id=p.name, marks=marks))
+    unknown = set(known_limits) - {p.name for group in groups for p in group}
+    assert not unknown, f"known limits of no probe: {sorted(unknown)}"
+    return params

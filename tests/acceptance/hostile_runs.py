@@ -104,9 +104,8 @@ def _report_db(where="in", change=None):
     """Set-up: ``<where>/r.sqlite`` holding ``change(rows)`` of the report tests' rows."""
 
     def setup(ws):
-        from test_report import make_rows
-
         from lilium.experiments.store import ResultStore
+        from report_rows import make_rows
 
         folder = ws.root / where
         folder.mkdir(exist_ok=True)
