@@ -64,6 +64,7 @@ class Workspace:
         self.skull = self.root / "in" / "subjects" / "standin"
         self.photo = self.root / "in" / "photos" / "standin_frontal"
         self.out = self.root / "out"
+        self.console = None  # (stdout, stderr) of the probe's command, once it ran
 
     def sfo(self, *extra, method="posest-sfo"):
         return ["sfo", "--skull", self.skull, "--photo", self.photo, "--out", self.out]
@@ -126,6 +127,7 @@ def run_probe(probe, ws, limit_s=LIMIT_S):
     except subprocess.TimeoutExpired:
         return "hang", time.monotonic() - start, f"over {limit_s} s"
     seconds = time.monotonic() - start
+    ws.console = (done.stdout, done.stderr)  # for the checks that read what it printed
     code, text = done.returncode, done.stderr
     lines = [ln for ln in text.splitlines() if ln.strip()]
     last = lines[-1] if lines else ""

@@ -40,7 +40,7 @@ from hostile_reportcheck import (  # noqa: E402
     _console_problems,
     _report_consistent,
 )
-from hostile_reportpage import _arm, _console, _install  # noqa: E402
+from hostile_reportpage import _arm, _console  # noqa: E402
 from hostile_semantic import _invert_mask, _view  # noqa: E402
 
 # -- lineups ----------------------------------------------------------------------------------
@@ -366,7 +366,6 @@ def _armed(*setups):
 
 def report_probes():
     """Report, console and result.json against each other (module docstring)."""
-    _install()
     L = ("lilium",)
     PL = ("posest-sfo", "lilium")
     syn = lambda *s: _armed(_syn, *s)  # noqa: E731

@@ -4,15 +4,13 @@
 pictures, and what the files of a run imply (the skull mesh projected with a ``result.json``'s
 camera, the box it covers on the photo).
 
-The console is captured by wrapping :func:`lilium.cli.main.main` while a probe runs (the set-up
-arms it with :func:`_arm`; nothing else changes); :func:`_console` gives what it printed.
+The console is what the probe's ``lilium`` process printed (recorded on the workspace by
+:func:`hostile_machinery.run_probe`); :func:`_console` gives it.
 """
 
 import base64
-import importlib
 import io
 import re
-import sys
 import urllib.parse
 from html.parser import HTMLParser
 from pathlib import Path
@@ -22,40 +20,16 @@ from hostile_fixtures import _json
 
 # -- the console ------------------------------------------------------------------------------
 
-_ARMED = []
-
-
-def _recording_main(argv=None):
-    """:func:`lilium.cli.main.main`, recording the streams it prints to on the armed workspace."""
-    module = importlib.import_module("lilium.cli.main")
-    ws = _ARMED.pop() if _ARMED else None
-    if ws is not None:
-        ws.console = (sys.stdout, sys.stderr)
-    return module._report_probe_real_main(argv)
-
-
-def _install():
-    """Wrap :func:`lilium.cli.main.main` (once): ``run_probe`` imports it before the set-up
-    runs, so the wrapper is in place when the probes are made. Transparent when not armed."""
-    module = importlib.import_module("lilium.cli.main")
-    if not hasattr(module, "_report_probe_real_main"):
-        module._report_probe_real_main = module.main
-        module.main = _recording_main
-
 
 def _arm(ws):
-    """Set-up (last step): the next ``lilium`` command records its console on ``ws``."""
-    _install()
-    _ARMED.clear()
-    _ARMED.append(ws)
+    """Set-up (last step): forget any console recorded before the probe's command (the
+    command's own is recorded on ``ws`` by :func:`hostile_machinery.run_probe`)."""
     ws.console = None
 
 
 def _console(ws):
-    streams = getattr(ws, "console", None)
-    if not streams:
-        return "", ""
-    return tuple(s.getvalue() if isinstance(s, io.StringIO) else "" for s in streams)
+    """``(stdout, stderr)`` of the probe's command."""
+    return getattr(ws, "console", None) or ("", "")
 
 
 # -- the page ---------------------------------------------------------------------------------
