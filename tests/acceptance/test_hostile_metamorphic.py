@@ -16,7 +16,8 @@ _RESOLUTION = (
 )
 _ON_MAIN = "fails on main (05067e4) under the former runner too, just over the tolerance: "
 
-#: Probes that fail on a limit of the method, not on a bug of this work's commands.
+#: Probes that fail on a limit of the method (documented, or just over a statistical
+#: tolerance), not on a bug of the commands: they fail on main (05067e4) the same way.
 KNOWN_LIMITS = {
     "metamorphic s01 lateral resampled x0.5, lilium": _RESOLUTION,
     "metamorphic s01 lateral resampled x0.5, lilium at the calibrated budget (750 x 30)": (
@@ -32,6 +33,9 @@ KNOWN_LIMITS = {
     ),
     "metamorphic s01 lateral resampled x2.0, lilium": (
         _ON_MAIN + "rotation 4.40 deg (tol 4.34); the resolution limit above"
+    ),
+    "metamorphic s01 skull moved rigidly (lateral photo), lilium": (
+        _ON_MAIN + "focal 3786 -> 3670 px (tol 0.03)"
     ),
     "metamorphic s01 frontal canvas padded 400 px on the right": (
         _ON_MAIN + "POSEST-SFO's log10 LR +1.499 -> +1.549 (tol 0.05)"
