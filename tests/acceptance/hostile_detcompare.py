@@ -10,6 +10,7 @@ import csv
 import hashlib
 import json
 import math
+import re
 import sqlite3
 from pathlib import Path
 
@@ -29,6 +30,11 @@ from hostile_runs import _in
 # -- comparisons ------------------------------------------------------------------------------
 
 
+#: The campaign's dataset and its copies (``det-cache/dataset``, ``det-cache/data/<kind>``) in a
+#: stored message (a warning naming a photo's file): each run names the copy it ran on.
+_DATASET_COPY = re.compile(r"det-cache/(?:dataset|data/[^/]+)/")
+
+
 def _load(db):
     conn = sqlite3.connect(f"file:{db}?mode=ro", uri=True)
     conn.row_factory = sqlite3.Row
@@ -40,7 +46,8 @@ def _load(db):
 
     out = {}
     for r in rows:
-        r["result"] = json.loads(r["result"]) if r["result"] else None
+        text = _DATASET_COPY.sub("det-cache/<dataset>/", r["result"]) if r["result"] else None
+        r["result"] = json.loads(text) if text else None
         out[tuple(r[c] for c in KEY_COLUMNS)] = r
     return out
 
