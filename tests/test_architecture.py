@@ -14,7 +14,6 @@ LAYERS = {
     "constants": 0,
     "validation": 0,
     "jit": 0,
-    "jit_signatures": 0,
     "workers": 0,
     "geometry": 1,
     "optimisation": 1,
@@ -142,3 +141,22 @@ def test_the_compiled_curve_index_does_not_import_scipy_spatial():
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     ).stdout
     assert out.strip() == "False", out
+
+
+#: Test folders that are not a subpackage of lilium: the benchmark cases' tests, the slow
+#: acceptance campaign of every command (and its snapshot data).
+OTHER_TEST_FOLDERS = {"benchmarks", "acceptance"}
+
+
+def test_tests_mirror_the_package():
+    """Each test folder is named after the subpackage it tests (tests of the top-level modules
+    sit in tests/ itself), and no two test modules share a name: without ``__init__.py`` files
+    pytest imports each by its base name."""
+    tests = Path(__file__).resolve().parent
+    subpackages = {p.parent.name for p in ROOT.glob("*/__init__.py")}
+    folders = {p.name for p in tests.iterdir() if p.is_dir() and not p.name.startswith((".", "__"))}
+    assert folders - subpackages - OTHER_TEST_FOLDERS == set()
+    names = [p.name for p in tests.rglob("test_*.py")]
+    assert sorted({n for n in names if names.count(n) > 1}) == []
+    for path in tests.glob("test_*.py"):
+        assert path.stem.removeprefix("test_").split("_")[0] not in subpackages, path.name

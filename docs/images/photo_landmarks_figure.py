@@ -2,7 +2,7 @@
 
     cd docs/images && PYTHONPATH=../../src:../../tests python photo_landmarks_figure.py out.png
 
-The faces of both public-domain portraits of ``tests/test_photo_accuracy.py`` (scikit-image's
+The faces of both public-domain portraits of ``tests/photo/test_photo_accuracy.py`` (scikit-image's
 astronaut, Matplotlib's Grace Hopper), enlarged: green rings = the hand marks of its ``HAND``
 table (eyes, nose, mouth, chin, zygion, gonion), red dots = tracked automatic landmarks, blue
 dots = template ones, each joined to its hand mark by a thin line.

@@ -7,7 +7,7 @@ tissue, 1 mm voxels with partial volume, Gaussian blur sigma 0.7 mm, noise 15 HU
 - **Hounsfield units**: bone 300 HU puts the outer bone surface 0.4-0.6 mm outside the truth
   and keeps plates 0.8 mm thin closed (400 HU starts to open them, 500 HU loses them: thin
   orbital and maxillary walls); skin -400 HU is within 0.2 mm of the air/skin boundary (-500 HU
-  is the half-way level, -200 HU sits 0.6 mm inside). ``tests/test_ct_frame.py`` checks both.
+  is the half-way level, -200 HU sits 0.6 mm inside). ``tests/ct/test_ct_frame.py`` checks both.
 - **Scanner units** (air near 0, water near 1000; VTK's ``headsq``): bone 1150, skin 500, the
   classic levels of VTK's head example.
 

@@ -3,7 +3,7 @@
 Mutation, exponential crossover and folding into the cube of a whole population in one pass, from
 the same random draws as the numpy path (:func:`~lilium.optimisation.de.distinct_others`'s keys,
 the crossover's start genes and run lengths), with the same arithmetic element by element: the
-two paths give the same trials bit for bit (``tests/test_de.py``).
+two paths give the same trials bit for bit (``tests/optimisation/test_de.py``).
 """
 
 import numpy as np

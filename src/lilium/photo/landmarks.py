@@ -1,7 +1,7 @@
 """docs/method/skull.md facial landmarks from MediaPipe's 468-point face mesh.
 
 Each landmark is one mesh vertex, chosen by where the vertex lies on the mesh's own topology
-and checked on real portraits against points placed by hand (``tests/test_photo_accuracy.py``,
+and checked on real portraits against points placed by hand (``tests/photo/test_photo_accuracy.py``,
 ``docs/method/photo.md``). ``"tracked"`` points sit on image evidence the model follows (eye
 corners, the alar wings, the nostril base, the lip border, the mouth corners); ``"template"``
 points are where the model's face template puts them (nasion, glabella and the forehead, the

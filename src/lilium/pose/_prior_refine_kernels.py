@@ -7,7 +7,7 @@ with the same unknowns, residuals (the reprojection errors of
 hinges), Jacobian, damping updates and stopping tests, so every problem takes the same steps.
 As in :mod:`lilium.pose._refine_kernels`, the 7 x 7 system is solved by Gaussian elimination
 (a singular system is a rejected step, where numpy turns to a pseudo-inverse) and sums run in a
-fixed order: results agree with the numpy path to rounding (``tests/test_prior_refine.py``).
+fixed order: results agree with the numpy path to rounding (``tests/pose/test_prior_refine.py``).
 A prior is switched off by NaN bounds (NaN ``tol`` for the head orientation).
 """
 
