@@ -439,7 +439,9 @@ def synth_probes():
         Probe("synth --photos 2.5", _synth("--photos", "2.5"), "error", ("--photos",)),
         Probe("synth --seed -1", _synth("--seed", "-1"), "error", ("--seed",)),
         Probe("synth --seed 2^64", _synth("--seed", str(2**64)), "error", ("--seed",)),
-        Probe("synth --workers 0", _synth("--workers", "0"), "error", ("--workers",)),
+        Probe("synth --workers -1", _synth("--workers", "-1"), "error", ("--workers",)),
+        # 0: one worker per core, as lilium experiment's --workers (cli.options)
+        Probe("synth --workers 0", _synth("--workers", "0"), "ok", ()),
         Probe("synth --experiments X", _synth("--experiments", "X"), "error", ("--experiments", "X")),  # noqa: E501
         Probe("synth --experiments empty", _synth("--experiments", ","), "error", ("--experiments",)),  # noqa: E501
         Probe("synth --experiments A,A", _synth("--experiments", "A,A"), "error", ("--experiments", "twice")),  # noqa: E501
