@@ -52,6 +52,12 @@ HEAD_BEYOND_FACE = 0.2
 #: face mesh. Measured on the prints of benchmarks/studies/head_mask_prints.py: without the
 #: band the crop pass adds background beside the head (28 % outside on the colour astronaut).
 HEAD_CROP_HALF = 1.6
+#: A head mask reaches at least this many face heights above the nasion (or the photo's edge,
+#: where the frame cuts the head): the vertex lies about 0.9 face heights above it, the face
+#: outline alone reaches 0.40-0.50; complete masks on the measured prints reach 0.72-1.24 (0.72:
+#: Hopper's crop, whose frame cuts her cap), the whole Hopper scanned print without the crown
+#: pass 0.76. Lower, the mask misses the head's top (:func:`reaches_head_top`).
+HEAD_TOP_ABOVE_NASION = 0.6
 HEAD_CROP_RAISE = 0.3
 
 
@@ -230,10 +236,46 @@ def head_share_beyond_face(
     return float(np.count_nonzero(mask & ~face & above_jaw) / max(1, np.count_nonzero(face)))
 
 
+def reaches_head_top(mask, mesh_uv, nasion_index=168, gnathion_index=152):
+    """Whether the mask reaches :data:`HEAD_TOP_ABOVE_NASION` face heights above the nasion, up
+    the face's axis (or, nearer, the photo's edge on that line).
+
+    Parameters
+    ----------
+    mask : ndarray of shape (H, W), bool
+    mesh_uv : ndarray of shape (468, 2+)
+        Face mesh in image pixels.
+
+    Returns
+    -------
+    bool
+    """
+    mask = np.asarray(mask, dtype=bool)
+    mesh = np.asarray(mesh_uv, dtype=float)[:, :2]
+    face_height, down = _face_geometry(mesh, nasion_index, gnathion_index)
+    nasion = mesh[nasion_index]
+    v, u = np.nonzero(mask)
+    if len(u) == 0:
+        return False
+    reach = -float(np.min((u - nasion[0]) * down[0] + (v - nasion[1]) * down[1]))
+    # The photo's edge up the face's axis from the nasion (pixel centres span 0 .. side - 1).
+    h, w = mask.shape
+    to_edge = np.inf
+    for d, x, side in ((-down[0], nasion[0], w), (-down[1], nasion[1], h)):
+        if d > 1e-9:
+            to_edge = min(to_edge, (side - 1 - x) / d)
+        elif d < -1e-9:
+            to_edge = min(to_edge, -x / d)
+    return reach >= min(HEAD_TOP_ABOVE_NASION * face_height, to_edge - 1.0)
+
+
 def is_head_mask(mask, mesh_uv):
-    """Whether the mask holds the head as seen (hair, ears) rather than the face outline alone:
-    :func:`head_share_beyond_face` at least :data:`HEAD_BEYOND_FACE`."""
-    return head_share_beyond_face(mask, mesh_uv) >= HEAD_BEYOND_FACE
+    """Whether the mask holds the head as seen (hair, ears) rather than the face outline alone
+    or a part of the head: :func:`head_share_beyond_face` at least :data:`HEAD_BEYOND_FACE` and
+    :func:`reaches_head_top`."""
+    return head_share_beyond_face(mask, mesh_uv) >= HEAD_BEYOND_FACE and reaches_head_top(
+        mask, mesh_uv
+    )
 
 
 def polygon_mask(outline_uv, size_wh):
