@@ -103,3 +103,55 @@ def test_lilium_photo_says_when_it_found_only_the_face(tmp_path, monkeypatch, ca
     meta = json.loads((out / "photo.json").read_text())
     assert meta["face_mask_is_head"] is True
     assert "head_mask_face_only" not in [w["code"] for w in meta.get("warnings", ())]
+
+
+def test_lilium_photo_says_when_the_mask_misses_the_head_top(tmp_path, monkeypatch, capsys):
+    """A head mask with hair and ears but cut 0.4 face heights above the nasion (as the whole
+    Hopper portrait's scanned print lost her dark cap before the crown pass, issue 55) is more
+    than the face outline, yet misses the head's top: photo.json marks it
+    ``face_mask_is_head: false`` with ``head_mask_face_only``, saying the mask stops below the
+    head's top."""
+    pytest.importorskip("ai_edge_litert")
+    from skimage import data
+
+    from lilium.photo import analysis, mask
+
+    Image.fromarray(data.astronaut()).save(tmp_path / "a.png")
+    real = analysis.segmented_head_mask
+
+    def cut_top(image, mesh_xyz):
+        head = real(image, mesh_xyz)
+        nasion, chin = mesh_xyz[168, :2], mesh_xyz[152, :2]
+        top = nasion[1] - 0.4 * np.linalg.norm(chin - nasion)
+        head[: int(np.ceil(top))] = False
+        assert mask.head_share_beyond_face(head, mesh_xyz) >= mask.HEAD_BEYOND_FACE
+        return head
+
+    monkeypatch.setattr(analysis, "segmented_head_mask", cut_top)
+    out = tmp_path / "photo"
+    assert main(["photo", str(tmp_path / "a.png"), "--out", str(out)]) == 0
+    meta = json.loads((out / "photo.json").read_text())
+    assert meta["face_mask_is_head"] is False
+    (warning,) = [w for w in meta["warnings"] if w["code"] == "head_mask_face_only"]
+    assert "stops below the head's top" in warning["message"]
+    assert "warning head_mask_face_only" in capsys.readouterr().err
+
+
+def test_reaches_head_top_where_the_frame_cuts_the_head():
+    """A mask that reaches the photo's top edge reaches the head's top as seen, however near the
+    nasion the edge is; one that stops short of both does not."""
+    from lilium.photo.mask import HEAD_TOP_ABOVE_NASION, reaches_head_top
+
+    mesh = np.zeros((468, 2))
+    mesh[168], mesh[152] = (50.0, 30.0), (50.0, 130.0)  # nasion, gnathion: face height 100 px
+    head = np.zeros((200, 100), bool)
+    head[0:140, 20:80] = True  # up to the top edge, 30 px above the nasion
+    assert reaches_head_top(head, mesh)
+    head[:2] = False
+    assert not reaches_head_top(head, mesh)
+    mesh[:, 1] += 100  # nasion at row 130: the edge is 1.3 face heights up
+    head[:] = False
+    head[130 - int(HEAD_TOP_ABOVE_NASION * 100) : 240, 20:80] = True
+    assert reaches_head_top(head, mesh)
+    head[: 130 - int(HEAD_TOP_ABOVE_NASION * 100) + 5] = False
+    assert not reaches_head_top(head, mesh)

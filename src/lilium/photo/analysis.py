@@ -8,7 +8,7 @@ import numpy as np
 from . import runtime
 from .headpose import euler_deg, face_rotation_face2cam
 from .landmarks import mesh_to_landmarks
-from .mask import head_mask, segmentation_input
+from .mask import head_crop_box, head_mask, segmentation_input
 
 #: Smallest face (detection box side, pixels) the mesh model is trusted on.
 MIN_FACE_PX = 40
@@ -296,7 +296,7 @@ def analyse_face(image, face=None, faces=None):
     irises = runtime.iris(image, mesh)
     iris_px = float(np.mean([2 * r for _, r in irises.values()]))
     interpupillary = float(np.linalg.norm(irises["left"][0] - irises["right"][0]))
-    mask = head_mask(runtime.person_mask(segmentation_input(image)), mesh)
+    mask = segmented_head_mask(image, mesh)
     return FaceAnalysis(
         mesh_xyz=mesh,
         landmarks=landmarks,
@@ -311,6 +311,17 @@ def analyse_face(image, face=None, faces=None):
         interpupillary_px=interpupillary,
         head_width_px=mesh_width_px(mesh),
     )
+
+
+def segmented_head_mask(image, mesh_xyz):
+    """:func:`.mask.head_mask` from two person segmentations of :func:`.mask.segmentation_input`:
+    the whole photo, and the crop around the head (:func:`.mask.head_crop_box`)."""
+    seg = segmentation_input(image)
+    u0, v0, u1, v1 = head_crop_box(mesh_xyz, image.shape[:2])
+    crown = np.zeros(image.shape[:2], np.float32)
+    if u1 > u0 and v1 > v0:
+        crown[v0:v1, u0:u1] = runtime.person_mask(np.ascontiguousarray(seg[v0:v1, u0:u1]))
+    return head_mask(runtime.person_mask(seg), mesh_xyz, crown_prob=crown)
 
 
 def mesh_width_px(mesh_xyz):

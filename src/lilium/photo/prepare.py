@@ -28,7 +28,13 @@ from .analysis import analyse_face, find_faces, upright_turns
 from .folder import PREPARED_BY, check_image_path, check_photo_not_output, claim_folder
 from .headpose import implausible_distance, iris_distance_mm
 from .landmarks import mesh_face_curves
-from .mask import is_head_mask, mask_outline, polygon_mask
+from .mask import (
+    HEAD_BEYOND_FACE,
+    head_share_beyond_face,
+    is_head_mask,
+    mask_outline,
+    polygon_mask,
+)
 from .profile import profile_of_photo
 from .review import read_head_outline, review_page
 
@@ -138,13 +144,19 @@ def _priors(image_path, analysis, sensor_width_mm):
     return priors, warnings
 
 
-def _face_only_warning(image_path):
+def _face_only_warning(image_path, partial=False):
+    found = (
+        "the head mask stops below the head's top (a dark cap or hair on a dark background?): "
+        "face_mask.png holds only part of the head"
+        if partial
+        else "no head was found around the face (a faded, tinted or low-contrast print?): "
+        "face_mask.png is the face outline alone, without hair and ears"
+    )
     return {
         "code": "head_mask_face_only",
-        "message": f"{image_path}: no head was found around the face (a faded, tinted or "
-        "low-contrast print?): face_mask.png is the face outline alone, without hair and ears; "
-        "a case does not count the skull above the eye corners as outside it. Draw the head's "
-        "outline in review.html and pass the saved file with --landmarks",
+        "message": f"{image_path}: {found}; a case does not count the skull above the eye "
+        "corners as outside it. Draw the head's outline in review.html and pass the saved file "
+        "with --landmarks",
     }
 
 
@@ -258,11 +270,14 @@ def prepare_photo(
     head = analysis.mask if analysis else (profile_mask if profile else None)
     if outline_px is not None:  # the reviewed outline: the user's head
         head = polygon_mask(outline_px, (w, h))
-    head_is_head = outline_px is not None or bool(profile) or (
-        bool(analysis) and is_head_mask(head, analysis.mesh_xyz)
+    head_is_head = (
+        outline_px is not None
+        or bool(profile)
+        or (bool(analysis) and is_head_mask(head, analysis.mesh_xyz))
     )
     if head is not None and not head_is_head:
-        warnings.append(_face_only_warning(image_path))
+        partial = head_share_beyond_face(head, analysis.mesh_xyz) >= HEAD_BEYOND_FACE
+        warnings.append(_face_only_warning(image_path, partial))
     curves = mesh_face_curves(analysis.mesh_xyz, (w, h)) if analysis else {}
     meta = {
         "prepared_by": PREPARED_BY,
