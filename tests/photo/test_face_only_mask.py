@@ -18,8 +18,8 @@ def _face_only_folder(case, tmp_path, is_head, landmarks=None):
 
     from scipy import ndimage as ndi
 
+    from lilium.casework.build import read_skull
     from lilium.imaging.raster import mesh_mask
-    from lilium.io.case import read_skull
     from lilium.io.truth import read_ground_truth
 
     subject_dir, photo_dir = case

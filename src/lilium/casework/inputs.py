@@ -22,8 +22,6 @@ from ..io.case import (
     photo_from_files,
     read_mask,
     read_photo,
-    read_skull,
-    skull_from_files,
     subject_files,
 )
 from ..io.curves import read_face_curve
@@ -33,6 +31,7 @@ from ..io.paths import safe_id
 from ..io.prepared import read_prepared
 from ..methods.photo_checks import check_distinct_photos, check_landmarks_in_mask
 from ..validation import check_prior, fmt_range
+from .build import read_skull, skull_from_files
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 from .request import PriorOverrides
 

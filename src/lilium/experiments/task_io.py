@@ -20,7 +20,7 @@ _DROPPED_RESULT_KEYS = ("history", "genes")
 @functools.lru_cache(maxsize=SKULL_CACHE)
 def task_skull(subject_dir, axes_file):
     """A subject's skull with one axes file (``None``: its own axes), cached per process."""
-    from ..io.case import read_skull
+    from ..casework.build import read_skull
 
     if axes_file is not None and not os.path.isfile(axes_file):
         # Checked before the run too; a file gone since is an error row, never a success with

@@ -9,26 +9,21 @@ from pathlib import Path
 import numpy as np
 
 from ..constants import (
-    MIN_CRANIAL_EXTENT_FRACTION,
     MIN_LANDMARK_EXTENT_FRACTION,
     MIN_LANDMARK_EXTENT_PX,
     MIN_LANDMARK_SPREAD_RATIO,
     MIN_PHOTO_SIDE_PX,
-    PART_APART_MM,
     VIEWS,
 )
-from ..geometry.mesh import compact, parts_apart, point_surface_distance
-from ..inputs import CaseWarning, Photo, Priors, Skull
+from ..inputs import Photo, Priors
 from ..softtissue.depths import DepthStats, check_depth_table
-from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from ..softtissue.normals import landmark_normals
 from ..validation import check_prior, is_real
 from .curves import read_face_curve
 from .formats import find_landmark_file, points_from_object, read_landmarks
 from .images import image_size_wh, read_image, read_mask
 from .jsonio import read_json
 from .keys import json_type, unknown_key_warnings
-from .mesh import MESH_SUFFIXES, read_mesh
+from .mesh import MESH_SUFFIXES
 from .paths import path_id, safe_id
 from .prepared import (
     _without_unconfirmed_templates,
@@ -39,6 +34,8 @@ from .prepared import (
 
 __all__ = [
     "IMAGE_NAMES",
+    "check_axes_file",
+    "check_folder",
     "check_in_image",
     "check_landmark_layout",
     "parse_priors",
@@ -48,8 +45,8 @@ __all__ = [
     "read_image",
     "read_mask",
     "read_photo",
-    "read_skull",
-    "skull_from_files",
+    "parse_axes",
+    "parse_cranial_landmarks",
 ]
 
 IMAGE_NAMES = ("image.png", "image.jpg", "image.jpeg")
@@ -62,7 +59,8 @@ def _find(folder, stems_or_names, what, fix):
     raise ValueError(f"{folder}: no {what} ({' or '.join(stems_or_names)}); {fix}")
 
 
-def _check_folder(folder, kind):
+def check_folder(folder, kind):
+    """``folder`` as a Path; a ``ValueError`` when it is not a folder."""
     folder = Path(folder)
     if not folder.is_dir():
         raise ValueError(f"{folder}: {kind} folder not found")
@@ -104,37 +102,6 @@ def subject_files(folder):
     return mesh_path, lm_path
 
 
-def read_skull(folder, axes_path=None, landmarks_path=None):
-    """Read a subject (skull) folder.
-
-    Parameters
-    ----------
-    folder : str or Path
-        Holds ``skull.ply`` (or ``.obj``/``.stl``), ``cranial_landmarks.json`` and optionally
-        ``soft_tissue_axes.json``.
-    axes_path : str or Path, optional
-        Soft-tissue axes file to use instead of the folder's own (e.g. a perturbed set); it
-        must exist (a missing file is an error, never a silent fall-back to the normals).
-    landmarks_path : str or Path, optional
-        Cranial landmark file to use instead of the folder's own (any supported format).
-
-    Returns
-    -------
-    Skull
-        Axes missing from the file default to the outward skull-surface normal. Its id is the
-        folder's name (:func:`lilium.io.paths.path_id`).
-    """
-    folder = _check_folder(folder, "subject")
-    mesh_path, lm_path = subject_files(folder)
-    if landmarks_path is not None:
-        lm_path = Path(landmarks_path)
-    if axes_path is not None:
-        check_axes_file(axes_path)
-    else:
-        axes_path = folder / "soft_tissue_axes.json"
-    return skull_from_files(mesh_path, lm_path, axes_path, skull_id=path_id(folder, "skull"))
-
-
 def check_axes_file(axes_path, option="soft-tissue axes file"):
     """Raise a ``ValueError`` naming ``axes_path`` when an explicitly given axes file is not a file.
 
@@ -149,90 +116,24 @@ def check_axes_file(axes_path, option="soft-tissue axes file"):
         )
 
 
-def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
-    """A :class:`Skull` from a mesh file and a landmark file of any supported format.
-
-    Parameters
-    ----------
-    mesh_path : str or Path
-        PLY, OBJ or STL (millimetres).
-    landmarks_path : str or Path
-        ``cranial_landmarks.json`` (docs/contract.md), or any file
-        :func:`lilium.io.formats.read_landmarks` reads (3D Slicer, MeshLab, CSV, JSON; aliases).
-    axes_path : str or Path, optional
-        ``soft_tissue_axes.json``; absent axes default to the outward skull-surface normal.
-    skull_id : str, optional
-        Defaults to the mesh's folder name for ``skull.*`` and to the mesh's stem otherwise;
-        made a safe folder name either way (:func:`lilium.io.paths.safe_id`).
-    """
-    mesh_path, lm_path = Path(mesh_path), Path(landmarks_path)
-    if skull_id is None:
-        skull_id = (
-            path_id(mesh_path.parent, "skull") if mesh_path.stem == "skull" else mesh_path.stem
-        )
-    skull_id = safe_id(skull_id, "skull")
-    vertices, faces = read_mesh(mesh_path)
+def parse_cranial_landmarks(landmarks_path):
+    """The cranial landmarks of a ``cranial_landmarks.json`` or of any file
+    :func:`lilium.io.formats.read_landmarks` reads, as parsed: dict of str -> ndarray (3,), mm."""
+    lm_path = Path(landmarks_path)
     if lm_path.name == "cranial_landmarks.json" or not lm_path.is_file():
         raw = _field(lm_path, read_json(lm_path), "landmarks")
-        landmarks = points_from_object(lm_path, "landmarks", raw, "cranial")
-    else:
-        landmarks = read_landmarks(lm_path, "cranial")
-    vertices, faces, warnings = _skull_part(mesh_path, vertices, faces, landmarks)
-    extent = np.ptp(vertices, axis=0).max()
-    _check_on_mesh(lm_path, landmarks, vertices, faces, 0.1 * extent)
-    check_landmark_layout(lm_path, landmarks, extent * MIN_CRANIAL_EXTENT_FRACTION, "mm")
-    axes = {}
+        return points_from_object(lm_path, "landmarks", raw, "cranial")
+    return read_landmarks(lm_path, "cranial")
+
+
+def parse_axes(axes_path):
+    """The soft-tissue axes of ``soft_tissue_axes.json`` as given (not normalised): dict of
+    str -> ndarray (3,); empty when ``axes_path`` is None or not a file."""
     axes_path = Path(axes_path) if axes_path else None
-    if axes_path is not None and axes_path.is_file():
-        raw = _field(axes_path, read_json(axes_path), "axes")
-        axes_raw = points_from_object(axes_path, "axes", raw, "cranial", allow_empty=True)
-        for name, a in axes_raw.items():
-            norm = np.linalg.norm(a)
-            if norm == 0:
-                raise ValueError(f"{axes_path}: axes.{name} is the zero vector; give a direction")
-            axes[name] = a / norm
-    missing = [n for n in landmarks if n not in axes and n in CRANIAL_TO_FACIAL]
-    if missing:
-        axes.update(landmark_normals(vertices, faces, {n: landmarks[n] for n in missing}))
-    return Skull(skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings))
-
-
-def _skull_part(mesh_path, vertices, faces, landmarks):
-    """The mesh without the parts apart from its cranial landmarks' part (:data:`PART_APART_MM`)
-    and without unreferenced vertices; and the warning that names what was left out."""
-    apart, parts = parts_apart(vertices, faces, np.array(list(landmarks.values())), PART_APART_MM)
-    warnings = []
-    if parts:
-        faces = faces[~apart]
-        sizes = "; ".join(f"{n} faces, {gap:.0f} mm away" for n, gap in parts[:3])
-        more = f"; and {len(parts) - 3} more" if len(parts) > 3 else ""
-        warnings.append(
-            CaseWarning(
-                "mesh_part_left_out",
-                f"{mesh_path}: {len(parts)} fragment(s) of the mesh lie apart from the skull (the "
-                f"part holding its cranial landmarks) and are left out ({sizes}{more}); delete "
-                "them from the mesh if they are not this skull's bone",
-            )
-        )
-    vertices, faces = compact(vertices, faces)
-    return vertices, faces, warnings
-
-
-def _check_on_mesh(lm_path, landmarks, vertices, faces, tolerance_mm):
-    """Raise when a cranial landmark lies farther than ``tolerance_mm`` from the skull's surface
-    (its triangles, not only its vertices: a coarse mesh has vertices far apart)."""
-    sample = vertices[:: max(1, len(vertices) // 20_000)]  # a CT skull's: a sample first
-    for name, p in landmarks.items():
-        gap = np.min(np.linalg.norm(sample - p, axis=1))  # >= the whole mesh's gap
-        if gap > tolerance_mm:
-            gap = np.min(np.linalg.norm(vertices - p, axis=1))
-        if gap > tolerance_mm:
-            gap = point_surface_distance(p[None], vertices, faces)[0]
-        if gap > tolerance_mm:
-            raise ValueError(
-                f"{lm_path}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
-                "must be in the mesh's frame and units"
-            )
+    if axes_path is None or not axes_path.is_file():
+        return {}
+    raw = _field(axes_path, read_json(axes_path), "axes")
+    return points_from_object(axes_path, "axes", raw, "cranial", allow_empty=True)
 
 
 def _interval(path, priors, key):
@@ -300,7 +201,7 @@ def read_photo(folder, load_image=True):
     ValueError
         Every problem of docs/checks.md, naming the file, the field and the fix.
     """
-    folder = _check_folder(folder, "photo")
+    folder = check_folder(folder, "photo")
     image_path = _find(folder, IMAGE_NAMES, "photo image", "put the photograph there")
     images = [name for name in IMAGE_NAMES if (folder / name).is_file()]
     if len(images) > 1:  # which one the landmarks belong to is unknown
