@@ -19,9 +19,7 @@ from ..inputs import CaseWarning
 from ..io.case import (
     IMAGE_NAMES,
     check_axes_file,
-    photo_from_files,
     read_mask,
-    read_photo,
     subject_files,
 )
 from ..io.curves import read_face_curve
@@ -31,7 +29,7 @@ from ..io.paths import safe_id
 from ..io.prepared import read_prepared
 from ..methods.photo_checks import check_distinct_photos, check_landmarks_in_mask
 from ..validation import check_prior, fmt_range
-from .build import read_skull, skull_from_files
+from .build import photo_from_files, read_photo, read_skull, skull_from_files
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 from .request import PriorOverrides
 
@@ -128,8 +126,9 @@ def _check_interval(values, option, key):
     return None if values is None else check_prior(values, key, f"command line: {option}")
 
 
-def load_photos(sources, priors=PriorOverrides(), log=None, skull=None, auto_landmarks=False,
-                out=None):
+def load_photos(
+    sources, priors=PriorOverrides(), log=None, skull=None, auto_landmarks=False, out=None
+):
     """Read every photo (folders and image files) with its priors.
 
     Parameters

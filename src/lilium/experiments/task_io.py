@@ -55,7 +55,7 @@ def facial_truth(subject_dir):
 def task_photo(photo_dir):
     """The photo and its :class:`~lilium.io.truth.GroundTruth` (without the 3D landmarks),
     cached per process."""
-    from ..io.case import read_photo
+    from ..casework.build import read_photo
     from ..io.truth import read_ground_truth
 
     return read_photo(photo_dir, load_image=False), read_ground_truth(photo_dir)
