@@ -232,6 +232,7 @@ def photo_from_files(
     priors=None,
     photo_id=None,
     load_image=True,
+    face_curve_path=None,
 ):
     """A :class:`Photo` from an image file and a facial landmark file of any supported format.
 
@@ -249,6 +250,10 @@ def photo_from_files(
     photo_id : str, optional
         Defaults to the image's stem; made a safe folder name either way
         (:func:`lilium.io.paths.safe_id`).
+    load_image : bool
+        Keep the pixels (for overlays); without them only the image's header is read.
+    face_curve_path : str or Path, optional
+        Facial curve (``face_curve.json`` format, :func:`lilium.io.curves.read_face_curve`).
     """
     image_path = Path(image_path)
     if not image_path.is_file():
@@ -264,13 +269,14 @@ def photo_from_files(
         if not Path(mask_path).is_file():
             raise ValueError(f"{mask_path}: file not found; check the face mask's path")
         mask = read_mask(mask_path, size_wh)
+    curve = None if face_curve_path is None else read_face_curve(face_curve_path, view, size_wh)
     return Photo(
         safe_id(photo_id or image_path.stem),
         size_wh,
         view,
         landmarks,
         mask,
-        None,
+        curve,
         priors or Priors(),
         image,
         mask_file=None if mask_path is None else str(mask_path),

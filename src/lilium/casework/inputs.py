@@ -226,17 +226,18 @@ def load_photos(
                     path, _taken(records), out, source.view, mask, sensor_width_mm, log
                 )
                 origin = landmark_origin(photo, facts)
-                view = photo.view
+                if curve is not None:
+                    photo = replace(
+                        photo,
+                        face_curve_uv=read_face_curve(curve, photo.view, photo.image_size_wh),
+                    )
             else:
-                photo = photo_from_files(path, lm_file, view, mask)
+                photo = photo_from_files(path, lm_file, view, mask, face_curve_path=curve)
                 inputs["photo"] = path
                 inputs["facial landmarks"] = lm_file
             if mask is not None:
                 inputs["face mask"] = mask
             if curve is not None:
-                photo = replace(
-                    photo, face_curve_uv=read_face_curve(curve, view, photo.image_size_wh)
-                )
                 inputs["face curve"] = curve
         photo, notes = with_priors(
             photo, image, focal_cli, scd_cli, use_exif=use_exif, sensor_width_mm=sensor_width_mm
