@@ -50,9 +50,9 @@ from pathlib import Path
 
 import numpy as np
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.evaluation import outside_face, score
 from lilium.inputs import correspondences
-from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions, run_sfo

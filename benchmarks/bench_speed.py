@@ -42,7 +42,7 @@ from pathlib import Path  # noqa: E402
 import lilium.methods.lilium_outcome as lilium_outcome  # noqa: E402
 import lilium.methods.lilium_terms as lilium_terms  # noqa: E402
 from lilium import jit  # noqa: E402
-from lilium.io.case import read_photo, read_skull  # noqa: E402
+from lilium.casework.build import read_photo, read_skull  # noqa: E402
 from lilium.io.jsonio import read_json  # noqa: E402
 from lilium.methods import METHODS, SfoOptions, run_sfo  # noqa: E402
 from lilium.methods import lilium as lilium_method  # noqa: E402

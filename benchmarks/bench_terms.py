@@ -26,9 +26,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.fitness.skof import prepare_skof, skull_outside_pixels_batch
 from lilium.geometry.camera import Cameras, principal_point_of
-from lilium.io.case import read_photo, read_skull
 from lilium.io.truth import read_ground_truth
 from lilium.methods.lilium_terms import PllTerm, SkofTerm
 

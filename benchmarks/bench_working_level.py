@@ -29,8 +29,8 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from lilium.casework.build import read_photo, read_skull  # noqa: E402
 from lilium.evaluation.scoring import score  # noqa: E402
-from lilium.io.case import read_photo, read_skull  # noqa: E402
 from lilium.io.jsonio import read_json  # noqa: E402
 from lilium.io.truth import read_ground_truth  # noqa: E402
 from lilium.methods import SfoOptions, run_sfo  # noqa: E402

@@ -81,7 +81,7 @@ def test_a_stale_build_is_not_used(monkeypatch, changed):
 
 @built
 def test_ahead_of_time_and_jit_give_the_same_sfo(case, monkeypatch):
-    from lilium.io.case import read_photo, read_skull
+    from lilium.casework.build import read_photo, read_skull
     from lilium.methods import SfoOptions, run_sfo
     from lilium.optimisation import DEOptions
 

@@ -155,8 +155,8 @@ def test_camera_terms_and_checks_kernels_match_numpy(case, priors_on):
     the numpy path: the same validity and capped fit, terms to rounding."""
     from dataclasses import replace
 
+    from lilium.casework.build import read_photo, read_skull
     from lilium.inputs import CameraPriors
-    from lilium.io.case import read_photo, read_skull
     from lilium.methods import SfoOptions
     from lilium.methods.lilium import LiliumProblem
 
@@ -274,7 +274,7 @@ def test_camera_stage_in_one_call_is_the_steps_one_by_one(case, nasion):
     distance from the nasion or, without it, from the mean of every facial landmark."""
     from dataclasses import replace
 
-    from lilium.io.case import read_photo, read_skull
+    from lilium.casework.build import read_photo, read_skull
     from lilium.methods import SfoOptions
     from lilium.methods.lilium import LiliumProblem
 

@@ -19,9 +19,9 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.fitness.pll import pair_curves_batch, terms_from_pairs, trim_curves_batch
 from lilium.geometry.camera import Camera, principal_point_of
-from lilium.io.case import read_photo, read_skull
 from lilium.io.truth import read_ground_truth
 from lilium.methods.lilium_terms import PllTerm, TermOff
 

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.geometry.camera import Camera
 from lilium.identification.cohort import (
     centred_cohort_terms,
@@ -39,7 +40,6 @@ from lilium.identification.cohort import (
 from lilium.identification.terms import landmark_blocks, landmark_chi2, make_view
 from lilium.inputs import correspondences
 from lilium.io.calibration import shipped_cohort
-from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 
 #: The data tools (benchmarks/datasets) this study imports: ``headsq_case``, ``cranium_case``.

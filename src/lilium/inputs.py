@@ -1,6 +1,7 @@
 """In-memory SFO inputs: a skull, a photo and the a-priori camera information.
 
-These are plain validated arrays; reading them from case folders is :mod:`lilium.io.case`'s job.
+These are plain validated arrays; :mod:`lilium.io.case` parses case folders and
+:mod:`lilium.casework.build` builds these from what it parses.
 """
 
 from dataclasses import dataclass, field
@@ -95,7 +96,7 @@ class Photo:
     prior_sources : dict of str -> str
         Where each prior came from, keyed ``focal_px``, ``scd_mm``, ``head_rotation``, values
         among :data:`PRIOR_SOURCES`. A prior given without a source is taken as from
-        ``photo.json`` (what :func:`lilium.io.case.read_photo` reads).
+        ``photo.json`` (what :func:`lilium.casework.build.read_photo` reads).
     warnings : tuple of CaseWarning
         Found while reading the photo (e.g. ``exif_focal_unusable``); every result of the photo
         carries them.

@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.constants import FACING_MAX_DEG, VIEW_SPLIT_DEG
-from lilium.io.case import read_photo, read_skull
 from lilium.io.truth import read_ground_truth
 from lilium.methods import run_sfo
 from lilium.methods.checks import (

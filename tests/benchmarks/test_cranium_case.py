@@ -59,8 +59,8 @@ def case(tmp_path_factory):
 
 @pytest.mark.slow
 def test_cranium_dataset_structure(case):
+    from lilium.casework.build import read_photo, read_skull
     from lilium.experiments.dataset import check_index
-    from lilium.io.case import read_photo, read_skull
     from lilium.io.mesh import read_mesh
 
     index = json.loads((case / "dataset.json").read_text())

@@ -65,8 +65,8 @@ def test_the_record_names_a_misplaced_landmark(case, tmp_path):
     from dataclasses import replace
     from types import SimpleNamespace
 
+    from lilium.casework.build import read_photo, read_skull
     from lilium.inputs import correspondences
-    from lilium.io.case import read_photo, read_skull
     from lilium.report.conclusion_html import conclusion_section
 
     subject_dir, photo_dir = case
@@ -195,7 +195,7 @@ def _posest_sfo(case, tmp_path):
     skull, the photo and the ``result.json`` written."""
     from types import SimpleNamespace
 
-    from lilium.io.case import read_photo, read_skull
+    from lilium.casework.build import read_photo, read_skull
 
     subject_dir, photo_dir = case
     assert main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
@@ -272,7 +272,7 @@ def test_two_photos_reuse_each_photos_own_decision(case, tmp_path, monkeypatch):
     from types import SimpleNamespace
 
     import lilium.identification.decision as identify_module
-    from lilium.io.case import read_photo, read_skull
+    from lilium.casework.build import read_photo, read_skull
 
     subject_dir, photo_dir = case
     assert main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
@@ -398,10 +398,10 @@ def test_skull_outside_the_head_is_decided_beyond_the_edge_noise(case):
 
     from scipy import ndimage as ndi
 
+    from lilium.casework.build import read_photo, read_skull
     from lilium.identification.decision import skull_outside_head
     from lilium.identification.score import outside_fraction, skull_beyond_head
     from lilium.imaging.raster import mesh_mask
-    from lilium.io.case import read_photo, read_skull
     from lilium.io.truth import read_ground_truth
 
     subject_dir, photo_dir = case

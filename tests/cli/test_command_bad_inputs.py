@@ -167,8 +167,8 @@ def test_unknown_keys_of_photo_json_are_warned_about(case, tmp_path, capsys):
 def test_focal_cap_message_does_not_contradict_itself(case):
     from dataclasses import replace
 
+    from lilium.casework.build import read_photo
     from lilium.inputs import Priors
-    from lilium.io.case import read_photo
     from lilium.methods.posest_sfo import focal_cap_message
 
     _, photo_dir = case

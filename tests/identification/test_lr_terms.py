@@ -222,10 +222,10 @@ def test_landmark_tension_is_what_a_camera_off_the_landmarks_costs():
 def test_older_terms_are_completed_with_the_late_terms_only(case):
     """Terms stored before the skull cohort and the landmarks' refit get those computed;
     every stored term is kept as it was."""
+    from lilium.casework.build import read_photo, read_skull
     from lilium.geometry.camera import principal_point_of
     from lilium.identification.score import LATE_TERMS, identification_terms, with_late_terms
     from lilium.io.calibration import shipped_cohort
-    from lilium.io.case import read_photo, read_skull
 
     subject_dir, photo_dir = case
     skull, photo = read_skull(subject_dir), read_photo(photo_dir)

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from lilium import jit
+from lilium.casework.build import read_skull
 from lilium.fitness.regions import anatomical_frame
 from lilium.geometry.camera import Camera
 from lilium.geometry.rotations import rotvec_to_matrix
 from lilium.imaging.raster import skull_raster
 from lilium.imaging.shading import creases, render_surface, shade_surface
 from lilium.imaging.skull_views import SKULL_VIEWS, skull_view, view_rotation
-from lilium.io.case import read_skull
 from lilium.report.pictures import skull_view_pictures
 from lilium.report.svg import LABEL_COLUMN, skull_view_svg
 

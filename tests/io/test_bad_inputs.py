@@ -13,13 +13,13 @@ import pytest
 from PIL import Image
 
 from cli_helpers import _edit_json, _one_line_error, _run, _sfo
+from lilium.casework.build import read_photo, read_skull
 from lilium.cli import argtypes
 from lilium.cli.main import main
 from lilium.constants import MAX_PHOTO_PIXELS
 from lilium.geometry.camera import Camera
 from lilium.imaging import overlay as overlay_module
 from lilium.imaging.overlay import SKULL_RGB, blend_skull, draw_overlay
-from lilium.io.case import read_photo, read_skull
 from lilium.io.formats import name_error
 from lilium.io.images import image_size_wh, read_image, read_mask
 from lilium.io.paths import path_id, safe_id

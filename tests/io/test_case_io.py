@@ -5,8 +5,9 @@ import json
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.inputs import correspondences
-from lilium.io.case import read_depth_table, read_photo, read_skull
+from lilium.io.case import read_depth_table
 from lilium.io.mesh import write_mesh
 
 

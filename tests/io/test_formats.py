@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from lilium.io.case import read_skull
+from lilium.casework.build import read_skull
 from lilium.io.formats import canonical_name, find_landmark_file, read_landmarks
 
 POINTS = {"nasion": [1.0, 2.0, 3.0], "zygion_l": [4.0, 5.0, 6.0], "subspinale": [7, 8, 9.5]}

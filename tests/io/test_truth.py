@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo
 from lilium.evaluation import score
-from lilium.io.case import read_photo
 from lilium.io.truth import read_facial_landmarks, read_ground_truth
 
 

@@ -6,10 +6,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.geometry.camera import Camera, principal_point_of
 from lilium.geometry.rotations import rotvec_to_matrix
 from lilium.inputs import Photo, Priors, correspondences
-from lilium.io.case import read_photo, read_skull
 from lilium.methods import SfoOptions, run_sfo
 from lilium.methods.checks import (
     check_inputs,

@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from lilium import jit
+from lilium.casework.build import read_photo, read_skull
 from lilium.geometry.mesh import (
     compact,
     face_components,
     parts_apart,
     point_surface_distance,
 )
-from lilium.io.case import read_photo, read_skull
 from lilium.io.mesh import read_mesh, write_mesh
 from standin_case import make_standin_case
 

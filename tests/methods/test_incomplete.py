@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.casework.inputs import check_runnable
 from lilium.cli.main import main
 from lilium.experiments.report import write_report
@@ -16,7 +17,6 @@ from lilium.experiments.terms_off import terms_off_rows, terms_off_table
 from lilium.fitness.camera_penalty import CameraPriors
 from lilium.fitness.curves import face_curve_bounds, face_curve_from_mask, missing_curve_bounds
 from lilium.geometry.camera import principal_point_of
-from lilium.io.case import read_photo, read_skull
 from lilium.io.jsonio import read_json
 from lilium.methods import SfoOptions, run_sfo
 from lilium.methods.lilium import LiliumProblem

@@ -7,8 +7,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.cli.main import main
-from lilium.io.case import read_photo, read_skull
 from lilium.methods import SfoOptions, run_joint_sfo, run_sfo
 from lilium.methods.joint import (
     ANGLE_PRIOR_WEIGHT,

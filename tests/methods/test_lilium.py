@@ -3,10 +3,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.evaluation import score
 from lilium.geometry import geodesic_angle_deg
 from lilium.inputs import CameraPriors
-from lilium.io.case import read_photo, read_skull
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions
 from lilium.methods.lilium import LiliumProblem, lilium_sfo

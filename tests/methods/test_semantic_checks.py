@@ -9,8 +9,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo
 from lilium.inputs import Photo
-from lilium.io.case import read_depth_table, read_photo
+from lilium.io.case import read_depth_table
 from lilium.io.curves import read_face_curve
 from lilium.io.jsonio import write_json
 

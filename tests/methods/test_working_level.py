@@ -6,9 +6,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.geometry.camera import Camera
 from lilium.inputs import correspondences
-from lilium.io.case import read_photo, read_skull
 from lilium.methods import SfoOptions
 from lilium.methods.lilium import lilium_sfo
 from lilium.methods.lilium_terms import SkofTerm, full_image_terms

@@ -18,8 +18,8 @@ def _face_only_folder(case, tmp_path, is_head, landmarks=None):
 
     from scipy import ndimage as ndi
 
+    from lilium.casework.build import read_skull
     from lilium.imaging.raster import mesh_mask
-    from lilium.io.case import read_skull
     from lilium.io.truth import read_ground_truth
 
     subject_dir, photo_dir = case
@@ -47,10 +47,10 @@ def test_a_face_only_mask_does_not_read_the_vault_as_outside(case, tmp_path, is_
     skull_beyond_head, outside_fraction and P_skof's count see none of it; the photo says why."""
     from types import SimpleNamespace
 
+    from lilium.casework.build import read_photo
     from lilium.evaluation.metrics import outside_face
     from lilium.identification.decision import skull_outside_head
     from lilium.identification.score import outside_fraction, skull_beyond_head
-    from lilium.io.case import read_photo
 
     skull, camera, folder = _face_only_folder(case, tmp_path, is_head)
     photo = read_photo(folder)
@@ -69,7 +69,7 @@ def test_a_face_only_mask_does_not_read_the_vault_as_outside(case, tmp_path, is_
 
 
 def test_a_face_only_mask_without_eye_corners_is_not_used(case, tmp_path):
-    from lilium.io.case import read_photo
+    from lilium.casework.build import read_photo
 
     meta = json.loads((case[1] / "photo.json").read_text())
     kept = {k: v for k, v in meta["landmarks"].items() if "canthion" not in k}

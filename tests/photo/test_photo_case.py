@@ -66,7 +66,7 @@ def prepared(tmp_path_factory, portrait):
 
 @needs_litert
 def test_a_prepared_folder_is_a_photo_folder(standin, prepared, tmp_path, capsys):
-    from lilium.io.case import read_skull
+    from lilium.casework.build import read_skull
     from lilium.photo.headpose import head_rotation_skull2cam
 
     out = tmp_path / "out"

@@ -9,8 +9,8 @@ from PIL import Image
 
 pytest.importorskip("ai_edge_litert")
 
+from lilium.casework.build import read_photo  # noqa: E402
 from lilium.cli.main import main  # noqa: E402
-from lilium.io.case import read_photo  # noqa: E402
 
 
 def _grey(path, w=320, h=240):

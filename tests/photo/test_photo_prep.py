@@ -10,9 +10,9 @@ from PIL import Image
 
 pytest.importorskip("ai_edge_litert")
 
+from lilium.casework.build import read_photo  # noqa: E402
 from lilium.cli.main import main  # noqa: E402
 from lilium.geometry.rotations import rotvec_to_matrix  # noqa: E402
-from lilium.io.case import read_photo  # noqa: E402
 from lilium.photo import runtime  # noqa: E402
 from lilium.photo.analysis import analyse_face  # noqa: E402
 from lilium.photo.headpose import (  # noqa: E402

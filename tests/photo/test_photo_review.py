@@ -18,8 +18,8 @@ from browser import needs_chromium, run_chromium
 
 pytest.importorskip("ai_edge_litert")
 
+from lilium.casework.build import read_photo  # noqa: E402
 from lilium.cli.main import main  # noqa: E402
-from lilium.io.case import read_photo  # noqa: E402
 from lilium.photo.mask import mask_outline, polygon_mask  # noqa: E402
 from lilium.photo.review import review_page  # noqa: E402
 

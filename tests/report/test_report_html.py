@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from browser import needs_chromium, run_chromium
-from lilium.io.case import read_photo, read_skull
+from lilium.casework.build import read_photo, read_skull
 from lilium.io.provenance import sha256_of
 from lilium.methods.posest_sfo import posest_sfo
 from lilium.report import ReportEntry, build_report, skull_layer_rgba, write_report

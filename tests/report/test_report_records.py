@@ -6,8 +6,8 @@ import hashlib
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.experiments.task_io import score_result
-from lilium.io.case import read_photo, read_skull
 from lilium.io.provenance import input_files, sha256_of, software_versions
 from lilium.methods.posest_sfo import posest_sfo
 from lilium.report import ReportEntry, report_record, sfo_record

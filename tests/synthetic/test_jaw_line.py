@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from lilium.casework.build import read_photo, read_skull
 from lilium.fitness.pll import trim_curves_batch
 from lilium.geometry.camera import principal_point_of
-from lilium.io.case import read_photo, read_skull
 from lilium.io.truth import read_ground_truth
 from lilium.methods.lilium_terms import PllTerm
 from lilium.synthetic.dataset import generate_dataset

@@ -19,11 +19,7 @@ from ..inputs import CaseWarning
 from ..io.case import (
     IMAGE_NAMES,
     check_axes_file,
-    photo_from_files,
     read_mask,
-    read_photo,
-    read_skull,
-    skull_from_files,
     subject_files,
 )
 from ..io.curves import read_face_curve
@@ -33,6 +29,7 @@ from ..io.paths import safe_id
 from ..io.prepared import read_prepared
 from ..methods.photo_checks import check_distinct_photos, check_landmarks_in_mask
 from ..validation import check_prior, fmt_range
+from .build import photo_from_files, read_photo, read_skull, skull_from_files
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 from .request import PriorOverrides
 
@@ -129,8 +126,9 @@ def _check_interval(values, option, key):
     return None if values is None else check_prior(values, key, f"command line: {option}")
 
 
-def load_photos(sources, priors=PriorOverrides(), log=None, skull=None, auto_landmarks=False,
-                out=None):
+def load_photos(
+    sources, priors=PriorOverrides(), log=None, skull=None, auto_landmarks=False, out=None
+):
     """Read every photo (folders and image files) with its priors.
 
     Parameters
@@ -228,17 +226,18 @@ def load_photos(sources, priors=PriorOverrides(), log=None, skull=None, auto_lan
                     path, _taken(records), out, source.view, mask, sensor_width_mm, log
                 )
                 origin = landmark_origin(photo, facts)
-                view = photo.view
+                if curve is not None:
+                    photo = replace(
+                        photo,
+                        face_curve_uv=read_face_curve(curve, photo.view, photo.image_size_wh),
+                    )
             else:
-                photo = photo_from_files(path, lm_file, view, mask)
+                photo = photo_from_files(path, lm_file, view, mask, face_curve_path=curve)
                 inputs["photo"] = path
                 inputs["facial landmarks"] = lm_file
             if mask is not None:
                 inputs["face mask"] = mask
             if curve is not None:
-                photo = replace(
-                    photo, face_curve_uv=read_face_curve(curve, view, photo.image_size_wh)
-                )
                 inputs["face curve"] = curve
         photo, notes = with_priors(
             photo, image, focal_cli, scd_cli, use_exif=use_exif, sensor_width_mm=sensor_width_mm

@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..casework.build import read_photo, read_skull
 from ..geometry.camera import Camera
 from ..identification.calibration import (
     CALIBRATED_TERMS,
@@ -51,7 +52,6 @@ from ..identification.score import LATE_TERMS, identification_terms, pll_face, w
 from ..identification.terms import TERM_NAMES, eye_corner_px
 from ..inputs import correspondences
 from ..io.calibration import shipped_cohort
-from ..io.case import read_photo, read_skull
 from ..synthetic.subjects import axes_on_skull, make_subjects
 from .config import view_group
 from .store import COLUMNS, ResultStore, task_key

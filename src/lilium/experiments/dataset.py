@@ -35,7 +35,7 @@ from pathlib import Path, PurePosixPath, PureWindowsPath
 #: Views a photo entry may name (docs/contract.md).
 VIEWS = ("frontal", "lateral_left", "lateral_right")
 
-#: Skull mesh file names a subject folder must hold one of (``lilium.io.case.read_skull``).
+#: Skull mesh file names a subject folder must hold one of (``lilium.casework.build.read_skull``).
 SKULL_MESHES = ("skull.ply", "skull.obj", "skull.stl")
 
 #: Read size when hashing files.

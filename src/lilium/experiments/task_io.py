@@ -20,7 +20,7 @@ _DROPPED_RESULT_KEYS = ("history", "genes")
 @functools.lru_cache(maxsize=SKULL_CACHE)
 def task_skull(subject_dir, axes_file):
     """A subject's skull with one axes file (``None``: its own axes), cached per process."""
-    from ..io.case import read_skull
+    from ..casework.build import read_skull
 
     if axes_file is not None and not os.path.isfile(axes_file):
         # Checked before the run too; a file gone since is an error row, never a success with
@@ -55,7 +55,7 @@ def facial_truth(subject_dir):
 def task_photo(photo_dir):
     """The photo and its :class:`~lilium.io.truth.GroundTruth` (without the 3D landmarks),
     cached per process."""
-    from ..io.case import read_photo
+    from ..casework.build import read_photo
     from ..io.truth import read_ground_truth
 
     return read_photo(photo_dir, load_image=False), read_ground_truth(photo_dir)

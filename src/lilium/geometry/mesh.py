@@ -8,7 +8,15 @@ synthetic generator and the fitness terms alike.
 import numpy as np
 
 from .. import jit
+from ..constants import PART_APART_MM
 from ._mesh_kernels import cluster_kernel, component_kernel
+
+#: A skull in millimetres spans roughly 100-300 mm (an adult's length 170-210 mm, a mandible
+#: alone about 100 mm); outside this range the unit is wrong. The lower bound refuses a skull in
+#: centimetres (13-22 units), which the landmark checks cannot catch when its landmarks are in
+#: centimetres too: the depth table in mm then makes the soft tissue ten times too thick, and the
+#: true person was excluded.
+PLAUSIBLE_EXTENT_MM = (30.0, 1000.0)
 
 
 def face_components(faces, n_vertices):
@@ -275,3 +283,74 @@ def cluster_vertices(vertices_mm, faces, cell_mm):
     g = inverse[np.asarray(faces)]
     keep = (g[:, 0] != g[:, 1]) & (g[:, 1] != g[:, 2]) & (g[:, 0] != g[:, 2])
     return merged, np.ascontiguousarray(g[keep], dtype=np.int64)
+
+
+def clean_mesh(vertices, faces, shared=False, source="mesh"):
+    """A parsed mesh welded where its vertices are not shared, then checked
+    (:func:`check_mesh`).
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+    faces : ndarray of shape (F, 3), int
+    shared : bool
+        The vertices are shared as the file stored them (a binary PLY): welded only when there
+        are more of them than faces (loose triangles; a closed mesh has about F / 2). Otherwise
+        always welded (an STL's loose triangles, an OBJ's seams).
+    source : str
+        Names the mesh in the messages.
+
+    Returns
+    -------
+    vertices_mm : ndarray of shape (V', 3)
+    faces : ndarray of shape (F, 3), int
+    """
+    if (not shared or len(vertices) > len(faces)) and _indexed(vertices, faces):
+        vertices, faces = weld(vertices, faces)
+    check_mesh(vertices, faces, source)
+    return vertices, faces
+
+
+def _indexed(vertices, faces):
+    """Whether the faces index existing, finite vertices (else check_mesh names the fault)."""
+    valid = len(faces) and faces.min() >= 0 and faces.max() < len(vertices)
+    return bool(valid) and bool(np.all(np.isfinite(vertices)))
+
+
+def check_mesh(vertices_mm, faces, source="mesh"):
+    """Raise a ``ValueError`` saying what is wrong if a mesh cannot be a skull in mm."""
+    if len(faces) == 0 or len(vertices_mm) < 3:
+        raise ValueError(f"{source}: the mesh has no triangles; export the surface, not points")
+    if not np.all(np.isfinite(vertices_mm)):
+        raise ValueError(f"{source}: vertex coordinates contain NaN or infinity; repair the mesh")
+    if faces.min() < 0 or faces.max() >= len(vertices_mm):
+        raise ValueError(f"{source}: faces index missing vertices; repair the mesh")
+
+    def area_sum(f):
+        tri = vertices_mm[f]
+        return np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+
+    # Areas are >= 0: a sample with area settles it (a CT skull has hundreds of thousands).
+    if area_sum(faces[:: max(1, len(faces) // 20_000)]) <= 0 and area_sum(faces) <= 0:
+        raise ValueError(f"{source}: degenerate mesh (all triangles have zero area)")
+    used = np.zeros(len(vertices_mm), bool)
+    used[faces.reshape(-1)] = True
+    extent = np.ptp(vertices_mm[used], axis=0)
+    if extent.min() <= 1e-3 * extent.max():
+        raise ValueError(f"{source}: degenerate mesh (flat or a line, extent {extent.tolist()})")
+    lo, hi = PLAUSIBLE_EXTENT_MM
+    if extent.max() > hi and _largest_part_extent_mm(vertices_mm, faces) <= hi:
+        return  # a skull with a part far from it: the skull reader leaves that out and says so
+    if not lo <= extent.max() <= hi:
+        raise ValueError(
+            f"{source}: the mesh spans {extent.max():.3g} units; a skull in millimetres spans "
+            f"{lo:.0f}-{hi:.0f}; rescale it to millimetres"
+        )
+
+
+def _largest_part_extent_mm(vertices_mm, faces):
+    """Largest side of the bounding box of the mesh without its parts apart from the part with
+    the most faces (:func:`~lilium.geometry.mesh.parts_apart`)."""
+    apart, _ = parts_apart(vertices_mm, faces, None, PART_APART_MM)
+    corners = faces[~apart].reshape(-1)
+    return float(np.ptp(vertices_mm[corners], axis=0).max())

@@ -1,55 +1,41 @@
-"""Case folders of docs/contract.md: subject (skull) folders and photo folders.
+"""Case folders of docs/contract.md: subject (skull) folders and photo folders, parsed.
 
-Every problem found is a ``ValueError`` whose message names the file, the field and the fix.
+Each function here reads one file (or finds one in a folder) into plain arrays and dicts; the
+typed :class:`~lilium.inputs.Skull` and :class:`~lilium.inputs.Photo` are built and checked
+across files by :mod:`lilium.casework.build`. Every problem found is a ``ValueError`` whose
+message names the file, the field and the fix.
 """
 
 import csv
 from pathlib import Path
 
-import numpy as np
-
-from ..constants import (
-    MIN_CRANIAL_EXTENT_FRACTION,
-    MIN_LANDMARK_EXTENT_FRACTION,
-    MIN_LANDMARK_EXTENT_PX,
-    MIN_LANDMARK_SPREAD_RATIO,
-    MIN_PHOTO_SIDE_PX,
-    PART_APART_MM,
-    VIEWS,
-)
-from ..geometry.mesh import compact, parts_apart, point_surface_distance
-from ..inputs import CaseWarning, Photo, Priors, Skull
 from ..softtissue.depths import DepthStats, check_depth_table
-from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from ..softtissue.normals import landmark_normals
-from ..validation import check_prior, is_real
 from .curves import read_face_curve
 from .formats import find_landmark_file, points_from_object, read_landmarks
 from .images import image_size_wh, read_image, read_mask
 from .jsonio import read_json
-from .keys import json_type, unknown_key_warnings
-from .mesh import MESH_SUFFIXES, read_mesh
-from .paths import path_id, safe_id
+from .keys import json_type
+from .mesh import MESH_SUFFIXES
 from .prepared import (
     _without_unconfirmed_templates,
-    face_only_mask,
     landmark_qualities,
-    written_by_lilium_photo,
 )
 
 __all__ = [
     "IMAGE_NAMES",
-    "check_in_image",
-    "check_landmark_layout",
-    "parse_priors",
-    "photo_from_files",
+    "check_axes_file",
+    "check_folder",
+    "find_photo_image",
+    "parse_axes",
+    "parse_cranial_landmarks",
+    "parse_facial_landmarks",
     "read_depth_table",
     "read_face_curve",
     "read_image",
+    "read_image_or_size",
     "read_mask",
-    "read_photo",
-    "read_skull",
-    "skull_from_files",
+    "read_photo_meta",
+    "required_field",
 ]
 
 IMAGE_NAMES = ("image.png", "image.jpg", "image.jpeg")
@@ -62,14 +48,16 @@ def _find(folder, stems_or_names, what, fix):
     raise ValueError(f"{folder}: no {what} ({' or '.join(stems_or_names)}); {fix}")
 
 
-def _check_folder(folder, kind):
+def check_folder(folder, kind):
+    """``folder`` as a Path; a ``ValueError`` when it is not a folder."""
     folder = Path(folder)
     if not folder.is_dir():
         raise ValueError(f"{folder}: {kind} folder not found")
     return folder
 
 
-def _field(path, data, key):
+def required_field(path, data, key):
+    """``data[key]``; a ``ValueError`` naming ``path`` when it is missing."""
     if not isinstance(data, dict) or key not in data:
         raise ValueError(f"{path}: missing field {key!r}")
     return data[key]
@@ -104,37 +92,6 @@ def subject_files(folder):
     return mesh_path, lm_path
 
 
-def read_skull(folder, axes_path=None, landmarks_path=None):
-    """Read a subject (skull) folder.
-
-    Parameters
-    ----------
-    folder : str or Path
-        Holds ``skull.ply`` (or ``.obj``/``.stl``), ``cranial_landmarks.json`` and optionally
-        ``soft_tissue_axes.json``.
-    axes_path : str or Path, optional
-        Soft-tissue axes file to use instead of the folder's own (e.g. a perturbed set); it
-        must exist (a missing file is an error, never a silent fall-back to the normals).
-    landmarks_path : str or Path, optional
-        Cranial landmark file to use instead of the folder's own (any supported format).
-
-    Returns
-    -------
-    Skull
-        Axes missing from the file default to the outward skull-surface normal. Its id is the
-        folder's name (:func:`lilium.io.paths.path_id`).
-    """
-    folder = _check_folder(folder, "subject")
-    mesh_path, lm_path = subject_files(folder)
-    if landmarks_path is not None:
-        lm_path = Path(landmarks_path)
-    if axes_path is not None:
-        check_axes_file(axes_path)
-    else:
-        axes_path = folder / "soft_tissue_axes.json"
-    return skull_from_files(mesh_path, lm_path, axes_path, skull_id=path_id(folder, "skull"))
-
-
 def check_axes_file(axes_path, option="soft-tissue axes file"):
     """Raise a ``ValueError`` naming ``axes_path`` when an explicitly given axes file is not a file.
 
@@ -149,158 +106,29 @@ def check_axes_file(axes_path, option="soft-tissue axes file"):
         )
 
 
-def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
-    """A :class:`Skull` from a mesh file and a landmark file of any supported format.
-
-    Parameters
-    ----------
-    mesh_path : str or Path
-        PLY, OBJ or STL (millimetres).
-    landmarks_path : str or Path
-        ``cranial_landmarks.json`` (docs/contract.md), or any file
-        :func:`lilium.io.formats.read_landmarks` reads (3D Slicer, MeshLab, CSV, JSON; aliases).
-    axes_path : str or Path, optional
-        ``soft_tissue_axes.json``; absent axes default to the outward skull-surface normal.
-    skull_id : str, optional
-        Defaults to the mesh's folder name for ``skull.*`` and to the mesh's stem otherwise;
-        made a safe folder name either way (:func:`lilium.io.paths.safe_id`).
-    """
-    mesh_path, lm_path = Path(mesh_path), Path(landmarks_path)
-    if skull_id is None:
-        skull_id = (
-            path_id(mesh_path.parent, "skull") if mesh_path.stem == "skull" else mesh_path.stem
-        )
-    skull_id = safe_id(skull_id, "skull")
-    vertices, faces = read_mesh(mesh_path)
+def parse_cranial_landmarks(landmarks_path):
+    """The cranial landmarks of a ``cranial_landmarks.json`` or of any file
+    :func:`lilium.io.formats.read_landmarks` reads, as parsed: dict of str -> ndarray (3,), mm."""
+    lm_path = Path(landmarks_path)
     if lm_path.name == "cranial_landmarks.json" or not lm_path.is_file():
-        raw = _field(lm_path, read_json(lm_path), "landmarks")
-        landmarks = points_from_object(lm_path, "landmarks", raw, "cranial")
-    else:
-        landmarks = read_landmarks(lm_path, "cranial")
-    vertices, faces, warnings = _skull_part(mesh_path, vertices, faces, landmarks)
-    extent = np.ptp(vertices, axis=0).max()
-    _check_on_mesh(lm_path, landmarks, vertices, faces, 0.1 * extent)
-    check_landmark_layout(lm_path, landmarks, extent * MIN_CRANIAL_EXTENT_FRACTION, "mm")
-    axes = {}
+        raw = required_field(lm_path, read_json(lm_path), "landmarks")
+        return points_from_object(lm_path, "landmarks", raw, "cranial")
+    return read_landmarks(lm_path, "cranial")
+
+
+def parse_axes(axes_path):
+    """The soft-tissue axes of ``soft_tissue_axes.json`` as given (not normalised): dict of
+    str -> ndarray (3,); empty when ``axes_path`` is None or not a file."""
     axes_path = Path(axes_path) if axes_path else None
-    if axes_path is not None and axes_path.is_file():
-        raw = _field(axes_path, read_json(axes_path), "axes")
-        axes_raw = points_from_object(axes_path, "axes", raw, "cranial", allow_empty=True)
-        for name, a in axes_raw.items():
-            norm = np.linalg.norm(a)
-            if norm == 0:
-                raise ValueError(f"{axes_path}: axes.{name} is the zero vector; give a direction")
-            axes[name] = a / norm
-    missing = [n for n in landmarks if n not in axes and n in CRANIAL_TO_FACIAL]
-    if missing:
-        axes.update(landmark_normals(vertices, faces, {n: landmarks[n] for n in missing}))
-    return Skull(skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings))
+    if axes_path is None or not axes_path.is_file():
+        return {}
+    raw = required_field(axes_path, read_json(axes_path), "axes")
+    return points_from_object(axes_path, "axes", raw, "cranial", allow_empty=True)
 
 
-def _skull_part(mesh_path, vertices, faces, landmarks):
-    """The mesh without the parts apart from its cranial landmarks' part (:data:`PART_APART_MM`)
-    and without unreferenced vertices; and the warning that names what was left out."""
-    apart, parts = parts_apart(vertices, faces, np.array(list(landmarks.values())), PART_APART_MM)
-    warnings = []
-    if parts:
-        faces = faces[~apart]
-        sizes = "; ".join(f"{n} faces, {gap:.0f} mm away" for n, gap in parts[:3])
-        more = f"; and {len(parts) - 3} more" if len(parts) > 3 else ""
-        warnings.append(
-            CaseWarning(
-                "mesh_part_left_out",
-                f"{mesh_path}: {len(parts)} fragment(s) of the mesh lie apart from the skull (the "
-                f"part holding its cranial landmarks) and are left out ({sizes}{more}); delete "
-                "them from the mesh if they are not this skull's bone",
-            )
-        )
-    vertices, faces = compact(vertices, faces)
-    return vertices, faces, warnings
-
-
-def _check_on_mesh(lm_path, landmarks, vertices, faces, tolerance_mm):
-    """Raise when a cranial landmark lies farther than ``tolerance_mm`` from the skull's surface
-    (its triangles, not only its vertices: a coarse mesh has vertices far apart)."""
-    sample = vertices[:: max(1, len(vertices) // 20_000)]  # a CT skull's: a sample first
-    for name, p in landmarks.items():
-        gap = np.min(np.linalg.norm(sample - p, axis=1))  # >= the whole mesh's gap
-        if gap > tolerance_mm:
-            gap = np.min(np.linalg.norm(vertices - p, axis=1))
-        if gap > tolerance_mm:
-            gap = point_surface_distance(p[None], vertices, faces)[0]
-        if gap > tolerance_mm:
-            raise ValueError(
-                f"{lm_path}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
-                "must be in the mesh's frame and units"
-            )
-
-
-def _interval(path, priors, key):
-    value = priors.get(key)
-    return None if value is None else check_prior(value, key, f"{path}: priors.{key}")
-
-
-def parse_priors(path, priors):
-    """Validate the ``priors`` object of ``photo.json``."""
-    from ..geometry.rotations import check_rotation
-
-    if priors is None:
-        return Priors()
-    if not isinstance(priors, dict):
-        raise ValueError(f"{path}: priors must be an object")
-    rotation = priors.get("head_rotation_skull2cam")
-    if rotation is not None:
-        try:
-            rotation = check_rotation(rotation, name="priors.head_rotation_skull2cam")
-        except ValueError as exc:
-            raise ValueError(f"{path}: {exc}") from None
-    tolerance = priors.get("head_tolerance_deg")
-    if tolerance is not None:
-        if not (is_real(tolerance) and 0 < tolerance <= 180):
-            raise ValueError(f"{path}: priors.head_tolerance_deg must be in (0, 180] degrees")
-        tolerance = float(tolerance)
-    if (rotation is None) != (tolerance is None):
-        raise ValueError(
-            f"{path}: priors.head_rotation_skull2cam and priors.head_tolerance_deg go together; "
-            "give both or neither"
-        )
-    return Priors(
-        _interval(path, priors, "focal_px"), _interval(path, priors, "scd_mm"), rotation, tolerance
-    )
-
-
-def _photo_pixels(image_path, load_image):
-    """The photo's pixels (or None) and its ``(width, height)``, checking the smallest size."""
-    image = read_image(image_path) if load_image else None
-    size_wh = (image.shape[1], image.shape[0]) if load_image else image_size_wh(image_path)
-    if min(size_wh) < MIN_PHOTO_SIDE_PX:
-        raise ValueError(
-            f"{image_path}: the photo is {size_wh[0]}x{size_wh[1]} px, too small to superimpose "
-            f"a skull on (at least {MIN_PHOTO_SIDE_PX} px a side); use the original photograph"
-        )
-    return image, size_wh
-
-
-def read_photo(folder, load_image=True):
-    """Read a photo folder (``image.png``/``.jpg``, ``photo.json``, optional mask and curve).
-
-    Parameters
-    ----------
-    folder : str or Path
-    load_image : bool
-        Keep the pixels (for overlays); without them only the image's header is read (its size).
-
-    Returns
-    -------
-    Photo
-        Its id is the folder's name (:func:`lilium.io.paths.path_id`).
-
-    Raises
-    ------
-    ValueError
-        Every problem of docs/checks.md, naming the file, the field and the fix.
-    """
-    folder = _check_folder(folder, "photo")
+def find_photo_image(folder):
+    """The photograph of a photo folder (``image.png``/``.jpg``/``.jpeg``); a ``ValueError``
+    when there is none or more than one (which one the landmarks belong to is unknown)."""
     image_path = _find(folder, IMAGE_NAMES, "photo image", "put the photograph there")
     images = [name for name in IMAGE_NAMES if (folder / name).is_file()]
     if len(images) > 1:  # which one the landmarks belong to is unknown
@@ -308,166 +136,52 @@ def read_photo(folder, load_image=True):
             f"{folder}: holds {' and '.join(images)}; keep only the photograph its landmarks, "
             "mask and curve were made on"
         )
-    image, size_wh = _photo_pixels(image_path, load_image)
-    meta_path = folder / "photo.json"
+    return image_path
+
+
+def read_image_or_size(image_path, load_image=True):
+    """The image's pixels (or None without ``load_image``) and its ``(width, height)``; without
+    the pixels only the file's header is read."""
+    image = read_image(image_path) if load_image else None
+    size_wh = (image.shape[1], image.shape[0]) if load_image else image_size_wh(image_path)
+    return image, size_wh
+
+
+def read_photo_meta(meta_path):
+    """A ``photo.json`` as parsed: a dict (a ``ValueError`` for any other JSON value)."""
     meta = read_json(meta_path)
     if not isinstance(meta, dict):
         raise ValueError(
             f'{meta_path}: must be a JSON object {{"view": ..., "landmarks": {{...}}}}, '
             f"got a JSON {json_type(meta)}; see docs/contract.md for the photo folder"
         )
-    view = _field(meta_path, meta, "view")
-    if view not in VIEWS:
-        raise ValueError(f"{meta_path}: view must be one of {', '.join(VIEWS)}, got {view!r}")
+    return meta
+
+
+def parse_facial_landmarks(folder, meta_path, meta):
+    """A photo folder's facial landmarks as parsed: from ``photo.json``'s ``landmarks`` (without
+    unconfirmed template points) or, when it has none, from a file of their own
+    (``facial_landmarks.csv``, ``landmarks.json``, ...).
+
+    Returns
+    -------
+    landmarks_path : Path
+        The file they were read from.
+    landmarks_uv : dict of str -> ndarray of shape (2,), px
+    sources : dict of str -> str
+        Each landmark's quality from ``photo.json``'s ``landmark_sources`` (empty for a file of
+        their own).
+    """
     lm_path = meta_path
-    if isinstance(meta, dict) and "landmarks" not in meta:
+    if "landmarks" not in meta:
         # Facial landmarks in a file of their own (facial_landmarks.csv, landmarks.json, ...).
         lm_path = find_landmark_file(folder, ["facial_landmarks", "landmarks"]) or meta_path
     if lm_path == meta_path:
-        raw = _field(meta_path, meta, "landmarks")
+        raw = required_field(meta_path, meta, "landmarks")
         landmarks = points_from_object(meta_path, "landmarks", raw, "facial")
         landmarks = _without_unconfirmed_templates(landmarks, meta.get("landmark_sources"))
-        sources = landmark_qualities(meta.get("landmark_sources"), landmarks)
-    else:
-        landmarks = read_landmarks(lm_path, "facial")
-        sources = {}
-    check_in_image(lm_path, landmarks, size_wh, image_path.name)
-    check_landmark_layout(lm_path, landmarks, _min_extent_px(size_wh), "px")
-    priors = parse_priors(meta_path, meta.get("priors"))
-    mask_path = folder / "face_mask.png"
-    mask = read_mask(mask_path, size_wh) if mask_path.is_file() else None
-    warnings = unknown_key_warnings(meta_path, meta)
-    if mask is not None and meta.get("face_mask_is_head") is False:  # docs/method/photo.md
-        mask, warning = face_only_mask(mask, landmarks, folder)
-        warnings = (*warnings, warning)
-    curve_path = folder / "face_curve.json"
-    curve = read_face_curve(curve_path, view, size_wh) if curve_path.is_file() else None
-    if curve is None and mask is not None and written_by_lilium_photo(meta):
-        # A head mask ends at the neck (often the collar): never a facial curve
-        # (docs/method/photo.md).
-        curve = np.empty((0, 2))
-    return Photo(
-        path_id(folder),
-        size_wh,
-        view,
-        landmarks,
-        mask,
-        curve,
-        priors,
-        image,
-        landmark_sources=sources,
-        warnings=tuple(warnings),
-        mask_file=str(mask_path) if mask is not None else None,
-    )
-
-
-def _min_extent_px(image_size_wh):
-    return max(MIN_LANDMARK_EXTENT_PX, MIN_LANDMARK_EXTENT_FRACTION * max(image_size_wh))
-
-
-def check_landmark_layout(path, landmarks, min_extent, unit):
-    """Raise a ``ValueError`` naming ``path`` when landmarks are tiny, coincident or collinear.
-
-    A camera (from 2D landmarks) or a pose (from 3D ones) needs landmarks spread in two
-    directions: all of them at one place, or on one line, fit a camera at any distance with an
-    excellent score. Checked only with at least :data:`~lilium.constants.MIN_CORRESPONDENCES`
-    landmarks (fewer are reported as too few to pair).
-
-    Parameters
-    ----------
-    path : path
-        The landmark file, for the message.
-    landmarks : dict of str -> ndarray of shape (2,) or (3,)
-    min_extent : float
-        Smallest allowed longest distance between two landmarks (the photo's: 1 % of its longer
-        side, at least 16 px; the skull's: 5 % of the mesh's extent).
-    unit : str
-        ``"px"`` or ``"mm"``.
-    """
-    from ..constants import MIN_CORRESPONDENCES
-
-    if len(landmarks) < MIN_CORRESPONDENCES:
-        return
-    points = np.array(list(landmarks.values()), dtype=float)
-    extent = float(np.max(np.linalg.norm(points[:, None] - points[None], axis=-1)))
-    if extent < min_extent:
-        raise ValueError(
-            f"{path}: the {len(points)} landmarks lie within {extent:.3g} {unit} of each other "
-            f"(at least {min_extent:.3g} {unit} is needed); they are all at one place: check "
-            "their coordinates and units"
-        )
-    spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
-    if spread[1] < MIN_LANDMARK_SPREAD_RATIO * spread[0]:
-        raise ValueError(
-            f"{path}: the {len(points)} landmarks lie on one line (spread across it "
-            f"{spread[1] / spread[0]:.1%} of that along it, at least "
-            f"{MIN_LANDMARK_SPREAD_RATIO:.0%} is needed), which fixes no camera; add landmarks "
-            "off that line or check their coordinates"
-        )
-
-
-def check_in_image(path, landmarks_uv, image_size_wh, image_name):
-    """Raise a ``ValueError`` naming ``path`` when a landmark lies outside the image."""
-    w, h = image_size_wh
-    for name, (u, v) in landmarks_uv.items():
-        if not (-0.5 <= u <= w - 0.5 and -0.5 <= v <= h - 0.5):
-            raise ValueError(
-                f"{path}: landmarks.{name} = ({u:g}, {v:g}) lies outside the {w}x{h} image "
-                f"{image_name}; u is the column and v the row, in pixels"
-            )
-
-
-def photo_from_files(
-    image_path,
-    landmarks_path,
-    view="frontal",
-    mask_path=None,
-    priors=None,
-    photo_id=None,
-    load_image=True,
-):
-    """A :class:`Photo` from an image file and a facial landmark file of any supported format.
-
-    Parameters
-    ----------
-    image_path : str or Path
-        PNG or JPEG.
-    landmarks_path : str or Path
-        Facial landmarks (pixels, ``u`` = column, ``v`` = row): CSV ``name,u,v``, JSON
-        ``{"landmarks": {name: [u, v]}}`` or ``{name: [u, v]}``; aliases accepted.
-    view : {"frontal", "lateral_left", "lateral_right"}
-    mask_path : str or Path, optional
-        Face mask PNG (non-zero = face), the photo's size.
-    priors : Priors, optional
-    photo_id : str, optional
-        Defaults to the image's stem; made a safe folder name either way
-        (:func:`lilium.io.paths.safe_id`).
-    """
-    image_path = Path(image_path)
-    if not image_path.is_file():
-        raise ValueError(f"{image_path}: file not found; check the photo's path")
-    if view not in VIEWS:
-        raise ValueError(f"{image_path}: view must be one of {', '.join(VIEWS)}, got {view!r}")
-    image, size_wh = _photo_pixels(image_path, load_image)
-    landmarks = read_landmarks(landmarks_path, "facial")
-    check_in_image(landmarks_path, landmarks, size_wh, image_path.name)
-    check_landmark_layout(landmarks_path, landmarks, _min_extent_px(size_wh), "px")
-    mask = None
-    if mask_path is not None:
-        if not Path(mask_path).is_file():
-            raise ValueError(f"{mask_path}: file not found; check the face mask's path")
-        mask = read_mask(mask_path, size_wh)
-    return Photo(
-        safe_id(photo_id or image_path.stem),
-        size_wh,
-        view,
-        landmarks,
-        mask,
-        None,
-        priors or Priors(),
-        image,
-        mask_file=None if mask_path is None else str(mask_path),
-    )
+        return lm_path, landmarks, landmark_qualities(meta.get("landmark_sources"), landmarks)
+    return lm_path, read_landmarks(lm_path, "facial"), {}
 
 
 def read_depth_table(path):

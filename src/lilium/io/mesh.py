@@ -1,4 +1,5 @@
-"""Mesh files (PLY, OBJ, STL) through trimesh, with checks for degenerate meshes."""
+"""Mesh files (PLY, OBJ, STL): parsed into arrays here, welded and checked by
+:func:`lilium.geometry.mesh.clean_mesh`."""
 
 import signal
 import sys
@@ -7,18 +8,21 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import PART_APART_MM
-from ..geometry.mesh import parts_apart, weld
+from ..geometry.mesh import PLAUSIBLE_EXTENT_MM, check_mesh, clean_mesh
 from .paths import naming_errors
 
-MESH_SUFFIXES = (".ply", ".obj", ".stl")
+__all__ = [
+    "MESH_SUFFIXES",
+    "PLAUSIBLE_EXTENT_MM",
+    "check_mesh",
+    "import_trimesh",
+    "parse_mesh",
+    "read_binary_ply",
+    "read_mesh",
+    "write_mesh",
+]
 
-#: A skull in millimetres spans roughly 100-300 mm (an adult's length 170-210 mm, a mandible
-#: alone about 100 mm); outside this range the unit is wrong. The lower bound refuses a skull in
-#: centimetres (13-22 units), which the landmark checks cannot catch when its landmarks are in
-#: centimetres too: the depth table in mm then makes the soft tissue ten times too thick, and the
-#: true person was excluded.
-PLAUSIBLE_EXTENT_MM = (30.0, 1000.0)
+MESH_SUFFIXES = (".ply", ".obj", ".stl")
 
 
 def import_trimesh():
@@ -50,7 +54,8 @@ def import_trimesh():
 
 
 def read_mesh(path):
-    """Read a triangle mesh and check it.
+    """Read a triangle mesh and check it: :func:`parse_mesh`, then
+    :func:`~lilium.geometry.mesh.clean_mesh`.
 
     Parameters
     ----------
@@ -71,6 +76,30 @@ def read_mesh(path):
         Missing or unreadable file, no triangles, non-finite coordinates, a flat or
         point-like mesh, or one whose size suggests metres or centimetres.
     """
+    return clean_mesh(*parse_mesh(path), source=str(path))
+
+
+def parse_mesh(path):
+    """Parse a triangle mesh file into arrays, as stored: no welding, no checks.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.ply``, ``.obj`` or ``.stl``.
+
+    Returns
+    -------
+    vertices : ndarray of shape (V, 3)
+    faces : ndarray of shape (F, 3), int
+    shared : bool
+        True for a binary PLY read as stored (its vertices shared by its faces as written);
+        False for the formats read through trimesh (an STL's loose triangles, an OBJ's seams).
+
+    Raises
+    ------
+    ValueError
+        Missing, unsupported or unreadable file.
+    """
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"{path}: file not found")
@@ -79,12 +108,7 @@ def read_mesh(path):
     if path.suffix.lower() == ".ply":
         fast = read_binary_ply(path)
         if fast is not None:
-            vertices, faces = fast
-            if len(vertices) > len(faces) and _indexed(vertices, faces):
-                # More vertices than faces: loose triangles (a closed mesh has about F / 2)
-                vertices, faces = weld(vertices, faces)
-            check_mesh(vertices, faces, str(path))
-            return vertices, faces
+            return (*fast, True)
     trimesh = import_trimesh()  # 0.15 s: only for the layouts read_binary_ply does not read
     try:
         mesh = trimesh.load(path, force="mesh", process=False)
@@ -98,16 +122,7 @@ def read_mesh(path):
         ) from exc
     vertices = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=float)
     faces = np.asarray(getattr(mesh, "faces", np.empty((0, 3))), dtype=np.int64)
-    if _indexed(vertices, faces):
-        vertices, faces = weld(vertices, faces)  # an STL's loose triangles, an OBJ's seams
-    check_mesh(vertices, faces, str(path))
-    return vertices, faces
-
-
-def _indexed(vertices, faces):
-    """Whether the faces index existing, finite vertices (else check_mesh names the fault)."""
-    valid = len(faces) and faces.min() >= 0 and faces.max() < len(vertices)
-    return bool(valid) and bool(np.all(np.isfinite(vertices)))
+    return vertices, faces, False
 
 
 #: PLY scalar types and their numpy dtypes (little endian).
@@ -175,45 +190,6 @@ def read_binary_ply(path):
         return None
     vertices = np.column_stack([vertex["x"], vertex["y"], vertex["z"]]).astype(float)
     return vertices, face["i"].astype(np.int64)
-
-
-def check_mesh(vertices_mm, faces, source="mesh"):
-    """Raise a ``ValueError`` saying what is wrong if a mesh cannot be a skull in mm."""
-    if len(faces) == 0 or len(vertices_mm) < 3:
-        raise ValueError(f"{source}: the mesh has no triangles; export the surface, not points")
-    if not np.all(np.isfinite(vertices_mm)):
-        raise ValueError(f"{source}: vertex coordinates contain NaN or infinity; repair the mesh")
-    if faces.min() < 0 or faces.max() >= len(vertices_mm):
-        raise ValueError(f"{source}: faces index missing vertices; repair the mesh")
-
-    def area_sum(f):
-        tri = vertices_mm[f]
-        return np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
-
-    # Areas are >= 0: a sample with area settles it (a CT skull has hundreds of thousands).
-    if area_sum(faces[:: max(1, len(faces) // 20_000)]) <= 0 and area_sum(faces) <= 0:
-        raise ValueError(f"{source}: degenerate mesh (all triangles have zero area)")
-    used = np.zeros(len(vertices_mm), bool)
-    used[faces.reshape(-1)] = True
-    extent = np.ptp(vertices_mm[used], axis=0)
-    if extent.min() <= 1e-3 * extent.max():
-        raise ValueError(f"{source}: degenerate mesh (flat or a line, extent {extent.tolist()})")
-    lo, hi = PLAUSIBLE_EXTENT_MM
-    if extent.max() > hi and _largest_part_extent_mm(vertices_mm, faces) <= hi:
-        return  # a skull with a part far from it: the skull reader leaves that out and says so
-    if not lo <= extent.max() <= hi:
-        raise ValueError(
-            f"{source}: the mesh spans {extent.max():.3g} units; a skull in millimetres spans "
-            f"{lo:.0f}-{hi:.0f}; rescale it to millimetres"
-        )
-
-
-def _largest_part_extent_mm(vertices_mm, faces):
-    """Largest side of the bounding box of the mesh without its parts apart from the part with
-    the most faces (:func:`~lilium.geometry.mesh.parts_apart`)."""
-    apart, _ = parts_apart(vertices_mm, faces, None, PART_APART_MM)
-    corners = faces[~apart].reshape(-1)
-    return float(np.ptp(vertices_mm[corners], axis=0).max())
 
 
 def write_mesh(path, vertices_mm, faces):

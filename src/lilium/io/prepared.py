@@ -184,8 +184,8 @@ def read_prepared(folder):
     Parameters
     ----------
     folder : str or Path
-        A photo folder (read it with :func:`lilium.io.case.read_photo` too: this reads only the
-        extras).
+        A photo folder (read it with :func:`lilium.casework.build.read_photo` too: this reads
+        only the extras).
 
     Returns
     -------

@@ -11,9 +11,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from ..casework.build import read_photo
 from ..evaluation.metrics import implausible_sfo
 from ..imaging.raster import mesh_mask
-from ..io.case import read_photo
 from ..io.jsonio import read_json
 from ..io.truth import read_ground_truth
 from . import render as _render
