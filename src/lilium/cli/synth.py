@@ -146,7 +146,7 @@ def run(args):
             f"mandible, {unmarked} landmark(s) left unmarked"
         )
     if args.contact_sheet:
-        from ..synthetic.contact_sheet import contact_sheet
+        from ..report.contact_sheet import contact_sheet
 
         contact_sheet(args.out, args.contact_sheet, experiment=experiments[0])
         print(f"contact sheet: {args.contact_sheet}")

@@ -16,7 +16,7 @@ from ..evaluation.metrics import implausible_sfo
 from ..imaging.raster import mesh_mask
 from ..io.jsonio import read_json
 from ..io.truth import read_ground_truth
-from . import render as _render
+from ..synthetic import render as _render
 
 BONE_RGB = np.array([245.0, 245.0, 235.0])
 SKULL_ALPHA = 0.5
