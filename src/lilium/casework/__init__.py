@@ -7,6 +7,8 @@
   skull and photos from folders or plain files, with the precedence of priors: command line,
   ``photo.json``, EXIF) and :mod:`~lilium.casework.prepared` (photo folders of ``lilium photo``
   in a case, ``--auto-landmarks``);
+- :mod:`~lilium.casework.build`: the typed ``Skull`` and ``Photo`` built and checked from what
+  :mod:`lilium.io` parses;
 - :mod:`~lilium.casework.single`: one SFO without a report (``lilium sfo``);
 - :mod:`~lilium.casework.case`: every SFO of a case and its HTML report (``lilium case``);
 - :mod:`~lilium.casework.lineup`: one skull against several candidates (``lilium lineup``);
