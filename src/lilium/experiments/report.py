@@ -330,16 +330,8 @@ def rank_distribution(ranks):
                 [r["rank"] for r in items if (r["method"], r["variant"]) == (method, variant)]
             )
             label = method_label(method, variant)
-            out += [
-                {
-                    "method": label,
-                    "experiment": exp,
-                    "view": "all",
-                    "rank": g,
-                    "rate": float((values <= g).mean()),
-                }
-                for g in range(1, k + 1)
-            ]
+            row = {"method": label, "experiment": exp, "view": "all"}
+            out += [row | {"rank": g, "rate": float((values <= g).mean())} for g in range(1, k + 1)]
     return out
 
 
