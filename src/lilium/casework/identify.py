@@ -35,10 +35,8 @@ def decide(skull, photos, results, calibrations, facial_landmarks_mm=None, joint
 
 
 def conclusion_line(record):
-    """One console line: the conclusion, the LR, and what capped it (``record``: an
-    :class:`~lilium.identification.decision.Identification` or its dict)."""
-    if hasattr(record, "to_dict"):
-        record = record.to_dict()
+    """One console line: the conclusion, the LR, and what capped it (``record``: the
+    ``"identification"`` dict, :meth:`~lilium.identification.decision.Identification.to_dict`)."""
     lr = record.get("log10_lr")
     lr_text = "no LR" if lr is None else f"log10 LR {lr:+.2f} (LR {10**lr:.3g})"
     caps = dict(record.get("caps") or {})
