@@ -59,6 +59,7 @@ def test_the_command_line_becomes_one_request(case, tmp_path):
     record = request.to_dict()
     assert record["photos"][1]["landmarks"] == "b.csv"
     assert record["options"]["generations"] == 7 and record["skull"]["path"] == str(subject_dir)
+    assert "command" not in record  # the report's command row holds it
     json.dumps(record)  # plain JSON values only
     with pytest.raises(ValueError, match="--mask given 2 times for 1 photo image"):
         _request(["case", "--skull", str(subject_dir), "--photo", str(image), "--mask", "a.png",

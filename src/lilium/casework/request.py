@@ -154,8 +154,10 @@ class CaseRequest:
 
     def to_dict(self):
         """The request as plain JSON values (paths as strings; the SFO options as the
-        variant and the DE settings, the rest being the defaults)."""
-        out = {f.name: _plain(getattr(self, f.name)) for f in fields(self) if f.name != "options"}
+        variant and the DE settings, the rest being the defaults). Without ``command``: the
+        report shows the command line in a row of its own."""
+        skip = ("options", "command")
+        out = {f.name: _plain(getattr(self, f.name)) for f in fields(self) if f.name not in skip}
         de = self.options.de
         out["options"] = {
             "variant": self.options.variant,
