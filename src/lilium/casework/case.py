@@ -1,5 +1,6 @@
 """Every SFO of a user's case, written as it goes, and one HTML report for them all."""
 
+import functools
 from dataclasses import replace
 from pathlib import Path
 
@@ -12,6 +13,14 @@ from .inputs import check_runnable
 from .joint_case import check_joint_case, joint_entry, run_joint_methods
 from .prepared import check_photo_extra
 from .read import read_case
+
+
+def searched_line(result):
+    """One line for the search's camera scored as an examiner's is (soft tissue re-fitted
+    under it for Lilium): fitness and mean landmark error."""
+    error = (result.landmark_error or {}).get("mean_px")
+    px = "" if error is None else f", mean landmark error {error:.2f} px"
+    return f"fitness {result.fitness:.4g}{px}"
 
 
 def term_label(term):
@@ -129,16 +138,16 @@ def _check_records(inputs, methods, log):
     photos with unreviewed automatic landmarks."""
     variant = inputs.options.variant
     planned = {}
-    for photo, photo_inputs, _, _ in inputs.records:
-        planned[photo.id] = check_runnable(
-            inputs.skull, photo, methods, variant, inputs.skull_inputs, photo_inputs
+    for record in inputs.records:
+        planned[record.photo.id] = check_runnable(
+            inputs.skull, record.photo, methods, variant, inputs.skull_inputs, record.inputs
         )
     for photo_id, off in planned.items():
         for term, why in off.items():
             log(f"{photo_id}: lilium {variant}: {term_label(term)} switched off: {why}")
-    for photo, _, _, origin in inputs.records:
-        if origin is not None and origin.unreviewed:
-            log(f"{photo.id}: {origin.line()}")
+    for record in inputs.records:
+        if record.origin is not None and record.origin.unreviewed:
+            log(f"{record.photo.id}: {record.origin.line()}")
 
 
 class _CaseRun:
@@ -155,8 +164,9 @@ class _CaseRun:
     def entries(self, records, methods, joints):
         """The report entries of every photo and method (``joints``: the joint SFOs' runs)."""
         entries = []
-        for k, (photo, inputs, notes, origin) in enumerate(records):
-            landmark_info = _landmark_info(origin, self.out)
+        for k, record in enumerate(records):
+            photo, inputs, notes = record.photo, record.inputs, record.notes
+            landmark_info = _landmark_info(record.origin, self.out)
             labelled = {**self.skull_inputs, **inputs}
             for method in methods:
                 if method in joints:
@@ -165,24 +175,33 @@ class _CaseRun:
                 else:
                     entry = self.single(method, photo, inputs, notes, landmark_info)
                 entries.append(entry)
+                if record.camera is not None:  # the examiner's, beside the search's
+                    entries.append(self.examined(method, record, entry.result, landmark_info))
         return entries
 
-    def single(self, method, photo, inputs, notes, landmark_info):
-        """The report entry of ``method``'s SFO of ``photo``, run or reused, and logged."""
+    def single(self, method, photo, inputs, notes, landmark_info, camera=None, folder=None):
+        """The report entry of ``method``'s SFO of ``photo``, run or reused, and logged; with
+        ``camera`` (:meth:`examined`) that camera scored, in ``folder``."""
         from ..report.html import ReportEntry
 
         tag = method_tag(method, self.options.variant)
-        folder = self.out / safe_id(photo.id) / tag  # ids read from files are safe already
+        folder = folder or self.out / safe_id(photo.id) / tag  # ids read from files are safe
         fingerprint = sfo_fingerprint(
             method, self.options, self.seed, self.skull, self.skull_inputs, [photo], [inputs],
             self.digests,
         )
         sfo = (method, self.skull, photo, self.options, self.seed)
         calibrations, log = self.calibrations, self.log
-        result, reused = resumed_sfo(folder, *sfo, fingerprint, calibrations, log, run_sfo)
-        self.separate.setdefault(method, []).append((photo, result))
+        run = run_sfo
+        if camera is not None:
+            name = str(inputs["examiner camera"])
+            run = functools.partial(run_sfo, camera=camera, camera_name=name)
+        result, reused = resumed_sfo(folder, *sfo, fingerprint, calibrations, log, run)
+        if camera is None:
+            self.separate.setdefault(method, []).append((photo, result))
         outputs = sfo_outputs(folder, self.out)
         name = f"{result.method}{f' {result.variant}' if result.variant else ''}"
+        name += ", examiner's camera" if camera is not None else ""
         how = " (stored)" if reused else ""
         self.log(
             f"{photo.id}: {name}: {status_text(result)}, {result.seconds:.2f} s{how} -> {folder}"
@@ -191,6 +210,23 @@ class _CaseRun:
         self.log(f"  {conclusion_line(result.extra['identification'])}")
         labelled = {**self.skull_inputs, **inputs}
         return ReportEntry(self.skull, photo, result, labelled, notes, outputs, **landmark_info)
+
+    def examined(self, method, record, searched, landmark_info):
+        """The report entry of the examiner's camera of ``record`` (``--camera``) scored by
+        ``method`` without search, in ``<photo>/<method tag>/examiner/``; its notes give the
+        search's camera scored the same way (:func:`searched_line`), so that the two compare."""
+        photo = record.photo
+        folder = self.out / safe_id(photo.id) / method_tag(method, self.options.variant)
+        inputs = {**record.inputs, "examiner camera": record.camera_file}
+        notes = dict(record.notes)
+        if searched:
+            rescored = run_sfo(
+                method, self.skull, photo, self.options, self.seed, camera=searched.camera
+            )
+            notes["search's camera, scored the same way"] = searched_line(rescored)
+        return self.single(
+            method, photo, inputs, notes, landmark_info, record.camera, folder / "examiner"
+        )
 
     def decisions(self, methods):
         """Each method's decision over its separate SFOs of two or more photos, logged."""

@@ -37,12 +37,16 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 
 class PhotoRecord(NamedTuple):
-    """One photo of a case as :func:`load_photos` read it."""
+    """One photo of a case as :func:`load_photos` read it; ``camera``: the examiner's camera
+    to score (:class:`~lilium.geometry.camera.Camera`, ``--camera``), read by
+    :func:`~lilium.casework.read.read_case`, and ``camera_file`` its file."""
 
     photo: object
     inputs: dict
     notes: dict
     origin: object = None
+    camera: object = None
+    camera_file: object = None
 
 
 def first_file(folder, names):

@@ -183,7 +183,7 @@ class _LineupRun:
         """Yield (method, ReportEntry) of each method's SFO of candidate ``name``'s photo."""
         from ..report.html import ReportEntry
 
-        photo, inputs, notes, _ = record
+        photo, inputs, notes = record.photo, record.inputs, record.notes
         folder_id = safe_id(photo.id)
         # The report and the results name the candidate with the photo.
         photo = replace(photo, id=f"{name}: {photo.id}")

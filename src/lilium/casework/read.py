@@ -11,6 +11,7 @@ from dataclasses import dataclass, replace
 
 from ..inputs import CaseWarning
 from ..io.case import read_depth_table
+from ..io.results import read_camera
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..softtissue.depths import depth_table_warning
@@ -30,7 +31,7 @@ class CaseInputs:
         The skull's files, labelled (provenance, fingerprints).
     records : tuple of PhotoRecord
         The request's photos (:func:`~lilium.casework.inputs.load_photos`), each with the
-        depth table's warning when it has one.
+        depth table's warning when it has one and the camera given to score (``--camera``).
     candidates : tuple of (str, tuple of PhotoRecord)
         A lineup's candidates and their photos.
     options : SfoOptions
@@ -82,6 +83,10 @@ def read_case(request, log=None, out=None):
         return load_photos(sources, request.priors, log=log, skull=skull, **kwargs)
 
     records = photos_of(request.photos, auto_landmarks=request.auto_landmarks, out=out)
+    records = [
+        r if s.camera is None else r._replace(camera=read_camera(s.camera), camera_file=s.camera)
+        for r, s in zip(records, request.photos, strict=True)
+    ]
     candidates = tuple((c.name, tuple(photos_of(c.photos))) for c in request.candidates)
     options = request.options
     if request.depth_table is not None:

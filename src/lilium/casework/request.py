@@ -60,6 +60,10 @@ class PhotoSource:
         An image's view (default frontal, or the head's yaw with automatic landmarks); for
         a folder, the view the user said all photos have (checked against its
         ``photo.json``), else None.
+    camera : Path or None
+        A camera to score for this photo besides (``lilium case``) or instead of (``lilium
+        sfo``) the search: an examiner's ``camera.json`` (``workbench.html``'s Save) or a
+        ``result.json`` (``--camera``).
     """
 
     path: Path
@@ -67,6 +71,7 @@ class PhotoSource:
     mask: Path | None = None
     face_curve: Path | None = None
     view: str | None = None
+    camera: Path | None = None
 
 
 @dataclass(frozen=True)

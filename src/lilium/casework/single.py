@@ -25,7 +25,9 @@ def single_sfo(request, log=None):
     request : CaseRequest
         One photo and one method (``request.methods[0]``); its axes, priors, depth table
         (replaces ``options.depth_table``), calibration (default: the shipped one,
-        :mod:`lilium.casework.identify`) and ``overlay`` (write ``overlay.png`` too).
+        :mod:`lilium.casework.identify`) and ``overlay`` (write ``overlay.png`` too). A photo
+        with a ``camera`` file has that camera scored instead of searched
+        (:func:`~lilium.methods.registry.run_sfo`; ``"camera_source": "examiner"``).
     log : callable, optional
         Receives one line per sidecar file found beside a mesh or an image.
 
@@ -42,8 +44,11 @@ def single_sfo(request, log=None):
     (method,) = request.methods
     check_method(method, request.options.variant)
     inputs = read_case(request, log=log)
-    skull, (photo,) = inputs.skull, inputs.photos
-    result = run_sfo(method, skull, photo, inputs.options, request.seed)
+    skull, (record,) = inputs.skull, inputs.records
+    photo, camera = record.photo, record.camera
+    result = run_sfo(
+        method, skull, photo, inputs.options, request.seed, camera, str(record.camera_file)
+    )
     result = with_identification(result, skull, [photo], inputs.calibrations)
     overlay = result_overlay(result, skull, photo) if request.overlay else None
     write_result(request.out, result, overlay)
@@ -71,6 +76,11 @@ def joint_sfo(request, log=None):
     check_joint_method(method, request.options.variant)
     if len(request.photos) < 2:
         raise ValueError("a joint SFO needs two or more --photo folders")
+    if any(source.camera is not None for source in request.photos):
+        raise ValueError(
+            "--camera scores one photo's camera: give one --photo with it (lilium sfo), or "
+            "use lilium case, which scores each photo's --camera beside its SFO"
+        )
     check_distinct_photos([source.path for source in request.photos])
     inputs = read_case(request, log=log)
     skull, photos = inputs.skull, inputs.photos

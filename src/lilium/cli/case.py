@@ -70,7 +70,8 @@ def register(subparsers):
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    add_options(p, "skull", "landmarks", "axes", "photo", "auto_landmarks", *PHOTO_FILES, "out",
+    add_options(p, "skull", "landmarks", "axes", "photo", "auto_landmarks", *PHOTO_FILES, "camera",
+                "out",
                 *SFO, *PRIORS, "depth_table", required=("skull", "photo", "out"),
                 shown={"method": "lilium"})
     p.add_argument(

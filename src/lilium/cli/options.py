@@ -15,6 +15,7 @@ yaw), ``lilium import-ct``'s ``--landmarks`` (in the volume's coordinates).
 """
 
 import shlex
+from dataclasses import replace
 from pathlib import Path
 
 from ..casework.request import Candidate, CaseRequest, PhotoSource, PriorOverrides, SkullSource
@@ -62,6 +63,12 @@ OPTIONS = {
         action="append", choices=VIEWS, default=[],
         help="view of each photo image (once for all images, or once per image; default "
         "frontal); photo folders take theirs from photo.json",
+    )),
+    "camera": (("--camera",), dict(
+        action="append", default=[], metavar="[PHOTO=]FILE",
+        help="score this camera without search: a camera.json (workbench.html's Save: focal_px, "
+        "principal_point_px, skull2cam) or a result.json; PHOTO=FILE for one --photo (PHOTO as "
+        "given or its id), FILE alone with one --photo; repeat per photo",
     )),
     "auto_landmarks": (("--auto-landmarks",), dict(
         action="store_true",
@@ -179,7 +186,8 @@ def photo_sources(args):
 
     ``--photo-landmarks``, ``--mask`` and ``--face-curve`` go to the images (not folders) in
     order; ``--view`` once goes to every photo (a folder's is checked against its
-    ``photo.json``), or once per image.
+    ``photo.json``), or once per image; ``--camera PHOTO=FILE`` to the photo it names
+    (:func:`_cameras`).
     """
     paths = [Path(p) for p in args.photo]
     images = [p for p in paths if not p.is_dir()]
@@ -201,7 +209,43 @@ def photo_sources(args):
             k += 1
         else:
             sources.append(PhotoSource(path, view=view_for_all))
-    return tuple(sources)
+    cameras = _cameras(getattr(args, "camera", []), paths)
+    return tuple(replace(s, camera=cameras.get(k)) for k, s in enumerate(sources))
+
+
+def _cameras(values, paths):
+    """``--camera [PHOTO=]FILE`` values -> ``{index of the --photo: Path}``.
+
+    PHOTO is a ``--photo`` as typed, the same path, or its id (folder name or image stem);
+    FILE alone names the camera of the only ``--photo``.
+    """
+    cameras = {}
+    for value in values:
+        photo, sep, file = value.partition("=")
+        if not sep:
+            if len(paths) != 1:
+                raise ValueError(
+                    f"--camera {value}: {len(paths)} --photo given; name the photo, "
+                    "--camera PHOTO=FILE"
+                )
+            photo, file = str(paths[0]), value
+        matches = [
+            k for k, p in enumerate(paths)
+            if photo in (str(p), p.name, p.stem) or Path(photo).resolve() == p.resolve()
+        ]
+        if len(matches) != 1:
+            given = ", ".join(str(p) for p in paths)
+            why = "no" if not matches else "more than one"
+            raise ValueError(
+                f"--camera {value}: {why} --photo is {photo!r}; name one of {given} (as given, "
+                "or its folder name or image stem)"
+            )
+        if matches[0] in cameras:
+            raise ValueError(f"--camera {value}: a second camera for --photo {photo}; give one")
+        if not Path(file).is_file():
+            raise ValueError(f"--camera {value}: camera file {file} not found")
+        cameras[matches[0]] = Path(file)
+    return cameras
 
 
 def case_request(args):

@@ -29,8 +29,8 @@ def register(subparsers):
         ),
     )
     add_options(
-        p, "skull", "landmarks", "axes", "photo", *PHOTO_FILES, "out", *SFO, *PRIORS, "depth_table",
-        required=("skull", "photo", "out"), shown={"method": DEFAULT_METHOD},
+        p, "skull", "landmarks", "axes", "photo", *PHOTO_FILES, "camera", "out", *SFO, *PRIORS,
+        "depth_table", required=("skull", "photo", "out"), shown={"method": DEFAULT_METHOD},
     )
     p.add_argument("--no-overlay", action="store_true", help="skip overlay.png")
     add_options(p, "calibration")
@@ -61,6 +61,8 @@ def run(args):
         )
         return 1
     name = result.method + (f" {result.variant}" if result.variant else "")
+    if result.camera_source == "examiner":
+        name += ", the given camera scored"
     print(
         f"{name}: focal {result.camera.focal_px:.0f} px, score {result.fitness:.3f}, "
         f"{result.seconds:.2f} s -> {request.out}"

@@ -119,9 +119,33 @@ def read_result_camera(path):
     return Camera.from_dict(data["camera"], name=f"{path}: camera")
 
 
+def read_camera(path):
+    """The camera a file gives to score (``--camera``): a ``camera.json`` (``focal_px``,
+    ``principal_point_px``, ``skull2cam``: ``workbench.html``'s Save) or a ``result.json`` (its
+    ``camera``).
+
+    Raises
+    ------
+    ValueError
+        A missing or malformed file or camera, or a failed SFO's result, naming the file.
+    """
+    from ..geometry.camera import Camera
+
+    data = read_json(path)
+    if isinstance(data, dict) and "camera" in data and "focal_px" not in data:
+        if data["camera"] is None:
+            raise ValueError(
+                f"{path}: this result.json is a failed SFO's and has no camera; give a "
+                "camera.json (workbench.html's Save) or the result of an SFO that found one"
+            )
+        data = data["camera"]
+    return Camera.from_dict(data, name=str(path))
+
+
 #: ``result.json`` keys of one SFO that are :class:`~lilium.methods.result.SfoResult` fields
 #: (the others go to its ``extra``).
-_SFO_KEYS = {"method", "variant", "seed", "subject", "photo", "camera", "fitness", "terms",
+_SFO_KEYS = {"method", "variant", "seed", "subject", "photo", "camera", "camera_source",
+             "fitness", "terms",
              "terms_off", "facial_landmarks_3d", "seconds", "landmark_error", "warnings",
              "priors", "error"}
 
@@ -163,6 +187,7 @@ def _sfo_result(data, camera, extra):
         priors=data.get("priors"),
         landmark_error=data.get("landmark_error"),
         terms_off=dict(data.get("terms_off") or {}),
+        camera_source=str(data.get("camera_source", "search")),
     )
 
 

@@ -46,7 +46,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..constants import FACING_MAX_DEG, VIEW_SPLIT_DEG
+from ..constants import FACING_MAX_DEG, MIN_DEPTH_MM, VIEW_SPLIT_DEG
 from ..inputs import CaseWarning
 from ..softtissue.landmarks import side, twin
 from .photo_checks import (
@@ -217,6 +217,47 @@ def facing_check(skull):
     if directions is None:
         return None
     return FacingRule(directions, float(np.cos(np.radians(FACING_MAX_DEG))))
+
+
+def check_given_camera(camera, skull, photo, name="camera"):
+    """Raise when a camera given to score (an examiner's, ``--camera``) cannot show the skull
+    in the photo: a skull landmark at or behind the camera, the skull's front turned away
+    (the facing rule of the search, :func:`facing_check`), or a principal point outside the
+    image.
+
+    Parameters
+    ----------
+    camera : Camera
+    skull : Skull
+    photo : Photo
+    name : str
+        Where the camera came from (a file), for the message.
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``, what is wrong and the fix.
+    """
+    points = np.array(list(skull.landmarks_mm.values()) or skull.vertices_mm[:1], dtype=float)
+    depth = camera.to_camera_frame(points)[:, 2]
+    if np.any(depth <= MIN_DEPTH_MM):
+        raise ValueError(
+            f"{name}: the skull lies behind this camera (a landmark {depth.min():.0f} mm from "
+            "its image plane); give the camera of an overlay (skull2cam maps the skull in front "
+            "of the camera, z forward)"
+        )
+    rule = facing_check(skull)
+    if rule is not None and not rule(camera.R[None], camera.t[None])[0]:
+        raise ValueError(
+            f"{name}: this camera sees the back of skull {skull.id!r} (more than "
+            f"{FACING_MAX_DEG:g} deg from its anterior direction); give the camera of an overlay"
+        )
+    (w, h), (u, v) = photo.image_size_wh, camera.principal_point_px
+    if not (-0.5 <= u <= w - 0.5 and -0.5 <= v <= h - 0.5):
+        raise ValueError(
+            f"{name}: principal point ({u:g}, {v:g}) px lies outside the {w} x {h} photo "
+            f"{photo.id!r}; is the camera for another photo?"
+        )
 
 
 def facing_failure(skull, photo):

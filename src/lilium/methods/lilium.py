@@ -92,9 +92,13 @@ class LiliumProblem:
     options : SfoOptions
     rng : seed or numpy Generator
         For the RANSAC of initial and fallback POSEST runs.
+    camera : Camera, optional
+        A fixed camera (an examiner's, :func:`lilium_sfo`'s ``camera``): every member gets it,
+        so the DE searches the soft tissue only; its principal point replaces the image centre.
+        The image terms, which depend on the camera alone, are computed once.
     """
 
-    def __init__(self, skull, photo, options=SfoOptions(), rng=0):
+    def __init__(self, skull, photo, options=SfoOptions(), rng=0, camera=None):
         if options.variant not in VARIANTS:
             raise ValueError(
                 f"unknown Lilium variant {options.variant!r}; use one of {', '.join(VARIANTS)}"
@@ -106,7 +110,13 @@ class LiliumProblem:
         self.use_skof, self.use_pll = VARIANTS[options.variant]
         self.corr = correspondences(skull, photo)
         self.cones = build_cones(skull, self.corr, options.depth_table)
-        self.centre = principal_point_of(photo.image_size_wh)
+        self.camera = camera
+        self.centre = (
+            principal_point_of(photo.image_size_wh)
+            if camera is None
+            else np.asarray(camera.principal_point_px, dtype=float)
+        )
+        self._fixed_terms = {}  # the image terms of the fixed camera, once computed
         self.uv_c = self.corr.uv_px - self.centre
         names = self.corr.facial_names
         self.scd_index = [names.index("nasion")] if "nasion" in names else list(range(len(names)))
@@ -188,6 +198,10 @@ class LiliumProblem:
         R (S, 3, 3), t (S, 3), focal_px (S,), success (S,) bool, sq_err_px2 (S, N)
         """
         S = len(facial_mm)
+        if self.camera is not None:
+            c = self.camera
+            R, t = np.repeat(c.R[None], S, axis=0), np.repeat(c.t[None], S, axis=0)
+            return self._scored(facial_mm, R, t, np.full(S, c.focal_px))
         if members is None:
             # One POSEST, then every member refines from that camera (members it does not suit
             # fall back to their own POSEST below).
@@ -302,7 +316,7 @@ class LiliumProblem:
             ``fitness``, ``mse_pix``, ``p_cam``, ``p_skof``, ``p_pll`` (NaN when off or
             skipped), ``success`` and the cameras ``R``, ``t``, ``focal_px``.
         """
-        if members is not None and jit.compiled():
+        if members is not None and jit.compiled() and self.camera is None:
             terms = camera_terms_compiled(self, genes, members)
         else:
             terms = self.camera_terms(self.facial_landmarks(genes), members)
@@ -388,12 +402,18 @@ class LiliumProblem:
         if not pose:
             return None
         facial = self.facial_landmarks(genes)
-        R, t = pose.camera.R[None], pose.camera.t[None]
-        f = np.array([pose.camera.focal_px])
-        sq = reprojection_sq_errors(self.uv_c, facial, R, t, f)
+        c = pose.camera
+        scored = self._scored(facial, c.R[None], c.t[None], np.array([c.focal_px]))
+        return genes, self.add_image_terms(self._terms(facial, *scored))
+
+    def _scored(self, facial_mm, R, t, f):
+        """:meth:`cameras`' tuple for given cameras ``R (S, 3, 3)``, ``t (S, 3)``, ``f (S,)``
+        (no fit): a camera is valid when its focal length and facing pass and every point lies
+        in front of it."""
+        sq = reprojection_sq_errors(self.uv_c, facial_mm, R, t, f)
         ok = self._valid(f, self._facing(R, t)) & np.all(np.isfinite(sq), axis=1)
         sq[~ok] = np.inf
-        return genes, self.add_image_terms(self._terms(facial, R, t, f, ok, sq))
+        return R, t, f, ok, sq
 
     def add_image_terms(self, terms, thresholds=None, offset=0.0, weight=1.0, names=IMAGE_TERMS):
         """Add P_skof and P_pll to :meth:`camera_terms`' dictionary (in place; returned).
@@ -432,10 +452,19 @@ class LiliumProblem:
             with np.errstate(over="ignore", invalid="ignore"):
                 todo = ok & (offset + weight * fitness <= bound)
             if todo.any():
-                values[todo] = term(Cameras(R[todo], t[todo], f[todo], self.centre))
+                values[todo] = self._image_term(name, term, R[todo], t[todo], f[todo])
                 fitness[todo] += values[todo]
             values[~ok] = 0.0
         return terms
+
+    def _image_term(self, name, term, R, t, f):
+        """One image term of cameras ``R (K, 3, 3)``, ``t (K, 3)``, ``f (K,)``: ``(K,)``; with a
+        fixed camera its value is computed once (it does not depend on the soft tissue)."""
+        if self.camera is None:
+            return term(Cameras(R, t, f, self.centre))
+        if name not in self._fixed_terms:
+            self._fixed_terms[name] = term(Cameras(R[:1], t[:1], f[:1], self.centre))[0]
+        return np.full(len(R), self._fixed_terms[name])
 
     def __call__(self, genes, members=None, thresholds=None):
         """DE's objective: ``(fitness (S,), payload)``, the payload being :meth:`evaluate`'s
@@ -444,7 +473,7 @@ class LiliumProblem:
         return terms["fitness"], terms
 
 
-def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
+def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None, camera=None):
     """Run Lilium on one skull and one photo.
 
     Parameters
@@ -456,6 +485,10 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
         Seeds DE and the RANSAC of POSEST calls: the same seed gives the same result.
     callback : callable, optional
         ``callback(solver) -> bool`` after every generation (progress; True stops).
+    camera : Camera, optional
+        Score this camera instead of searching one: the DE runs over the soft-tissue cones
+        only, every member under this camera, and the result is the best soft tissue under it
+        (its terms, fitness and facial landmarks; ``camera`` itself).
 
     Returns
     -------
@@ -474,11 +507,11 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None):
     """
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
-    problem = LiliumProblem(skull, photo, options, rng=rng)
+    problem = LiliumProblem(skull, photo, options, rng=rng, camera=camera)
     solver = DifferentialEvolution(
         problem, problem.cones.n_genes, problem.periodic, options.de, rng=rng, callback=callback
     )
-    rescued = rescue_population(problem, solver)
+    rescued = camera is None and rescue_population(problem, solver)
     de = solver.solve()
     best = de.payload
     camera, terms, error, warnings = photo_outcome(problem, best, seed)

@@ -5,13 +5,13 @@ runs a method through :func:`run_sfo` with one :class:`~lilium.methods.options.S
 :data:`METHODS` is the one list of methods and their variants.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-from .checks import check_inputs, finish_result
+from .checks import check_given_camera, check_inputs, finish_result
 from .joint import joint_lilium_sfo
 from .lilium import VARIANTS, lilium_sfo
 from .options import SfoOptions
-from .posest_sfo import posest_sfo
+from .posest_sfo import posest_sfo, posest_sfo_at
 
 
 @dataclass(frozen=True)
@@ -24,6 +24,9 @@ class Method:
         As on the command line and in ``result.json``.
     run : callable
         ``run(skull, photo, options, seed) -> SfoResult``.
+    score : callable
+        ``score(skull, photo, camera, options, seed) -> SfoResult``: the method's result for a
+        given camera, without search (an examiner's camera, docs/method/workbench.md).
     variants : tuple of str
         Fitness variants (empty for a method without variants).
     stochastic : bool
@@ -36,6 +39,7 @@ class Method:
 
     name: str
     run: object
+    score: object
     variants: tuple = ()
     stochastic: bool = False
     run_joint: object = None
@@ -46,8 +50,17 @@ def _posest_sfo(skull, photo, options, seed):
     return posest_sfo(skull, photo, options)
 
 
+def _posest_sfo_at(skull, photo, camera, options, seed):
+    del seed  # deterministic
+    return posest_sfo_at(skull, photo, camera, options)
+
+
 def _lilium(skull, photo, options, seed):
     return lilium_sfo(skull, photo, options, seed=seed)
+
+
+def _lilium_at(skull, photo, camera, options, seed):
+    return lilium_sfo(skull, photo, options, seed=seed, camera=camera)
 
 
 def _joint_lilium(skull, photos, options, seed):
@@ -56,8 +69,10 @@ def _joint_lilium(skull, photos, options, seed):
 
 #: The methods, by name.
 METHODS = {
-    "posest-sfo": Method("posest-sfo", _posest_sfo),
-    "lilium": Method("lilium", _lilium, tuple(VARIANTS), stochastic=True, run_joint=_joint_lilium),
+    "posest-sfo": Method("posest-sfo", _posest_sfo, _posest_sfo_at),
+    "lilium": Method(
+        "lilium", _lilium, _lilium_at, tuple(VARIANTS), stochastic=True, run_joint=_joint_lilium
+    ),
 }
 
 
@@ -78,8 +93,8 @@ def method_tag(method, variant=None):
     return f"{method}-{variant}" if METHODS[method].variants and variant else method
 
 
-def run_sfo(method, skull, photo, options=SfoOptions(), seed=0):
-    """Run one SFO.
+def run_sfo(method, skull, photo, options=SfoOptions(), seed=0, camera=None, camera_name="camera"):
+    """Run one SFO, or score a given camera.
 
     Parameters
     ----------
@@ -91,6 +106,12 @@ def run_sfo(method, skull, photo, options=SfoOptions(), seed=0):
         ``options.variant`` selects the variant of a method that has them.
     seed : int
         For stochastic methods; the same seed gives the same result.
+    camera : Camera, optional
+        Score this camera instead of searching one (the method's ``score``; for Lilium the
+        best soft tissue under it): ``camera_source`` ``"examiner"``.
+    camera_name : str
+        Where ``camera`` came from, for the message of a camera that cannot show the skull
+        (:func:`~lilium.methods.checks.check_given_camera`).
 
     Returns
     -------
@@ -107,7 +128,11 @@ def run_sfo(method, skull, photo, options=SfoOptions(), seed=0):
     """
     m = check_method(method, options.variant)
     check_inputs(skull, photo)
-    return finish_result(m.run(skull, photo, options, seed), skull, photo)
+    if camera is None:
+        return finish_result(m.run(skull, photo, options, seed), skull, photo)
+    check_given_camera(camera, skull, photo, camera_name)
+    result = replace(m.score(skull, photo, camera, options, seed), camera_source="examiner")
+    return finish_result(result, skull, photo)
 
 
 def check_joint_method(method, variant=None):
@@ -149,8 +174,6 @@ def run_joint_sfo(method, skull, photos, options=SfoOptions(), seed=0):
         As :func:`run_sfo` for each photo; a method without a joint form; fewer than two
         photos or a repeated photo id.
     """
-    from dataclasses import replace
-
     m = check_joint_method(method, options.variant)
     photos = list(photos)
     for photo in photos:

@@ -44,6 +44,9 @@ class SfoResult:
         (docs/method/lilium.md, "When a term cannot apply"): ``p_skof``, ``p_pll`` (asked for by the
         variant), ``p_cam_focal``, ``p_cam_scd``, ``p_cam_head`` (a P_cam part without its
         prior). Empty when every term ran; ``result.json`` then has no ``terms_off`` key.
+    camera_source : {"search", "examiner"}
+        Where the camera came from: the method's search, or given to score (``--camera``,
+        :func:`lilium.methods.run_sfo`'s ``camera``).
 
     :func:`lilium.methods.run_sfo` fills ``warnings``, ``priors`` and ``landmark_error`` for
     every method (:func:`lilium.methods.checks.finish_result`).
@@ -65,6 +68,7 @@ class SfoResult:
     priors: dict | None = None
     landmark_error: dict | None = None
     terms_off: dict = field(default_factory=dict)
+    camera_source: str = "search"
 
     def __bool__(self):
         return self.camera is not None
@@ -79,6 +83,7 @@ class SfoResult:
             "subject": self.skull_id,
             "photo": self.photo_id,
             "camera": camera,
+            "camera_source": self.camera_source,
             "fitness": finite_or_none(self.fitness),
             "terms": {k: finite_or_none(v) for k, v in self.terms.items()},
             **(

@@ -89,7 +89,10 @@ def method_label(result):
     """Method and variant of an SFO, e.g. ``"lilium skof+pll"``; ``"lilium skof+pll joint"``
     for a photo's part of a joint SFO."""
     joint = " joint" if result.extra.get("joint_photos") else ""
-    return result.method + (f" {result.variant}" if result.variant else "") + joint
+    examiner = ""
+    if result.camera_source == "examiner":
+        examiner = ", examiner's camera (scored, no search)"
+    return result.method + (f" {result.variant}" if result.variant else "") + joint + examiner
 
 
 def landmark_rows(result, photo):
