@@ -50,7 +50,11 @@ PAGE_SIDE_PX = 4000
 JPEG_QUALITY = 90
 
 #: The scripts inlined in the page, in order (``lilium/report/web/``).
-SCRIPTS = {"__PAGE_JS__": "page.js", "__MESHGL_JS__": "meshgl.js", "__WORKBENCH_JS__": "workbench.js"}
+SCRIPTS = {
+    "__PAGE_JS__": "page.js",
+    "__MESHGL_JS__": "meshgl.js",
+    "__WORKBENCH_JS__": "workbench.js",
+}
 
 
 def _web_file(name):
