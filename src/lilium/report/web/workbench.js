@@ -25,7 +25,7 @@
   const G = MeshGL;
 
   /** Degrees turned per CSS pixel dragged; distance change per wheel notch. */
-  const TURN_DEG_PER_PX = 0.25, WHEEL_DISTANCE = 0.01, WHEEL_ZOOM = 1.15;
+  const TURN_DEG_PER_PX = 0.1, WHEEL_DISTANCE = 0.01, WHEEL_ZOOM = 1.15;
   /** Largest side (pixels) of the offscreen picture the test hook measures the skull box on. */
   const MEASURE_MAX_PX = 4096;
 
@@ -54,8 +54,14 @@
 
   // ---- the stage: photo, skull canvas, marks; `view` is the photo region shown -------------
   const stage = $("stage"), canvas = $("skull"), photo = $("photo"), marks = $("marks");
-  const renderer = new G.Renderer(canvas);
-  renderer.setMesh(mesh);
+  let renderer = null;
+  try {
+    renderer = new G.Renderer(canvas);
+    renderer.setMesh(mesh);
+  } catch (err) {  // no WebGL 2: the landmarks and their errors still work
+    $("no-webgl").textContent = "The skull cannot be drawn: " + err.message;
+    $("no-webgl").hidden = false;
+  }
   const [W, H] = DATA.image_size_wh;
   const boxView = (b) => ({x: b[0] - 0.5, y: b[1] - 0.5, width: b[2] - b[0], height: b[3] - b[1]});
   let wanted = boxView(DATA.view_box), view = wanted, cssW = 1, cssH = 1;
@@ -162,7 +168,7 @@
   }
   function redraw() {
     const cam = camera();
-    renderer.draw(cam, view, style());
+    if (renderer) renderer.draw(cam, view, style());
     updateLandmarks(cam);
     $("camera").textContent = JSON.stringify(cam);
     const wipe = control("wipe").value;
@@ -291,7 +297,7 @@
       const pre = document.createElement("pre"); pre.id = id; pre.textContent = text;
       $("test-output").append(pre);
     };
-    out("skull-box", skullBox(cam));
+    out("skull-box", renderer ? skullBox(cam) : "no WebGL");
     const name = "nasion" in DATA.cranial_mm ? "nasion" : cranialNames[0];
     if (name) {
       const uv = G.project([DATA.cranial_mm[name]], cam)[0], hit = pick(uv[0], uv[1]);
