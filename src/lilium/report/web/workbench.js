@@ -156,32 +156,29 @@
   }
 
   // ---- drawing ---------------------------------------------------------------------------
-  const control = (id) => $(id);
   function style() {
     const dpr = window.devicePixelRatio || 1;
-    return {alpha: control("opacity").value / 100,
-            outline: control("outline").checked ? Math.max(1, Math.round(dpr)) : 0};
+    return {alpha: $("opacity").value / 100,
+            outline: $("outline").checked ? Math.max(1, Math.round(dpr)) : 0};
   }
-  function showFields(except) {
-    for (const [k, digits] of Object.entries(FIELDS)) {
-      if (k !== except) control(k).value = state[k].toFixed(digits);
-    }
+  function showFields() {
+    for (const [k, digits] of Object.entries(FIELDS)) $(k).value = state[k].toFixed(digits);
   }
   function redraw() {
     const cam = camera();
     if (renderer) renderer.draw(cam, view, style());
     updateLandmarks(cam);
     $("camera").textContent = JSON.stringify(cam);
-    const wipe = control("wipe").value;
+    const wipe = $("wipe").value;
     canvas.style.clipPath = "inset(0px " + (100 - wipe) + "% 0px 0px)";
-    control("opacity").nextElementSibling.textContent = control("opacity").value + " %";
-    control("wipe").nextElementSibling.textContent = wipe + " %";
+    $("opacity").nextElementSibling.textContent = $("opacity").value + " %";
+    $("wipe").nextElementSibling.textContent = wipe + " %";
     const wipeLine = $("wipe-line");
     wipeLine.style.left = wipe + "%"; wipeLine.hidden = Number(wipe) >= 100;
     for (const g of ["cranial", "photo", "estimate", "tissue", "errors"]) {
-      $("g-" + g).style.display = control("show-" + g).checked ? "" : "none";
+      $("g-" + g).style.display = $("show-" + g).checked ? "" : "none";
     }
-    marks.classList.toggle("names", control("show-names").checked);
+    marks.classList.toggle("names", $("show-names").checked);
   }
   let pending = false;
   function schedule() {
@@ -192,17 +189,17 @@
 
   // ---- controls ---------------------------------------------------------------------------
   for (const k of Object.keys(FIELDS)) {
-    control(k).addEventListener("input", () => {
-      const x = Number(control(k).value);
+    $(k).addEventListener("input", () => {
+      const x = Number($(k).value);
       const ok = Number.isFinite(x) && (k !== "distance" && k !== "focal" || x > 0);
-      control(k).classList.toggle("bad", !ok);
+      $(k).classList.toggle("bad", !ok);
       if (ok) { state[k] = x; schedule(); }
     });
   }
   for (const id of ["opacity", "wipe", "outline", "show-cranial", "show-photo", "show-estimate",
     "show-tissue", "show-errors", "show-names"]) {
-    control(id).addEventListener("input", schedule);
-    control(id).addEventListener("change", schedule);
+    $(id).addEventListener("input", schedule);
+    $(id).addEventListener("change", schedule);
   }
   $("reset").onclick = () => { state = sfoState(); showFields(); schedule(); };
   $("view-face").onclick = () => { wanted = boxView(DATA.view_box); layout(); schedule(); };
