@@ -18,7 +18,8 @@ is decimated (:func:`lilium.geometry.mesh.decimate`, quadric).
 Opened as ``workbench.html?test[&yaw=D][&pitch=D][&roll=D]`` the page turns the skull, draws it
 and writes ``<pre id="skull-box">u0 v0 u1 v1</pre>`` (the drawn skull's box, photo pixels, read
 back from the framebuffer), ``<pre id="camera">`` (its camera), ``<pre id="pick">`` (a surface
-pick at the projected nasion) and ``<pre id="timing">``, and presses Save (for the
+pick at the projected nasion) and ``<pre id="timing">``, and presses Save, which only fills the
+download link (for the
 headless-browser tests).
 """
 

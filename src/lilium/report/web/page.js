@@ -20,12 +20,13 @@ const Page = (function () {
   function float32(id) { return new Float32Array(bytes(id).buffer); }
   function uint32(id) { return new Uint32Array(bytes(id).buffer); }
 
-  /** Offer `text` as the download of `link` (an <a download=...>) and click it. */
-  function offerDownload(link, text, mime) {
+  /** Offer `text` as the download of `link` (an <a download=...>), and click it unless
+      `click` is false (a headless test reads the link instead of saving a file). */
+  function offerDownload(link, text, mime, click) {
     link.href = "data:" + (mime || "application/json") + ";charset=utf-8," +
       encodeURIComponent(text);
     link.hidden = false;
-    link.click();
+    if (click !== false) link.click();
   }
 
   /** The page's query (`?test&yaw=5`). */

@@ -18,7 +18,7 @@
    skull, draws, and writes pre elements: skull-box, "u0 v0 u1 v1" (the drawn skull's pixels'
    extreme centres, photo pixels, read back with gl.readPixels); camera (its JSON); pick (a
    surface pick at the projected nasion); timing (ms from opening to the first draw, and to
-   the end of the hooks); and presses Save. */
+   the end of the hooks); and presses Save, which then fills the download link only. */
 (function () {
   "use strict";
   const $ = (id) => document.getElementById(id);
@@ -204,8 +204,9 @@
   $("reset").onclick = () => { state = sfoState(); showFields(); schedule(); };
   $("view-face").onclick = () => { wanted = boxView(DATA.view_box); layout(); schedule(); };
   $("view-photo").onclick = () => { wanted = boxView([0, 0, W, H]); layout(); schedule(); };
-  $("save").onclick = () => {
-    Page.offerDownload($("download"), JSON.stringify(camera(), null, 1));
+  const testing = Page.params().has("test");
+  $("save").onclick = () => {  // under test the link is only filled (no file in Downloads)
+    Page.offerDownload($("download"), JSON.stringify(camera(), null, 1), null, !testing);
   };
 
   /** The photo pixel under a pointer event. */
