@@ -19,8 +19,7 @@ Opened as ``workbench.html?test[&yaw=D][&pitch=D][&roll=D]`` the page turns the 
 and writes ``<pre id="skull-box">u0 v0 u1 v1</pre>`` (the drawn skull's box, photo pixels, read
 back from the framebuffer), ``<pre id="camera">`` (its camera), ``<pre id="pick">`` (a surface
 pick at the projected nasion) and ``<pre id="timing">``, and presses Save, which only fills the
-download link (for the
-headless-browser tests).
+download link (for the headless-browser tests).
 """
 
 import base64
