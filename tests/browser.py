@@ -20,6 +20,16 @@ needs_chromium = pytest.mark.skipif(
 )
 
 
+#: Flags for pages that draw with WebGL: Chromium's software GPU (SwiftShader through ANGLE),
+#: as headless machines have no GPU.
+WEBGL_FLAGS = (
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--enable-webgl",
+    "--ignore-gpu-blocklist",
+)
+
+
 def run_chromium(*args, tmp_path, timeout=120):
     """Run headless Chromium with ``args`` (its own profile under ``tmp_path``); the
     completed process (``stdout``: e.g. ``--dump-dom``'s page)."""

@@ -20,12 +20,18 @@ The report is built in two steps, computing first and formatting second:
   views with their labelled cranial landmarks).
 
 Input hashing and software versions come from :mod:`lilium.io.provenance`.
+
+:mod:`~lilium.report.workbench` writes ``workbench.html`` beside an SFO's result: the skull drawn
+with WebGL through the result's camera over the photo, to turn, move and save as
+``camera.json`` (scripts in ``lilium/report/web/``: ``meshgl.js``, the mesh module any page
+reuses, ``page.js``, ``workbench.js``).
 """
 
 from .html import build_report, format_report, write_report
 from .pictures import skull_layer_rgba, view_box
 from .record_types import ReportRecord, SfoRecord
 from .records import ReportEntry, report_record, sfo_record
+from .workbench import workbench_page, write_workbench
 
 __all__ = [
     "ReportEntry",
@@ -37,5 +43,7 @@ __all__ = [
     "sfo_record",
     "skull_layer_rgba",
     "view_box",
+    "workbench_page",
     "write_report",
+    "write_workbench",
 ]
