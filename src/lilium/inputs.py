@@ -123,6 +123,25 @@ class Photo:
 
 
 @dataclass(frozen=True)
+class GivenCamera:
+    """A camera given to score without search (an examiner's, ``--camera``).
+
+    Attributes
+    ----------
+    camera : lilium.geometry.camera.Camera
+    facial_landmarks_mm : dict of str -> ndarray of shape (3,), or None
+        The soft tissue the camera was chosen with (the facial landmarks of the result the
+        workbench showed, or of a ``result.json``), skull frame; None for a bare camera.
+    source : str
+        Where it came from (a file), for messages.
+    """
+
+    camera: object
+    facial_landmarks_mm: dict | None = None
+    source: str = "camera"
+
+
+@dataclass(frozen=True)
 class Correspondences:
     """Landmarks usable for one SFO: present on the skull and visible in the photo.
 

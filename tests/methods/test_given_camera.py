@@ -2,6 +2,7 @@
 ``lilium sfo --camera`` and ``lilium case --camera PHOTO=FILE``."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -10,6 +11,7 @@ from cli_helpers import _one_line_error, _run, _sfo
 from lilium.casework.build import read_photo, read_skull
 from lilium.geometry.camera import Camera
 from lilium.geometry.rotations import geodesic_angle_deg, rotvec_to_matrix
+from lilium.inputs import GivenCamera
 from lilium.methods import SfoOptions, run_sfo
 
 FAST = SfoOptions(variant="skof+pll").with_de(max_generations=60, population_size=16)
@@ -35,7 +37,7 @@ def _turned(camera, skull, yaw_deg):
 def test_posest_sfo_reproduces_its_own_camera(case):
     skull, photo = _inputs(case)
     searched = run_sfo("posest-sfo", skull, photo)
-    scored = run_sfo("posest-sfo", skull, photo, camera=searched.camera)
+    scored = run_sfo("posest-sfo", skull, photo, camera=GivenCamera(searched.camera))
     assert scored.camera_source == "examiner" and searched.camera_source == "search"
     assert scored.fitness == pytest.approx(searched.fitness, rel=1e-9)
     assert scored.terms["mse_pix"] == pytest.approx(searched.terms["mse_pix"], rel=1e-9)
@@ -49,37 +51,61 @@ def test_a_turned_camera_scores_worse(case):
     searched = run_sfo("posest-sfo", skull, photo)
     turned = _turned(searched.camera, skull, 5.0)
     assert geodesic_angle_deg(turned.R, searched.camera.R) == pytest.approx(5.0, abs=1e-9)
-    scored = run_sfo("posest-sfo", skull, photo, camera=turned)
+    scored = run_sfo("posest-sfo", skull, photo, camera=GivenCamera(turned))
     assert scored.fitness > 2 * searched.fitness
     assert scored.landmark_error["mean_px"] > searched.landmark_error["mean_px"]
 
 
-def test_lilium_fits_the_soft_tissue_under_the_camera(case):
-    """The DE over the cones only: the camera stays the one given, the image terms are those
-    of that camera, the soft tissue is at least as good as the search's under it, and the same
-    seed gives the same result."""
+def test_lilium_scores_the_given_soft_tissue_or_fits_one(case):
+    """With the soft tissue the camera came with (the SFO's own), its fitness and terms come
+    back; a bare camera gets the best soft tissue under it (the DE over the cones only): the
+    same camera and image terms, a reprojection error no larger, and the same seed gives the
+    same result."""
     skull, photo = _inputs(case)
     searched = run_sfo("lilium", skull, photo, FAST, seed=3)
-    scored = run_sfo("lilium", skull, photo, FAST, seed=3, camera=searched.camera)
-    again = run_sfo("lilium", skull, photo, FAST, seed=3, camera=searched.camera)
-    np.testing.assert_array_equal(scored.camera.skull2cam, searched.camera.skull2cam)
+    own = GivenCamera(searched.camera, searched.facial_landmarks_mm)
+    scored = run_sfo("lilium", skull, photo, FAST, seed=3, camera=own)
+    assert scored.extra["soft_tissue"] == "given"
+    assert scored.fitness == pytest.approx(searched.fitness, rel=1e-9)
+    for term, value in searched.terms.items():
+        assert scored.terms[term] == (
+            None if value is None else pytest.approx(value, rel=1e-9, abs=1e-12)
+        )
+    bare = GivenCamera(searched.camera)
+    fitted = run_sfo("lilium", skull, photo, FAST, seed=3, camera=bare)
+    again = run_sfo("lilium", skull, photo, FAST, seed=3, camera=bare)
+    assert fitted.extra["soft_tissue"] == "fitted" and fitted.fitness == again.fitness
+    np.testing.assert_array_equal(fitted.camera.skull2cam, searched.camera.skull2cam)
     assert searched.terms["p_skof"] is not None
     for term in ("p_skof", "p_pll", "p_cam"):
         if searched.terms[term] is None:
-            assert scored.terms[term] is None
+            assert fitted.terms[term] is None
         else:
-            assert scored.terms[term] == pytest.approx(searched.terms[term], rel=1e-9, abs=1e-12)
-    assert scored.terms["mse_pix"] <= searched.terms["mse_pix"] + 1e-9
-    assert scored.fitness == again.fitness
-    turned = run_sfo(
-        "lilium", skull, photo, FAST, seed=3, camera=_turned(searched.camera, skull, 5.0)
-    )
-    assert turned.landmark_error["mean_px"] > scored.landmark_error["mean_px"]
+            assert fitted.terms[term] == pytest.approx(searched.terms[term], rel=1e-9, abs=1e-12)
+    assert fitted.terms["mse_pix"] <= searched.terms["mse_pix"] + 1e-9
+    turned = _turned(searched.camera, skull, 5.0)
+    moved = run_sfo("lilium", skull, photo, FAST, seed=3, camera=replace(own, camera=turned))
+    assert moved.landmark_error["mean_px"] > scored.landmark_error["mean_px"]
+    assert moved.fitness > scored.fitness
 
 
 def _camera_file(path, camera):
     path.write_text(json.dumps(camera.to_dict()))
     return path
+
+
+def test_sfo_camera_option_reproduces_lilium_from_its_result(case, tmp_path, capsys):
+    fast = ["--method", "lilium", "--generations", "40", "--population", "12"]
+    assert _run(_sfo(case, tmp_path / "search", *fast), capsys)[0] == 0
+    result = json.loads((tmp_path / "search" / "result.json").read_text())
+    given = tmp_path / "search" / "result.json"
+    assert _run(_sfo(case, tmp_path / "own", *fast, "--camera", given), capsys)[0] == 0
+    own = json.loads((tmp_path / "own" / "result.json").read_text())
+    assert own["camera_source"] == "examiner" and own["soft_tissue"] == "given"
+    assert own["fitness"] == pytest.approx(result["fitness"], rel=1e-9)
+    assert own["identification"]["log10_lr"] == pytest.approx(
+        result["identification"]["log10_lr"], rel=1e-9
+    )
 
 
 def test_sfo_camera_option(case, tmp_path, capsys):

@@ -25,6 +25,7 @@ from lilium.casework.build import read_photo, read_skull
 from lilium.geometry.camera import Camera, principal_point_of
 from lilium.geometry.rotations import geodesic_angle_deg, matrix_to_rotvec, rotvec_to_matrix
 from lilium.io.jsonio import read_json
+from lilium.io.results import read_camera
 from lilium.methods.checks import landmark_error
 from lilium.methods.result import SfoResult
 from lilium.report.workbench import (
@@ -181,15 +182,24 @@ def test_pitch_and_roll_follow_the_python_model(sfo, opened):
 
 
 @needs_chromium
-def test_saved_camera_reads_back(opened):
+def test_saved_camera_reads_back(sfo, opened, tmp_path):
+    """camera.json: the page's camera and the soft tissue it showed (the result's facial
+    landmarks), as ``--camera`` reads them (:func:`lilium.io.results.read_camera`)."""
+    result = sfo[2]
     dom = opened("test&yaw=5")
     href = html.unescape(re.search(r'id="download"[^>]*href="([^"]+)"', dom)[1])
     assert href.startswith("data:application/json")
     saved = json.loads(urllib.parse.unquote(href.split(",", 1)[1]))
-    assert set(saved) == {"focal_px", "principal_point_px", "skull2cam"}
+    assert set(saved) == {"focal_px", "principal_point_px", "skull2cam", "facial_landmarks_3d"}
     camera = Camera.from_dict(saved)
     assert np.allclose(camera.skull2cam, _page_camera(dom).skull2cam, atol=1e-12)
-    assert Camera.from_dict(camera.to_dict()).to_dict() == saved
+    path = tmp_path / "camera.json"
+    path.write_text(json.dumps(saved))
+    given = read_camera(path)
+    assert np.allclose(given.camera.skull2cam, camera.skull2cam, atol=0)
+    assert set(given.facial_landmarks_mm) == set(result.facial_landmarks_mm)
+    for name, point in result.facial_landmarks_mm.items():
+        assert np.allclose(given.facial_landmarks_mm[name], point, atol=1e-9)
 
 
 def test_page_fetches_nothing(page):

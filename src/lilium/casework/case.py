@@ -4,6 +4,7 @@ import functools
 from dataclasses import replace
 from pathlib import Path
 
+from ..inputs import GivenCamera
 from ..io.paths import safe_id
 from ..methods.registry import check_method, method_tag, run_sfo
 from .console import log_warnings, status_text
@@ -192,10 +193,7 @@ class _CaseRun:
         )
         sfo = (method, self.skull, photo, self.options, self.seed)
         calibrations, log = self.calibrations, self.log
-        run = run_sfo
-        if camera is not None:
-            name = str(inputs["examiner camera"])
-            run = functools.partial(run_sfo, camera=camera, camera_name=name)
+        run = run_sfo if camera is None else functools.partial(run_sfo, camera=camera)
         result, reused = resumed_sfo(folder, *sfo, fingerprint, calibrations, log, run)
         if camera is None:
             self.separate.setdefault(method, []).append((photo, result))
@@ -217,12 +215,11 @@ class _CaseRun:
         search's camera scored the same way (:func:`searched_line`), so that the two compare."""
         photo = record.photo
         folder = self.out / safe_id(photo.id) / method_tag(method, self.options.variant)
-        inputs = {**record.inputs, "examiner camera": record.camera_file}
+        inputs = {**record.inputs, "examiner camera": Path(record.camera.source)}
         notes = dict(record.notes)
         if searched:
-            rescored = run_sfo(
-                method, self.skull, photo, self.options, self.seed, camera=searched.camera
-            )
+            given = GivenCamera(searched.camera, searched.facial_landmarks_mm, "the search")
+            rescored = run_sfo(method, self.skull, photo, self.options, self.seed, given)
             notes["search's camera, scored the same way"] = searched_line(rescored)
         return self.single(
             method, photo, inputs, notes, landmark_info, record.camera, folder / "examiner"

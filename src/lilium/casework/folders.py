@@ -29,6 +29,32 @@ from ..methods.registry import (
 from .identify import with_identification
 from .inputs import first_file
 
+#: Name of one SFO's workbench page in its folder (:func:`write_sfo`).
+WORKBENCH = "workbench.html"
+
+
+def joint_workbench_name(photo_id):
+    """File name of a photo's workbench page in a joint SFO's folder."""
+    return f"workbench_{safe_id(photo_id)}.html"
+
+
+def write_sfo(folder, result, skull, photo, overlay=True):
+    """Write one SFO's files in ``folder``: ``workbench.html`` (the overlay workbench,
+    :mod:`lilium.report.workbench`; none for a failed SFO, whose folder then holds no earlier
+    one), ``overlay.png`` (with ``overlay``) and ``result.json``, last
+    (:func:`~lilium.io.results.write_result`)."""
+    _workbench(Path(folder) / WORKBENCH, skull, photo, result)
+    write_result(folder, result, result_overlay(result, skull, photo) if overlay else None)
+
+
+def _workbench(page, skull, photo, result):
+    """(Re)write one result's workbench page ``page``; a failed SFO has none."""
+    from ..report.workbench import write_workbench  # the report layer, loaded when used
+
+    page.unlink(missing_ok=True)
+    if result:
+        write_workbench(page, skull, photo, result)
+
 
 def joint_overlay_name(photo_id):
     """File name of a photo's overlay in a joint SFO's folder: ``overlay_<photo id>.png``."""
@@ -44,6 +70,9 @@ def write_joint_result(out_dir, result, skull, photos, overlay=True):
     first and the new ``result.json`` written last, so it is only ever there with its whole
     overlays.
 
+    Each photo with a camera gets its workbench page, ``workbench_<photo id>.html``
+    (:mod:`lilium.report.workbench`).
+
     Returns
     -------
     dict of str -> Path
@@ -58,6 +87,7 @@ def write_joint_result(out_dir, result, skull, photos, overlay=True):
             path = out_dir / joint_overlay_name(photo.id)
             write_png(path, result_overlay(single, skull, photo))
             written[photo.id] = path
+        _workbench(out_dir / joint_workbench_name(photo.id), skull, photo, single)
     write_json(written["result.json"], result.to_dict())
     return written
 
@@ -248,23 +278,27 @@ def resumed_sfo(
     if result is not None:
         result = with_identification(result, skull, [photo], calibrations)
         write_json(Path(folder) / "result.json", result.to_dict())  # this run's calibration
+        if not (Path(folder) / WORKBENCH).is_file():  # stored by an older Lilium
+            _workbench(Path(folder) / WORKBENCH, skull, photo, result)
         return result, True
     if why:
         log(f"{printable(photo.id)}: {tag}: running the SFO again: {why}")
     result = (run or run_sfo)(method, skull, photo, options, seed)
     result = with_identification(result, skull, [photo], calibrations)
     result = with_fingerprint(result, fingerprint)
-    write_result(folder, result, result_overlay(result, skull, photo))
+    write_sfo(folder, result, skull, photo)
     return result, False
 
 
 def sfo_outputs(folder, out):
-    """The report's links to one SFO's files in ``folder``: ``result.json`` and, when it was
-    written, ``overlay.png``, as POSIX paths relative to the output folder ``out``."""
+    """The report's links to one SFO's files in ``folder``: ``result.json`` and, when they
+    were written, ``overlay.png`` and ``workbench.html``, as POSIX paths relative to the output
+    folder ``out``."""
     rel = Path(folder).relative_to(out).as_posix()
     outputs = {"result.json": f"{rel}/result.json"}
-    if (Path(folder) / "overlay.png").is_file():
-        outputs["overlay.png"] = f"{rel}/overlay.png"
+    for name in ("overlay.png", WORKBENCH):
+        if (Path(folder) / name).is_file():
+            outputs[name] = f"{rel}/{name}"
     return outputs
 
 

@@ -38,15 +38,14 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 class PhotoRecord(NamedTuple):
     """One photo of a case as :func:`load_photos` read it; ``camera``: the examiner's camera
-    to score (:class:`~lilium.geometry.camera.Camera`, ``--camera``), read by
-    :func:`~lilium.casework.read.read_case`, and ``camera_file`` its file."""
+    to score (:class:`~lilium.inputs.GivenCamera`, ``--camera``), read by
+    :func:`~lilium.casework.read.read_case`."""
 
     photo: object
     inputs: dict
     notes: dict
     origin: object = None
     camera: object = None
-    camera_file: object = None
 
 
 def first_file(folder, names):

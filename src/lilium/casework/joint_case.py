@@ -15,6 +15,7 @@ from ..methods.registry import METHODS, method_tag, run_joint_sfo
 from .console import log_warnings, status_text
 from .folders import (
     joint_overlay_name,
+    joint_workbench_name,
     sfo_fingerprint,
     stored_result,
     with_fingerprint,
@@ -135,4 +136,6 @@ def joint_entry(joint_run, k, skull, photo, inputs, notes, out):
     outputs = {"result.json (joint)": f"{rel}/result.json"}
     if (folder / joint_overlay_name(photo.id)).is_file():
         outputs["overlay.png"] = f"{rel}/{joint_overlay_name(photo.id)}"
+    if (folder / joint_workbench_name(photo.id)).is_file():
+        outputs["workbench.html"] = f"{rel}/{joint_workbench_name(photo.id)}"
     return ReportEntry(skull, photo, result.photos[k], inputs, notes, outputs, joint=result)

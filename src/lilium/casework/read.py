@@ -84,7 +84,7 @@ def read_case(request, log=None, out=None):
 
     records = photos_of(request.photos, auto_landmarks=request.auto_landmarks, out=out)
     records = [
-        r if s.camera is None else r._replace(camera=read_camera(s.camera), camera_file=s.camera)
+        r if s.camera is None else r._replace(camera=read_camera(s.camera))
         for r, s in zip(records, request.photos, strict=True)
     ]
     candidates = tuple((c.name, tuple(photos_of(c.photos))) for c in request.candidates)

@@ -1,12 +1,10 @@
 """One SFO of a request, without a report (``lilium sfo``): read, check, run, write
-``result.json`` and the overlays; one photo (:func:`single_sfo`) or a joint SFO of two or more
-photos of one person (:func:`joint_sfo`).
+``result.json``, the overlays and the workbench pages; one photo (:func:`single_sfo`) or a
+joint SFO of two or more photos of one person (:func:`joint_sfo`).
 """
 
-from ..io.results import write_result
-from ..methods.overlay import result_overlay
 from ..methods.registry import check_joint_method, check_method, run_joint_sfo, run_sfo
-from .folders import check_distinct_photos, write_joint_result
+from .folders import check_distinct_photos, write_joint_result, write_sfo
 from .identify import with_identification
 from .read import read_case
 
@@ -45,13 +43,10 @@ def single_sfo(request, log=None):
     check_method(method, request.options.variant)
     inputs = read_case(request, log=log)
     skull, (record,) = inputs.skull, inputs.records
-    photo, camera = record.photo, record.camera
-    result = run_sfo(
-        method, skull, photo, inputs.options, request.seed, camera, str(record.camera_file)
-    )
+    photo = record.photo
+    result = run_sfo(method, skull, photo, inputs.options, request.seed, record.camera)
     result = with_identification(result, skull, [photo], inputs.calibrations)
-    overlay = result_overlay(result, skull, photo) if request.overlay else None
-    write_result(request.out, result, overlay)
+    write_sfo(request.out, result, skull, photo, overlay=request.overlay)
     return result
 
 

@@ -6,6 +6,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from .formats import points_from_object
 from .jsonio import read_json, write_json
 from .paths import naming_errors
 
@@ -120,26 +121,40 @@ def read_result_camera(path):
 
 
 def read_camera(path):
-    """The camera a file gives to score (``--camera``): a ``camera.json`` (``focal_px``,
-    ``principal_point_px``, ``skull2cam``: ``workbench.html``'s Save) or a ``result.json`` (its
-    ``camera``).
+    """The camera a file gives to score (``--camera``), with the soft tissue it carries.
+
+    The file is a ``camera.json`` (``focal_px``, ``principal_point_px``, ``skull2cam``, and
+    ``facial_landmarks_3d`` when ``workbench.html``'s Save wrote it: the soft tissue the page
+    showed) or a ``result.json`` (its ``camera`` and ``facial_landmarks_3d``).
+
+    Returns
+    -------
+    GivenCamera
 
     Raises
     ------
     ValueError
-        A missing or malformed file or camera, or a failed SFO's result, naming the file.
+        A missing or malformed file, camera or soft tissue, or a failed SFO's result, naming
+        the file.
     """
     from ..geometry.camera import Camera
+    from ..inputs import GivenCamera
 
     data = read_json(path)
-    if isinstance(data, dict) and "camera" in data and "focal_px" not in data:
+    if not isinstance(data, dict):
+        raise ValueError(f"{path}: a camera file holds an object (focal_px, ...); got JSON text")
+    camera = data
+    if "camera" in data and "focal_px" not in data:
         if data["camera"] is None:
             raise ValueError(
                 f"{path}: this result.json is a failed SFO's and has no camera; give a "
                 "camera.json (workbench.html's Save) or the result of an SFO that found one"
             )
-        data = data["camera"]
-    return Camera.from_dict(data, name=str(path))
+        camera = data["camera"]
+    facial = data.get("facial_landmarks_3d")
+    if facial is not None:
+        facial = points_from_object(path, "facial_landmarks_3d", facial, "facial", dim=3)
+    return GivenCamera(Camera.from_dict(camera, name=str(path)), facial or None, str(path))
 
 
 #: ``result.json`` keys of one SFO that are :class:`~lilium.methods.result.SfoResult` fields

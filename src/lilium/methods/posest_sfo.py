@@ -19,7 +19,6 @@ from ..constants import FOCAL_MAX_PX, focal_cap_px
 from ..geometry.camera import principal_point_of
 from ..inputs import CaseWarning, correspondences
 from ..pose.posest import posest
-from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.depths import depth_stats
 from ..validation import fmt_number, fmt_range
 from .checks import facing_check, facing_failure
@@ -110,44 +109,6 @@ def posest_sfo(skull, photo, options=SfoOptions(), seed=0):
         seconds=time.perf_counter() - start,
         warnings=warnings,
         **common,
-    )
-
-
-def posest_sfo_at(skull, photo, camera, options=SfoOptions()):
-    """POSEST-SFO's score of a given camera (no search): its facial landmarks (the population
-    mean depth along each axis) under ``camera``.
-
-    Parameters
-    ----------
-    skull, photo, options
-        As :func:`posest_sfo` (``options.depth_table``).
-    camera : Camera
-        Checked by the caller (:func:`~lilium.methods.checks.check_given_camera`).
-
-    Returns
-    -------
-    SfoResult
-        As :func:`posest_sfo`'s for that camera: ``fitness`` the mean pixel error,
-        ``terms["mse_pix"]`` the mean squared one; the SFO's own camera gives its fitness back.
-    """
-    start = time.perf_counter()
-    corr = correspondences(skull, photo)
-    facial_mm = mean_depth_landmarks(corr, options.depth_table)
-    uv_c = corr.uv_px - camera.principal_point_px
-    sq = reprojection_sq_errors(
-        uv_c, facial_mm, camera.R[None], camera.t[None], np.array([camera.focal_px])
-    )[0]
-    return SfoResult(
-        method="posest-sfo",
-        variant=None,
-        seed=None,
-        skull_id=skull.id,
-        photo_id=photo.id,
-        camera=camera,
-        fitness=float(np.mean(np.sqrt(sq))),
-        terms={"mse_pix": float(np.mean(sq)), "p_cam": None, "p_skof": None, "p_pll": None},
-        facial_landmarks_mm=dict(zip(corr.facial_names, facial_mm, strict=True)),
-        seconds=time.perf_counter() - start,
     )
 
 

@@ -8,10 +8,11 @@ runs a method through :func:`run_sfo` with one :class:`~lilium.methods.options.S
 from dataclasses import dataclass, replace
 
 from .checks import check_given_camera, check_inputs, finish_result
+from .given_camera import lilium_at, posest_sfo_at
 from .joint import joint_lilium_sfo
 from .lilium import VARIANTS, lilium_sfo
 from .options import SfoOptions
-from .posest_sfo import posest_sfo, posest_sfo_at
+from .posest_sfo import posest_sfo
 
 
 @dataclass(frozen=True)
@@ -25,8 +26,8 @@ class Method:
     run : callable
         ``run(skull, photo, options, seed) -> SfoResult``.
     score : callable
-        ``score(skull, photo, camera, options, seed) -> SfoResult``: the method's result for a
-        given camera, without search (an examiner's camera, docs/method/workbench.md).
+        ``score(skull, photo, given, options, seed) -> SfoResult``: the method's result for a
+        :class:`~lilium.inputs.GivenCamera`, without search (docs/method/workbench.md).
     variants : tuple of str
         Fitness variants (empty for a method without variants).
     stochastic : bool
@@ -50,17 +51,17 @@ def _posest_sfo(skull, photo, options, seed):
     return posest_sfo(skull, photo, options)
 
 
-def _posest_sfo_at(skull, photo, camera, options, seed):
-    del seed  # deterministic
-    return posest_sfo_at(skull, photo, camera, options)
+def _posest_sfo_at(skull, photo, given, options, seed):
+    del seed  # deterministic; its soft tissue is always the mean one
+    return posest_sfo_at(skull, photo, given.camera, options)
 
 
 def _lilium(skull, photo, options, seed):
     return lilium_sfo(skull, photo, options, seed=seed)
 
 
-def _lilium_at(skull, photo, camera, options, seed):
-    return lilium_sfo(skull, photo, options, seed=seed, camera=camera)
+def _lilium_at(skull, photo, given, options, seed):
+    return lilium_at(skull, photo, given, options, seed=seed)
 
 
 def _joint_lilium(skull, photos, options, seed):
@@ -93,7 +94,7 @@ def method_tag(method, variant=None):
     return f"{method}-{variant}" if METHODS[method].variants and variant else method
 
 
-def run_sfo(method, skull, photo, options=SfoOptions(), seed=0, camera=None, camera_name="camera"):
+def run_sfo(method, skull, photo, options=SfoOptions(), seed=0, camera=None):
     """Run one SFO, or score a given camera.
 
     Parameters
@@ -106,12 +107,10 @@ def run_sfo(method, skull, photo, options=SfoOptions(), seed=0, camera=None, cam
         ``options.variant`` selects the variant of a method that has them.
     seed : int
         For stochastic methods; the same seed gives the same result.
-    camera : Camera, optional
-        Score this camera instead of searching one (the method's ``score``; for Lilium the
-        best soft tissue under it): ``camera_source`` ``"examiner"``.
-    camera_name : str
-        Where ``camera`` came from, for the message of a camera that cannot show the skull
-        (:func:`~lilium.methods.checks.check_given_camera`).
+    camera : GivenCamera, optional
+        Score this camera instead of searching one (the method's ``score``;
+        docs/method/workbench.md): ``camera_source`` ``"examiner"``. Refused when it cannot
+        show the skull (:func:`~lilium.methods.checks.check_given_camera`).
 
     Returns
     -------
@@ -130,7 +129,7 @@ def run_sfo(method, skull, photo, options=SfoOptions(), seed=0, camera=None, cam
     check_inputs(skull, photo)
     if camera is None:
         return finish_result(m.run(skull, photo, options, seed), skull, photo)
-    check_given_camera(camera, skull, photo, camera_name)
+    check_given_camera(camera.camera, skull, photo, camera.source)
     result = replace(m.score(skull, photo, camera, options, seed), camera_source="examiner")
     return finish_result(result, skull, photo)
 

@@ -38,6 +38,7 @@ from ..photo.review import fill_template, script_json
 from ..softtissue.landmarks import CORRESPONDENCES
 from .html import DEFAULT_OPACITY_PCT
 from .pictures import view_box
+from .records import method_label
 
 #: Faces of the mesh the page draws (more are decimated): about 7 MB of base64 at 300,000.
 DEFAULT_MAX_FACES = 300_000
@@ -171,6 +172,23 @@ def _points(named):
     return {str(k): [float(x) for x in v] for k, v in named.items()}
 
 
+#: The last skull's decimated mesh (a case draws one skull in every page): (key, the skull's
+#: vertex array, held so that its id stays its own, (vertices, faces)).
+_LAST_MESH = []
+
+
+def page_mesh(skull, max_faces=DEFAULT_MAX_FACES):
+    """The skull's mesh as the page draws it: ``(vertices (V', 3), faces (F', 3))``, decimated
+    to about ``max_faces`` (:func:`lilium.geometry.mesh.decimate`); the last skull's is kept,
+    so the pages of one case decimate it once."""
+    key = (id(skull.vertices_mm), id(skull.faces), int(max_faces))
+    if _LAST_MESH and _LAST_MESH[0][0] == key and _LAST_MESH[0][1] is skull.vertices_mm:
+        return _LAST_MESH[0][2]
+    mesh = decimate(skull.vertices_mm, skull.faces, max_faces)
+    _LAST_MESH[:] = [(key, skull.vertices_mm, mesh)]
+    return mesh
+
+
 def workbench_page(skull, photo, result, *, max_faces=DEFAULT_MAX_FACES, title=""):
     """The workbench page of one SFO, as HTML text.
 
@@ -186,7 +204,8 @@ def workbench_page(skull, photo, result, *, max_faces=DEFAULT_MAX_FACES, title="
     max_faces : int
         Faces drawn; a larger mesh is decimated to about this many.
     title : str
-        Default ``"<skull> / <photo> / <method>"``.
+        Default ``"<skull> / <photo> / <method and variant>"``, saying "examiner's camera" for
+        an examiner's result (:func:`~lilium.report.records.method_label`).
 
     Returns
     -------
@@ -203,7 +222,7 @@ def workbench_page(skull, photo, result, *, max_faces=DEFAULT_MAX_FACES, title="
             f"{result.error or 'no camera'}); rerun the SFO first"
         )
     camera = result.camera
-    vertices, faces = decimate(skull.vertices_mm, skull.faces, max_faces)
+    vertices, faces = page_mesh(skull, max_faces)
     pivot = skull_centre(skull.vertices_mm)
     axes = workbench_axes(skull.landmarks_mm, camera)
     size_wh = tuple(int(s) for s in photo.image_size_wh)
@@ -234,7 +253,7 @@ def workbench_page(skull, photo, result, *, max_faces=DEFAULT_MAX_FACES, title="
         "fallback": "anatomical (midline landmarks; no Frankfurt plane)",
         "camera": "the SFO camera's (too few cranial landmarks for anatomical ones)",
     }[axes.source]
-    title = title or f"{skull.id} / {photo.id} / {result.method}"
+    title = title or f"{skull.id} / {photo.id} / {method_label(result)}"
     values = {
         "__TITLE__": html.escape(title),
         "__SFO_MEAN__": "&ndash;" if mean is None else f"{mean:.2f}",

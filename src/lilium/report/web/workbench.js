@@ -205,8 +205,11 @@
   $("view-face").onclick = () => { wanted = boxView(DATA.view_box); layout(); schedule(); };
   $("view-photo").onclick = () => { wanted = boxView([0, 0, W, H]); layout(); schedule(); };
   const testing = Page.params().has("test");
+  // camera.json: the camera, and the soft tissue shown with it (the result's facial landmarks,
+  // fixed in the skull frame), which `--camera` scores as it is (docs/method/workbench.md).
   $("save").onclick = () => {  // under test the link is only filled (no file in Downloads)
-    Page.offerDownload($("download"), JSON.stringify(camera(), null, 1), null, !testing);
+    const saved = Object.assign(camera(), {facial_landmarks_3d: DATA.facial_mm});
+    Page.offerDownload($("download"), JSON.stringify(saved, null, 1), null, !testing);
   };
 
   /** The photo pixel under a pointer event. */
