@@ -137,7 +137,9 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     check_skull_fit(fit.rms_mm, found, source)
     lap("transfer")
     anchors = {k: v / fit.scale for k, v in template.anchors.items()}
-    located = apply_rules(moved, faces, tree, found, anchors)
+    _, nearest = cKDTree(tpl).query(moved)
+    on_mandible = template.mandible[nearest] if has_mandible else np.zeros(len(moved), bool)
+    located = apply_rules(moved, faces, on_mandible, found, anchors)
     lap("rules")
     placed, quality = {}, {}
     for name in CRANIAL_NAMES:
