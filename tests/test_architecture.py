@@ -35,6 +35,7 @@ LAYERS = {
     "demo": 9,
     "cli": 10,
     "jit_aot": 10,
+    "skull": 8,
 }
 
 #: Longest module (lines) that still reads in one sitting.

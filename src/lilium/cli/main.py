@@ -34,6 +34,7 @@ COMMANDS = [
     "lilium.cli.calibrate",
     "lilium.cli.lineup",
     "lilium.cli.photo",
+    "lilium.cli.skull",
 ]
 
 

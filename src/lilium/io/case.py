@@ -108,11 +108,20 @@ def check_axes_file(axes_path, option="soft-tissue axes file"):
 
 def parse_cranial_landmarks(landmarks_path):
     """The cranial landmarks of a ``cranial_landmarks.json`` or of any file
-    :func:`lilium.io.formats.read_landmarks` reads, as parsed: dict of str -> ndarray (3,), mm."""
+    :func:`lilium.io.formats.read_landmarks` reads, as parsed: dict of str -> ndarray (3,), mm.
+
+    A ``cranial_landmarks.json`` written by ``lilium skull`` tags each point in
+    ``landmark_sources``; as on photos, a ``"quality": "template"`` point is left out unless its
+    entry says ``"confirmed": true`` (docs/method/skull.md).
+    """
+    from .prepared import _without_unconfirmed_templates
+
     lm_path = Path(landmarks_path)
     if lm_path.name == "cranial_landmarks.json" or not lm_path.is_file():
-        raw = required_field(lm_path, read_json(lm_path), "landmarks")
-        return points_from_object(lm_path, "landmarks", raw, "cranial")
+        data = read_json(lm_path)
+        raw = required_field(lm_path, data, "landmarks")
+        points = points_from_object(lm_path, "landmarks", raw, "cranial")
+        return _without_unconfirmed_templates(points, data.get("landmark_sources"))
     return read_landmarks(lm_path, "cranial")
 
 

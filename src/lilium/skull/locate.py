@@ -1,0 +1,158 @@
+"""Cranial landmarks on a bare skull mesh: the pipeline of ``lilium skull``.
+
+Stages (:func:`locate_skull_landmarks`, each timed in :attr:`SkullLandmarks.profile_s`):
+
+1. ``check``: the mesh's size is a skull's in millimetres (:mod:`lilium.skull.checks`);
+2. ``align``: the rigid motion (and scale) onto the template skull (:mod:`lilium.skull.align`),
+   with and without the template's mandible: the better fit (:func:`~lilium.skull.transfer.
+   mismatch_mm`) says whether the lower jaw is there;
+3. ``symmetry``: the mirror plane to ``x = 0``;
+4. ``transfer``: the template's landmarks fitted patch by patch (:mod:`lilium.skull.transfer`);
+   the fit checked (not a skull: an error);
+5. ``rules``: each landmark's own definition on the normalised mesh (:mod:`lilium.skull.rules`):
+   quality ``"located"``; where a rule finds nothing, the transfer stays, ``"template"``;
+6. ``axes``: the outward surface normals at the landmarks
+   (:func:`lilium.softtissue.normals.landmark_normals`, the default axes of ``lilium case``).
+
+Landmarks given (``keep``, e.g. reviewed ones) are kept as they are and not placed again.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL
+from ..synthetic.subjects import MANDIBLE_LANDMARKS
+from .align import align_to_template, symmetrise
+from .checks import check_skull_extent, check_skull_fit
+from .template import mean_template
+from .transfer import SURFACE_SAMPLES, mismatch_mm, surface_samples, transfer_landmarks
+
+#: Mesh surface samples the mirror plane is fitted on.
+SYMMETRY_POINTS = 6000
+#: Qualities of a placed landmark (docs/method/skull.md).
+LOCATED, TEMPLATE, GIVEN = "located", "template", "given"
+
+
+@dataclass(frozen=True)
+class SkullLandmarks:
+    """The landmarks placed on a skull mesh (its own frame and units).
+
+    Attributes
+    ----------
+    landmarks : dict of str -> ndarray of shape (3,)
+        In the order of :data:`~lilium.softtissue.landmarks.CRANIAL_NAMES`, mm.
+    quality : dict of str -> str
+        ``"located"`` (the landmark's own definition found it), ``"template"`` (only the fitted
+        template places it) or ``"given"`` (kept from ``keep``).
+    axes : dict of str -> ndarray of shape (3,)
+        Unit outward surface normal of each landmark of a correspondence.
+    mandible : bool
+        Whether the mesh has a mandible.
+    mismatch_mm : dict of bool -> float
+        The two-sided mismatch of the fits with (True) and without (False) the template's
+        mandible (:func:`~lilium.skull.transfer.mismatch_mm`); the smaller one decides.
+    mesh2skull : ndarray of shape (4, 4)
+        Rigid motion from the mesh's frame to the normalised skull frame.
+    scale : float
+        Template size over mesh size.
+    fit_rms_mm : float
+    profile_s : dict of str -> float
+        Seconds per stage.
+    """
+
+    landmarks: dict
+    quality: dict
+    axes: dict
+    mandible: bool
+    mismatch_mm: dict
+    mesh2skull: np.ndarray
+    scale: float
+    fit_rms_mm: float
+    profile_s: dict = field(default_factory=dict)
+
+
+def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
+    """Every cranial landmark a skull mesh has.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+        mm, any frame.
+    faces : ndarray of shape (F, 3), int
+    keep : dict of str -> ndarray of shape (3,), optional
+        Landmarks to keep as they are (mesh frame).
+    rng : anything :func:`numpy.random.default_rng` accepts
+        Draws the point samples of the fit; the same seed gives the same result.
+    source : str
+        Names the mesh in the messages.
+
+    Returns
+    -------
+    SkullLandmarks
+
+    Raises
+    ------
+    ValueError
+        The mesh is not a skull in millimetres (:mod:`lilium.skull.checks`).
+    """
+    from scipy.spatial import cKDTree
+
+    from ..softtissue.normals import landmark_normals
+    from .rules import apply_rules
+
+    vertices = np.asarray(vertices, float)
+    faces = np.asarray(faces, np.int64)
+    rng = np.random.default_rng(rng)
+    keep = {n: np.asarray(p, float) for n, p in (keep or {}).items()}
+    profile, clock = {}, [time.perf_counter()]
+
+    def lap(stage):
+        now = time.perf_counter()
+        profile[stage] = now - clock[0]
+        clock[0] = now
+
+    check_skull_extent(vertices, source)
+    template = mean_template()
+    lap("check")
+    mesh_samples = surface_samples(vertices, faces, SURFACE_SAMPLES, rng)
+    templates = {True: template.vertices, False: template.vertices[~template.mandible]}
+
+    def score(fit, has_mandible):
+        return mismatch_mm(fit.to_skull(mesh_samples), templates[has_mandible] / fit.scale)
+
+    has_mandible, fit, mismatch = align_to_template(mesh_samples, templates, score, rng)
+    lap("align")
+    fit = symmetrise(fit, mesh_samples[:: max(1, SURFACE_SAMPLES // SYMMETRY_POINTS)])
+    moved = fit.to_skull(vertices)
+    tpl = template.vertices / fit.scale
+    lap("symmetry")
+    tree = cKDTree(moved)
+    wanted = [n for n in CRANIAL_NAMES if has_mandible or n not in MANDIBLE_LANDMARKS]
+    part_of = {n: template.mandible == (n in MANDIBLE_LANDMARKS) for n in wanted}
+    found = transfer_landmarks(
+        tree, moved, tpl, {n: template.landmarks[n] / fit.scale for n in wanted}, part_of
+    )
+    check_skull_fit(fit.rms_mm, found, source)
+    lap("transfer")
+    anchors = {k: v / fit.scale for k, v in template.anchors.items()}
+    _, nearest = cKDTree(tpl).query(moved)
+    on_mandible = template.mandible[nearest] if has_mandible else np.zeros(len(moved), bool)
+    located = apply_rules(moved, faces, on_mandible, found, anchors)
+    lap("rules")
+    placed, quality = {}, {}
+    for name in CRANIAL_NAMES:
+        if name in keep:
+            placed[name], quality[name] = keep[name], GIVEN
+        elif name in located:
+            placed[name], quality[name] = fit.to_mesh(located[name][None])[0], LOCATED
+        elif name in found:
+            placed[name], quality[name] = fit.to_mesh(found[name][None])[0], TEMPLATE
+    with_axes = {n: p for n, p in placed.items() if n in CRANIAL_TO_FACIAL}
+    axes = landmark_normals(vertices, faces, with_axes) if with_axes else {}
+    lap("axes")
+    return SkullLandmarks(
+        placed, quality, axes, bool(has_mandible), mismatch, fit.mesh2skull, fit.scale,
+        fit.rms_mm, profile,
+    )  # fmt: skip

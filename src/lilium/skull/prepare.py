@@ -1,0 +1,110 @@
+"""``lilium skull``'s folder: a bare skull mesh to a subject folder (I/O; the maths is in
+:func:`lilium.skull.locate.locate_skull_landmarks`).
+
+Written in ``out`` (and nowhere else): ``skull.ply`` (the mesh in its own frame and units, welded
+and checked as ``lilium case`` reads it), ``cranial_landmarks.json`` (docs/contract.md:
+``landmarks``, ``landmark_sources``, ``parts``, ``prepared_by``) and ``soft_tissue_axes.json``
+(the outward surface normals at the landmarks: the axes ``lilium case`` would take by default).
+The review page is not written yet (:func:`_write_review_page`).
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from .locate import GIVEN, LOCATED, locate_skull_landmarks
+
+#: ``prepared_by`` of the files written here.
+PREPARED_BY = "lilium skull"
+
+
+def _reviewed(landmarks_path):
+    """The points of a landmark file to keep: all of them, but those a ``landmark_sources``
+    entry marks as automatic and not confirmed (they are placed again)."""
+    from ..io.case import parse_cranial_landmarks
+    from ..io.jsonio import read_json
+
+    points = parse_cranial_landmarks(landmarks_path)
+    sources = {}
+    if Path(landmarks_path).suffix.lower() == ".json":
+        data = read_json(landmarks_path)
+        sources = data.get("landmark_sources", {}) if isinstance(data, dict) else {}
+    keep = {}
+    for name, p in points.items():
+        entry = sources.get(name) if isinstance(sources, dict) else None
+        automatic = isinstance(entry, dict) and entry.get("source") == "automatic"
+        if not automatic or entry.get("confirmed") is True:
+            keep[name] = p
+    return keep
+
+
+def landmark_sources(result):
+    """``{name: {"source", "quality"[, "confirmed"]}}`` of the contract for a
+    :class:`~lilium.skull.locate.SkullLandmarks`."""
+    out = {}
+    for name, quality in result.quality.items():
+        if quality == GIVEN:
+            out[name] = {"source": "reviewed", "quality": "manual", "confirmed": True}
+        else:
+            out[name] = {"source": "automatic", "quality": quality}
+    return out
+
+
+def _write_review_page(out, mesh_path, result):
+    """The 3D review page (``review.html``): not written yet.
+
+    The hook for the shared WebGL review module: it gets the folder, the mesh written there and
+    the :class:`~lilium.skull.locate.SkullLandmarks` (landmarks, qualities, axes).
+    """
+    del out, mesh_path, result
+
+
+def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
+    """Place the cranial landmarks of a skull mesh and write the subject folder ``out``.
+
+    Parameters
+    ----------
+    mesh_path : str or Path
+        PLY, OBJ or STL, millimetres, any pose.
+    out : str or Path
+        The subject folder (created; only files inside it are written).
+    landmarks_path : str or Path, optional
+        Reviewed landmarks (any cranial landmark file ``lilium case`` reads): kept as they are;
+        the rest are placed.
+    rng : anything :func:`numpy.random.default_rng` accepts
+
+    Returns
+    -------
+    dict
+        ``folder``, ``result`` (:class:`~lilium.skull.locate.SkullLandmarks`), ``faces``.
+
+    Raises
+    ------
+    ValueError
+        An unreadable mesh, a mesh that is not a skull in millimetres, a bad landmark file.
+    """
+    from ..geometry.mesh import clean_mesh, compact
+    from ..io.jsonio import write_json
+    from ..io.mesh import parse_mesh, write_mesh
+
+    mesh_path, out = Path(mesh_path), Path(out)
+    vertices, faces = compact(*clean_mesh(*parse_mesh(mesh_path), source=str(mesh_path)))
+    keep = _reviewed(landmarks_path) if landmarks_path is not None else None
+    result = locate_skull_landmarks(vertices, faces, keep=keep, rng=rng, source=str(mesh_path))
+    out.mkdir(parents=True, exist_ok=True)
+    skull_path = out / "skull.ply"
+    write_mesh(skull_path, vertices, faces)
+    write_json(
+        out / "cranial_landmarks.json",
+        {
+            "landmarks": result.landmarks,
+            "landmark_sources": landmark_sources(result),
+            "parts": {"cranium": True, "mandible": result.mandible},
+            "prepared_by": PREPARED_BY,
+            "mesh": mesh_path.name,
+            "mesh2skull": np.round(result.mesh2skull, 9),
+        },
+    )
+    write_json(out / "soft_tissue_axes.json", {"axes": result.axes, "prepared_by": PREPARED_BY})
+    _write_review_page(out, skull_path, result)
+    return {"folder": out, "result": result, "faces": len(faces), "located": LOCATED}

@@ -1,0 +1,227 @@
+"""Each landmark's own definition on the normalised mesh (skull frame, mm).
+
+The rules are the generator's placement rules (:mod:`lilium.synthetic.anatomy.landmarks`) with
+the search centres taken from the fitted template (``estimates``, ``anchors``) instead of the
+generator's design points; a landmark whose rule finds nothing keeps its template estimate.
+Written down (docs/method/skull.md lists them too):
+
+- midline profile: the most anterior point of the mesh's cut by ``x = 0`` per
+  :data:`PROFILE_STEP_MM` of height (cranium and mandible apart);
+- ``glabella``: the most anterior profile point within ``GLABELLA_MM`` of its estimate's height;
+- ``nasion``: the most posterior profile point from ``NASION_MM[0]`` below its estimate to
+  3 mm below glabella (the deepest point of the nasal root);
+- ``metopion``: the profile point 36 mm above glabella;
+- ``bregma``: the highest point of the cut at the estimate's z;
+- ``subspinale``: the most posterior profile point between the anterior nasal spine (the most
+  anterior profile point within ``ANS_MM`` of the template's spine) and the prosthion
+  estimate's height + 2 mm;
+- ``pogonion``: the most anterior mandible profile point within ``CHIN_MM`` of its estimate's
+  height; ``gnathion``: the mandible profile point furthest along ``(0, -1, 1)`` within
+  ``CHIN_MM``;
+- orbits (frontal height map, :class:`~lilium.skull.surface.FrontalMap`): the centre is the
+  template's, re-centred once between the rim edges of scans up/down and in/out;
+  ``ectoconchion``: the rim edge of the scan from the centre laterally (32 mm); ``orbitale``:
+  down (30 mm); ``dacryon``: from 4 mm above the centre to 2 mm off the midline;
+- ``alare``: the rim edge (0.9) of the scan from the aperture's centre laterally (25 mm),
+  the most lateral one of the rows within ``ALARE_ROWS_MM`` of the centre's height;
+- ``zygion``: the cranium vertex of largest ``|x|`` within ``ZYGION_BOX_MM`` (y, z) of its
+  estimate; ``gonion``: the mandible vertex furthest along ``(+-1, -0.22, -0.22)`` within
+  ``GONION_MM`` of its estimate; ``frontotemporale``: the cranium vertex furthest along
+  ``(+-1, 0, 0.8)`` within ``FRONTOTEMPORALE_MM`` of its estimate.
+
+Left as the template places them: ``prosthion`` and ``infradentale`` (the alveolar crest
+between the incisors: the teeth and the bone are one surface on a mesh), ``porion`` (the ear
+canal's top) and the mental foramina (no hole on most meshes).
+"""
+
+import numpy as np
+
+from .surface import anterior_profile, frontal_map, midline_section, rim_edge
+
+PROFILE_STEP_MM = 0.5
+PROFILE_BAND_MM = 0.5
+GLABELLA_MM = (-8.0, 12.0)
+NASION_MM = 12.0
+METOPION_ABOVE_GLABELLA_MM = 36.0
+ANS_MM = 6.0
+CHIN_MM = 10.0
+CHIN_ABOVE_MENTON_MM = 10.0
+GNATHION_SPAN_MM = 14.0
+#: The face's midline profile: section points in front of this (mm) behind the orbits' centres.
+FRONT_BEHIND_ORBIT_MM = 25.0
+#: Extreme points: the centre of the points within this (mm) of the extreme (a flat crest's
+#: middle, not its first vertex).
+PLATEAU_MM = 0.5
+ORBIT_SCANS_MM = {"ectoconchion": 32.0, "orbitale": 30.0, "dacryon_dy": 4.0, "dacryon_x": 2.0}
+ALARE_SCAN_MM = 25.0
+ALARE_FRACTION = 0.9
+ALARE_ROWS_MM = 4.0
+ZYGION_BOX_MM = (8.0, 12.0)
+GONION_MM = 15.0
+GONION_DIRECTION = (1.0, -0.22, -0.22)
+FRONTOTEMPORALE_MM = 10.0
+FRONTOTEMPORALE_DIRECTION = (1.0, 0.0, 0.8)
+
+
+def _profile(points, lo, hi, z_min=-np.inf):
+    points = points[points[:, 2] > z_min]
+    ys = np.arange(lo, hi, PROFILE_STEP_MM)
+    prof = anterior_profile(points, ys, PROFILE_BAND_MM)
+    return prof[np.isfinite(prof[:, 2])]
+
+
+def _midline(section, on_mandible, est, anchors):
+    """The midline landmarks found (dict)."""
+    pts, mand = section
+    cranium, mandible = pts[~mand], pts[mand]
+    # The face's profile: in front of the orbits' centres.
+    front = 0.5 * (anchors["orbit_l"][2] + anchors["orbit_r"][2]) - FRONT_BEHIND_ORBIT_MM
+    cranium_front = cranium[cranium[:, 2] > front]
+    mandible_front = mandible[mandible[:, 2] > front]
+    out = {}
+    if "glabella" in est:
+        g = est["glabella"][1]
+        prof = _profile(cranium_front, g + GLABELLA_MM[0], g + GLABELLA_MM[1])
+        if len(prof):
+            out["glabella"] = prof[np.argmax(prof[:, 2])]
+    top = out.get("glabella", est.get("glabella"))
+    if "nasion" in est and top is not None:
+        prof = _profile(cranium_front, est["nasion"][1] - NASION_MM, top[1] - 3.0)
+        if len(prof):
+            out["nasion"] = prof[np.argmin(prof[:, 2])]
+    if "metopion" in est and "glabella" in out:
+        y = out["glabella"][1] + METOPION_ABOVE_GLABELLA_MM
+        prof = _profile(cranium_front, y - PROFILE_STEP_MM, y + PROFILE_STEP_MM)
+        if len(prof):
+            out["metopion"] = prof[np.argmin(np.abs(prof[:, 1] - y))]
+    if "bregma" in est:
+        near = cranium[np.abs(cranium[:, 2] - est["bregma"][2]) < PROFILE_BAND_MM]
+        if len(near):
+            out["bregma"] = near[np.argmax(near[:, 1])]
+    if "subspinale" in est and "prosthion" in est:
+        a = anchors["ans"][1]
+        spine = _profile(cranium_front, a - ANS_MM, a + ANS_MM)
+        if len(spine):
+            ans = spine[np.argmax(spine[:, 2])]
+            prof = _profile(cranium_front, est["prosthion"][1] + 2.0, ans[1] - 1.0)
+            if len(prof):
+                out["subspinale"] = prof[np.argmin(prof[:, 2])]
+    if "pogonion" in est and len(mandible_front):
+        menton = mandible_front[np.argmin(mandible_front[:, 1])]
+        centre = menton[1] + CHIN_ABOVE_MENTON_MM
+        prof = _profile(mandible_front, centre - CHIN_MM, centre + CHIN_MM)
+        if len(prof):
+            out["pogonion"] = _plateau(prof, np.array([0.0, 0.0, 1.0]))
+        chin = mandible_front[
+            np.abs((mandible_front - (0, centre, menton[2])) @ (0, 1, 1)) / np.sqrt(2)
+            < GNATHION_SPAN_MM
+        ]
+        if "gnathion" in est and len(chin):
+            out["gnathion"] = _plateau(chin, np.array([0.0, -1.0, 1.0]) / np.sqrt(2))
+    return out
+
+
+def _orbit(fm, centre, sx):
+    """Ectoconchion, orbitale, dacryon of one side (``sx`` 1 left, -1 right)."""
+    s = ORBIT_SCANS_MM
+    c = np.asarray(centre, float)[:2]
+    up = rim_edge(fm.scan(c, c + (0, s["orbitale"])))
+    down = rim_edge(fm.scan(c, c - (0, s["orbitale"])))
+    lateral = rim_edge(fm.scan(c, c + (sx * s["ectoconchion"], 0)))
+    medial = rim_edge(fm.scan(c, (sx * s["dacryon_x"], c[1])))
+    if up is not None and down is not None:
+        c[1] = 0.5 * (up[1] + down[1])
+    if lateral is not None and medial is not None:
+        c[0] = 0.5 * (lateral[0] + medial[0])
+    out = {
+        "ectoconchion": rim_edge(fm.scan(c, c + (sx * s["ectoconchion"], 0))),
+        "orbitale": rim_edge(fm.scan(c, c - (0, s["orbitale"]))),
+        "dacryon": rim_edge(
+            fm.scan(c + (0, s["dacryon_dy"]), (sx * s["dacryon_x"], c[1] + s["dacryon_dy"]))
+        ),
+    }
+    return {k: v for k, v in out.items() if v is not None and np.all(np.isfinite(v))}
+
+
+def _alare(fm, centre, sx):
+    c = np.asarray(centre, float)[:2]
+    best = None
+    for dy in np.arange(-ALARE_ROWS_MM, ALARE_ROWS_MM + 1e-9, fm.px):
+        start = (0.0, c[1] + dy)
+        p = rim_edge(fm.scan(start, (sx * ALARE_SCAN_MM, c[1] + dy)), ALARE_FRACTION)
+        if p is not None and np.isfinite(p[2]) and (best is None or sx * p[0] > sx * best[0]):
+            best = p
+    return best
+
+
+def _plateau(points, direction):
+    """The point of ``points`` nearest to the centre of those within :data:`PLATEAU_MM` of
+    the extreme along ``direction``."""
+    h = points @ direction
+    top = points[h >= h.max() - PLATEAU_MM]
+    return points[np.argmin(np.linalg.norm(points - top.mean(axis=0), axis=1))].copy()
+
+
+def _support(vertices, mask, centre, radius, direction):
+    near = mask & (np.linalg.norm(vertices - centre, axis=1) < radius)
+    if not near.any():
+        return None
+    d = np.asarray(direction, float)
+    return _plateau(vertices[near], d / np.linalg.norm(d))
+
+
+def apply_rules(vertices, faces, on_mandible, estimates, anchors):
+    """The landmarks found by their own definitions (module notes).
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+        The mesh in the normalised frame, mm.
+    faces : ndarray of shape (F, 3), int
+    on_mandible : ndarray of shape (V,), bool
+        The mandible's vertices.
+    estimates : dict of str -> ndarray of shape (3,)
+        The template's estimates (:func:`~lilium.skull.transfer.transfer_landmarks`); a
+        landmark is looked for only when it has one.
+    anchors : dict of str -> ndarray of shape (3,)
+        The template's design points in the normalised frame
+        (:attr:`~lilium.skull.template.Template.anchors`).
+
+    Returns
+    -------
+    dict of str -> ndarray of shape (3,)
+    """
+    est = estimates
+    points, face = midline_section(vertices, faces)
+    section = (points, on_mandible[faces[face]].all(axis=1))
+    out = _midline(section, on_mandible, est, anchors)
+    fm = frontal_map(vertices, faces)
+    cranium = ~on_mandible
+    for sx, sfx in ((1, "_l"), (-1, "_r")):
+        orbit = _orbit(fm, anchors["orbit" + sfx], sx)
+        out.update({k + sfx: v for k, v in orbit.items() if k + sfx in est})
+        if "alare" + sfx in est:
+            p = _alare(fm, anchors["aperture"], sx)
+            if p is not None:
+                out["alare" + sfx] = p
+        name = "zygion" + sfx
+        if name in est:
+            e = est[name]
+            box = (np.abs(vertices[:, 1] - e[1]) < ZYGION_BOX_MM[0]) & (
+                np.abs(vertices[:, 2] - e[2]) < ZYGION_BOX_MM[1]
+            )
+            if (box & cranium).any():
+                out[name] = _plateau(vertices[box & cranium], np.array([sx, 0.0, 0.0]))
+        name = "gonion" + sfx
+        if name in est:
+            d = np.array(GONION_DIRECTION) * (sx, 1, 1)
+            p = _support(vertices, on_mandible, est[name], GONION_MM, d)
+            if p is not None:
+                out[name] = p
+        name = "frontotemporale" + sfx
+        if name in est:
+            d = np.array(FRONTOTEMPORALE_DIRECTION) * (sx, 1, 1)
+            p = _support(vertices, cranium, est[name], FRONTOTEMPORALE_MM, d)
+            if p is not None:
+                out[name] = p
+    return {k: np.asarray(v, float) for k, v in out.items() if np.all(np.isfinite(v))}

@@ -1,0 +1,164 @@
+"""``lilium skull`` (:mod:`lilium.skull`): automatic cranial landmarks on generated skulls with
+known landmarks, the pose invariance, the mandible's detection and the refused meshes."""
+
+import copy
+
+import numpy as np
+import pytest
+
+from lilium.skull import locate_skull_landmarks
+from lilium.synthetic.subjects import MANDIBLE_LANDMARKS
+
+#: Located landmarks of a generated skull: median distance to the truth (mm); the
+#: rules are the generator's, so these hold well below the issue's 2 / 4 mm.
+LOCATED_MEDIAN_MM = 2.0
+#: Landmarks whose rule is the generator's own and must land within this (mm).
+EXACT = ("nasion", "glabella", "ectoconchion_l", "ectoconchion_r", "orbitale_l", "orbitale_r")
+EXACT_MM = 2.0
+
+
+def _skull(seed, mandible):
+    """A generated skull (mesh, true landmarks), as make_subject builds it, without the face."""
+    from lilium.synthetic.anatomy.bone import build_bone
+    from lilium.synthetic.anatomy.shape import draw_shape
+    from lilium.synthetic.subjects import SKULL_FACES, _mesh, _skull
+
+    rng = np.random.default_rng(seed)
+    shape = draw_shape(rng)
+    vault_rng = copy.deepcopy(rng)
+    _, _, v, f, cranial, _ = _skull(shape, rng)
+    if not mandible:
+        bone, _ = build_bone(shape, vault_rng, mandible=False)
+        v, f = _mesh(bone, SKULL_FACES)
+        cranial = {n: p for n, p in cranial.items() if n not in MANDIBLE_LANDMARKS}
+    return v, f, cranial
+
+
+@pytest.fixture(scope="module")
+def skull():
+    v, f, truth = _skull(3, True)
+    return v, f, truth, locate_skull_landmarks(v, f)
+
+
+def test_placement_on_a_generated_skull(skull):
+    _, _, truth, result = skull
+    assert result.mandible
+    assert set(result.landmarks) == set(truth)
+    errors = {n: np.linalg.norm(result.landmarks[n] - truth[n]) for n in truth}
+    located = [errors[n] for n in truth if result.quality[n] == "located"]
+    assert len(located) >= 15
+    assert np.median(located) <= LOCATED_MEDIAN_MM
+    assert max(errors[n] for n in EXACT) <= EXACT_MM, {n: errors[n] for n in EXACT}
+    assert set(result.quality.values()) <= {"located", "template"}
+    assert set(result.axes) <= set(result.landmarks)
+    for axis in result.axes.values():
+        assert np.isclose(np.linalg.norm(axis), 1.0)
+
+
+def test_invariant_to_a_rigid_motion(skull):
+    """The same accuracy after a random rigid motion (the fit starts from another pose, so the
+    points move by a fraction of a mm, not nothing)."""
+    from scipy.spatial.transform import Rotation
+
+    v, f, truth, result = skull
+    R = Rotation.from_rotvec([0.9, -2.1, 0.4]).as_matrix()
+    t = np.array([120.0, -40.0, 300.0])
+    moved = locate_skull_landmarks(v @ R.T + t, f)
+    assert moved.mandible
+    back = {n: R.T @ (p - t) for n, p in moved.landmarks.items()}
+    errors = {n: np.linalg.norm(back[n] - truth[n]) for n in truth}
+    located = [errors[n] for n in truth if moved.quality[n] == "located"]
+    assert np.median(located) <= LOCATED_MEDIAN_MM
+    assert max(errors[n] for n in EXACT) <= EXACT_MM, {n: errors[n] for n in EXACT}
+
+
+def test_mandible_absent():
+    v, f, truth = _skull(3, False)
+    result = locate_skull_landmarks(v, f)
+    assert not result.mandible
+    assert not set(result.landmarks) & set(MANDIBLE_LANDMARKS)
+    errors = [np.linalg.norm(result.landmarks[n] - truth[n]) for n in EXACT]
+    assert max(errors) <= EXACT_MM
+
+
+def test_mesh_in_metres_is_an_error(skull):
+    v, f, _, _ = skull
+    with pytest.raises(ValueError, match=r"skull.ply: .*in metres.*rescale it to millimetres"):
+        locate_skull_landmarks(v / 1000.0, f, source="skull.ply")
+
+
+@pytest.mark.parametrize("kind", ["sphere", "box"])
+def test_not_a_skull_is_an_error(kind):
+    import trimesh
+
+    mesh = trimesh.creation.icosphere(4, 90.0) if kind == "sphere" else trimesh.creation.box(
+        (150.0, 180.0, 190.0)
+    )  # fmt: skip
+    if kind == "box":
+        mesh = mesh.subdivide().subdivide().subdivide()
+    with pytest.raises(ValueError, match=r"thing.ply: does not look like a skull"):
+        locate_skull_landmarks(mesh.vertices, mesh.faces, source="thing.ply")
+
+
+def test_fragment_is_an_error(skull):
+    v, f, _, _ = skull
+    with pytest.raises(ValueError, match=r"a fragment or a part of a skull"):
+        locate_skull_landmarks(v * 0.4, f)
+
+
+def test_command_writes_a_folder_lilium_sfo_reads(skull, tmp_path, capsys):
+    from lilium.casework.build import read_skull
+    from lilium.cli.main import main
+    from lilium.io.jsonio import read_json
+    from lilium.io.mesh import write_mesh
+
+    v, f, _, _ = skull
+    write_mesh(tmp_path / "bare.ply", v, f)
+    out = tmp_path / "subject"
+    assert main(["skull", str(tmp_path / "bare.ply"), "--out", str(out)]) == 0
+    assert "parts found: cranium and mandible" in capsys.readouterr().out
+    data = read_json(out / "cranial_landmarks.json")
+    assert data["parts"] == {"cranium": True, "mandible": True}
+    sources = data["landmark_sources"]
+    assert set(sources) == set(data["landmarks"])
+    located = {n for n, s in sources.items() if s["quality"] == "located"}
+    # The case reads the folder as it is; template points wait for confirmation.
+    skull_read = read_skull(out)
+    assert set(skull_read.landmarks_mm) == located
+    assert set(skull_read.axes) <= set(read_json(out / "soft_tissue_axes.json")["axes"])
+    assert sorted(p.name for p in out.iterdir()) == [
+        "cranial_landmarks.json",
+        "skull.ply",
+        "soft_tissue_axes.json",
+    ]
+    # Reviewed points are kept: a template point confirmed by moving it.
+    name = next(n for n, s in sources.items() if s["quality"] == "template")
+    data["landmarks"][name] = [float(c) + 0.5 for c in data["landmarks"][name]]
+    data["landmark_sources"][name]["confirmed"] = True
+    from lilium.io.jsonio import write_json
+
+    write_json(tmp_path / "reviewed.json", data)
+    out2 = tmp_path / "subject2"
+    assert main(["skull", str(out / "skull.ply"), "--out", str(out2), "--landmarks",
+                 str(tmp_path / "reviewed.json")]) == 0  # fmt: skip
+    again = read_json(out2 / "cranial_landmarks.json")
+    assert np.allclose(again["landmarks"][name], data["landmarks"][name])
+    assert again["landmark_sources"][name] == {
+        "source": "reviewed",
+        "quality": "manual",
+        "confirmed": True,
+    }
+
+
+def test_command_error_is_one_line(tmp_path, capsys):
+    import trimesh
+
+    from lilium.cli.main import main
+
+    mesh = trimesh.creation.icosphere(3, 0.09)
+    mesh.export(tmp_path / "head.stl")
+    assert main(["skull", str(tmp_path / "head.stl"), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("lilium skull: error: ") and "\n" not in err
+    assert "metres" in err
+    assert not (tmp_path / "o").exists()
