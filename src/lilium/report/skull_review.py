@@ -23,11 +23,11 @@ base64 (float32 vertices relative to the skull's centre, uint32 faces, little-en
 above ``max_faces`` is decimated (:func:`lilium.geometry.mesh.decimate`, quadric).
 
 Opened as ``review.html?test[&view=left][&tick=NAME,...]``, the page draws, writes
-``<pre id="first-draw-ms">``, ticks the named landmarks, drags the first switched-on landmark in sight by (+15, +8) CSS pixels with pointer events
-(``<pre id="dragged">``), lists the landmarks in sight (``<pre id="visible">``) and presses
-Save, which then fills the download link and ``<pre id="saved">`` without saving a file (for
-the headless-browser tests). ``?view=left`` (``right``, ``top``, ``front``) also works without
-``test``.
+``<pre id="first-draw-ms">``, ticks the named landmarks, drags the first switched-on landmark in
+sight by (+15, +8) CSS pixels with pointer events (``<pre id="dragged">``), lists the landmarks
+in sight (``<pre id="visible">``) and presses Save, which then fills the download link and
+``<pre id="saved">`` without saving a file (for the headless-browser tests). ``?view=left``
+(``right``, ``top``, ``front``) also works without ``test``.
 """
 
 import base64
