@@ -67,6 +67,21 @@ const MeshGL = (function () {
     return {focal_px: focal, principal_point_px: principal.slice(), skull2cam: rows.concat(
       [[0, 0, 0, 1]])};
   }
+  /** The rotation (skull2cam's R: rows are the camera's x, y, z axes in the skull frame) of a
+      camera looking along `forward` with the image's down (+v) along `down` (its part across
+      `forward`); x = y cross z, so the frame is right-handed. */
+  function lookRotation(forward, down) {
+    const z = normalize(forward);
+    const y = normalize(sub(down, scale(z, dot(down, z))));
+    return [cross(y, z), y, z];
+  }
+  /** An orbit camera: rotation R, and the skull-frame point `pivot` (mm) at camera-frame
+      [shift[0], shift[1], distance] (mm), so turning R turns the skull about the pivot and
+      `shift` pans it across the image. */
+  function orbitCamera(R, pivot, distance, shift, focal, principal) {
+    const t = sub([shift[0], shift[1], distance], apply(R, pivot));
+    return makeCamera(R, t, focal, principal);
+  }
   /** A skull-frame point in the camera frame (mm). */
   function toCamera(point, camera) {
     return add(apply(rotationOf(camera), point), translationOf(camera));
@@ -165,6 +180,21 @@ const MeshGL = (function () {
     vec3 n = normalize(cross(dFdx(rotated), dFdy(rotated)));
     fragment = vec4((0.25 + 0.75 * abs(dot(n, light))) * color, 1.0);
   }`;
+  // Camera-frame depth instead of a colour: (z - near) / (far - near) in 24 bits (r, g, b
+  // high to low), alpha 1 where the mesh is; Renderer.depthAt reads it back.
+  const DEPTH_FS = `#version 300 es
+  precision highp float;
+  in vec3 rotated;
+  uniform vec3 t;
+  uniform vec2 depth;
+  out vec4 fragment;
+  void main() {
+    float s = clamp((rotated.z + t.z - depth.x) / (depth.y - depth.x), 0.0, 1.0);
+    float k = floor(s * 16777215.0 + 0.5);
+    float r = floor(k / 65536.0);
+    float g = floor((k - r * 65536.0) / 256.0);
+    fragment = vec4(r, g, k - r * 65536.0 - g * 256.0, 255.0) / 255.0;
+  }`;
   // Full-canvas triangle that blends the offscreen skull at `alpha` (premultiplied) and draws
   // its silhouette's inner `outline.w` pixels opaque in `outline.rgb`.
   const QUAD_VS = `#version 300 es
@@ -249,6 +279,7 @@ const MeshGL = (function () {
       if (!gl) throw new Error("this page needs WebGL 2 (any current browser has it)");
       this.gl = gl; this.canvas = canvas; this.targets = {};
       this.meshProgram = compile(gl, MESH_VS, MESH_FS);
+      this.depthProgram = compile(gl, MESH_VS, DEPTH_FS);
       this.compositeProgram = compile(gl, QUAD_VS, COMPOSITE_FS);
       this.vao = gl.createVertexArray();
       this.quad = gl.createVertexArray();  // no attributes: the vertices come from gl_VertexID
@@ -275,18 +306,21 @@ const MeshGL = (function () {
       }
       return (this.targets[name] = target(this.gl, width, height));
     }
-    /** The shaded mesh (opaque) into the bound framebuffer of width x height pixels. */
-    drawMesh(camera, view, width, height, style) {
-      const gl = this.gl, m = this.mesh, {program, uniforms} = this.meshProgram;
+    /** The shaded mesh (opaque) into the bound framebuffer of width x height pixels; with
+        `shader` (a compiled program; default the shaded one) another fragment shader over the
+        same projection.
+        Returns the [near, far] depths (mm) it used, or null when nothing was drawn. */
+    drawMesh(camera, view, width, height, style, shader) {
+      const gl = this.gl, m = this.mesh, {program, uniforms} = shader || this.meshProgram;
       gl.viewport(0, 0, width, height);
       gl.clearColor(0, 0, 0, 0); gl.clearDepth(1);
       gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
-      if (!m) return;
+      if (!m) return null;
       const R = rotationOf(camera), t = add(translationOf(camera), apply(R, m.origin));
       // Near and far planes bracket the mesh's bounding sphere (1% margin).
       const zc = apply(R, m.centre)[2] + t[2], r = 1.01 * m.radius;
       const far = zc + r, near = Math.max(zc - r, 1e-4 * far);
-      if (far <= MIN_DEPTH_MM) return;  // the whole mesh is behind the camera
+      if (far <= MIN_DEPTH_MM) return null;  // the whole mesh is behind the camera
       gl.useProgram(program);
       gl.uniformMatrix3fv(uniforms.R, false, [].concat(...transpose(R)));  // column-major
       gl.uniform3fv(uniforms.t, t);
@@ -294,13 +328,14 @@ const MeshGL = (function () {
       gl.uniform2fv(uniforms.principal, camera.principal_point_px);
       gl.uniform4f(uniforms.view, view.x, view.y, view.width, view.height);
       gl.uniform2f(uniforms.depth, near, far);
-      gl.uniform3fv(uniforms.light, (style && style.light) || LIGHT_DIR_CAM);
-      gl.uniform3fv(uniforms.color, (style && style.color) || SKULL_RGB);
+      if (uniforms.light) gl.uniform3fv(uniforms.light, (style && style.light) || LIGHT_DIR_CAM);
+      if (uniforms.color) gl.uniform3fv(uniforms.color, (style && style.color) || SKULL_RGB);
       gl.enable(gl.DEPTH_TEST); gl.depthFunc(gl.LESS);
       gl.bindVertexArray(this.vao);
       gl.drawElements(gl.TRIANGLES, m.indices.length, gl.UNSIGNED_INT, 0);
       gl.bindVertexArray(null);
       gl.disable(gl.DEPTH_TEST);
+      return [near, far];
     }
     /** The mesh on the whole canvas, showing `view` of the photo. style: {alpha (opacity, 0-1),
         outline (px, 0 = none), outlineColor, color, light}. */
@@ -339,9 +374,41 @@ const MeshGL = (function () {
       }
       return {mask, width, height, view};
     }
+    /** The camera-frame depth (mm) of the nearest surface around each photo pixel [u, v] of
+        `points`, drawn offscreen at width x height over `view`: for each point the FARTHEST
+        such depth among the pixels within `radius` pixels (default 1) of its pixel, Infinity
+        where one of them shows no mesh, NaN where the point is off the picture (or not
+        finite). A point on the surface is in sight when its own depth is at most this plus a
+        tolerance (a silhouette or a steep slope keeps it in sight). */
+    depthAt(camera, view, width, height, points, radius) {
+      const gl = this.gl, off = this.target("depth", width, height), k = radius === undefined
+        ? 1 : radius;
+      gl.bindFramebuffer(gl.FRAMEBUFFER, off.framebuffer);
+      const range = this.drawMesh(camera, view, width, height, {}, this.depthProgram);
+      const side = 2 * k + 1, rgba = new Uint8Array(4 * side * side);
+      const out = points.map(([u, v]) => {
+        const j = Math.floor((u - view.x) * width / view.width);
+        const i = Math.floor((v - view.y) * height / view.height);
+        if (!(j >= 0 && i >= 0 && j < width && i < height)) return NaN;
+        if (!range) return Infinity;
+        const j0 = Math.max(0, j - k), j1 = Math.min(width - 1, j + k);
+        const i0 = Math.max(0, i - k), i1 = Math.min(height - 1, i + k);
+        const w = j1 - j0 + 1, h = i1 - i0 + 1;
+        gl.readPixels(j0, height - 1 - i1, w, h, gl.RGBA, gl.UNSIGNED_BYTE, rgba);
+        let far = -Infinity;
+        for (let p = 0; p < w * h; p++) {
+          if (rgba[4 * p + 3] < 128) return Infinity;
+          const s = (rgba[4 * p] * 65536 + rgba[4 * p + 1] * 256 + rgba[4 * p + 2]) / 16777215;
+          far = Math.max(far, range[0] + s * (range[1] - range[0]));
+        }
+        return far;
+      });
+      gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+      return out;
+    }
   }
 
   return {MIN_DEPTH_MM, SKULL_RGB, LIGHT_DIR_CAM, OUTLINE_RGB, add, sub, scale, dot, cross, norm,
     normalize, apply, transpose, matmul, rotation, rotationOf, translationOf, makeCamera,
-    toCamera, project, ray, mesh, pickSurface, Renderer};
+    lookRotation, orbitCamera, toCamera, project, ray, mesh, pickSurface, Renderer};
 })();
