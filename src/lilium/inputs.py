@@ -62,6 +62,9 @@ class Skull:
         messages then name the skull).
     warnings : tuple of CaseWarning
         Found while reading the skull (``mesh_part_left_out``); every result on it repeats them.
+    landmark_sources : dict of str -> str
+        Who placed each cranial landmark: ``"located"`` or ``"template"`` for an automatic,
+        unreviewed point (``lilium skull``), else ``"manual"`` (missing = manual).
     """
 
     id: str
@@ -71,6 +74,7 @@ class Skull:
     axes: dict
     landmarks_file: str | None = None
     warnings: tuple = ()
+    landmark_sources: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -125,9 +125,11 @@ def test_command_writes_a_folder_lilium_sfo_reads(skull, tmp_path, capsys):
     # The case reads the folder as it is; template points wait for confirmation.
     skull_read = read_skull(out)
     assert set(skull_read.landmarks_mm) == located
+    assert set(skull_read.landmark_sources.values()) == {"located"}  # automatic, unreviewed
     assert set(skull_read.axes) <= set(read_json(out / "soft_tissue_axes.json")["axes"])
     assert sorted(p.name for p in out.iterdir()) == [
         "cranial_landmarks.json",
+        "review.html",
         "skull.ply",
         "soft_tissue_axes.json",
     ]
@@ -162,3 +164,27 @@ def test_command_error_is_one_line(tmp_path, capsys):
     assert err.startswith("lilium skull: error: ") and "\n" not in err
     assert "metres" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_case_places_the_landmarks_of_a_bare_mesh(skull, case, tmp_path, capsys):
+    """``lilium case --skull MESH`` without a landmark file runs ``lilium skull`` into
+    ``OUT/prepared-skull/``, says so, caps the conclusion (unreviewed automatic landmarks) and
+    reads the folder back on a rerun."""
+    from lilium.cli.main import main
+    from lilium.io.jsonio import read_json
+    from lilium.io.mesh import write_mesh
+
+    v, f, _, _ = skull
+    write_mesh(tmp_path / "bare.ply", v, f)
+    out = tmp_path / "out"
+    argv = ["case", "--skull", str(tmp_path / "bare.ply"), "--photo", str(case[1]),
+            "--method", "posest-sfo", "--out", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    assert "landmarks placed automatically (lilium skull)" in printed
+    assert (out / "prepared-skull" / "review.html").is_file()
+    result = read_json(out / case[1].name / "posest-sfo" / "result.json")
+    assert result["subject"] == "bare"
+    assert "unreviewed_landmarks" in result["identification"]["caps"]
+    assert main(argv) == 0
+    assert "landmarks read back from" in capsys.readouterr().out

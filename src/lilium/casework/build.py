@@ -26,9 +26,9 @@ from ..inputs import CaseWarning, Photo, Priors, Skull
 from ..io.case import (
     check_axes_file,
     check_folder,
+    cranial_landmark_file,
     find_photo_image,
     parse_axes,
-    parse_cranial_landmarks,
     parse_facial_landmarks,
     read_image_or_size,
     read_photo_meta,
@@ -111,7 +111,7 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
         )
     skull_id = safe_id(skull_id, "skull")
     vertices, faces = clean_mesh(*parse_mesh(mesh_path), source=str(mesh_path))
-    landmarks = parse_cranial_landmarks(lm_path)
+    landmarks, sources = cranial_landmark_file(lm_path)
     vertices, faces, warnings = _skull_part(mesh_path, vertices, faces, landmarks)
     extent = np.ptp(vertices, axis=0).max()
     _check_on_mesh(lm_path, landmarks, vertices, faces, 0.1 * extent)
@@ -125,7 +125,10 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
     missing = [n for n in landmarks if n not in axes and n in CRANIAL_TO_FACIAL]
     if missing:
         axes.update(landmark_normals(vertices, faces, {n: landmarks[n] for n in missing}))
-    return Skull(skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings))
+    return Skull(
+        skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings),
+        landmark_sources=sources,
+    )
 
 
 def _skull_part(mesh_path, vertices, faces, landmarks):

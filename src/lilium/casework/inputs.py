@@ -53,15 +53,23 @@ def first_file(folder, names):
     return next((folder / n for n in names if (folder / n).is_file()), None)
 
 
-def load_skull(source, log=None):
+def load_skull(source, log=None, out=None):
     """Read the skull from a subject folder or a mesh file.
+
+    A mesh without a landmark file (none given, none beside it) gets its cranial landmarks
+    placed automatically (``lilium skull``, :func:`~lilium.skull.prepare.prepared_skull`) into
+    ``out/prepared-skull/`` (reused while the mesh is unchanged), with its ``review.html``;
+    they are automatic and unreviewed, which caps every conclusion (docs/method/skull.md).
 
     Parameters
     ----------
     source : SkullSource
         The skull as given (:class:`~lilium.casework.request.SkullSource`).
     log : callable, optional
-        Receives one line for a landmark file found beside a mesh.
+        Receives one line for a landmark file found beside a mesh, and one for landmarks placed
+        automatically.
+    out : Path, optional
+        The output folder; without one a mesh needs its landmark file.
 
     Returns
     -------
@@ -94,11 +102,13 @@ def load_skull(source, log=None):
             landmarks = find_landmark_file(
                 skull_path.parent, [skull_path.stem, f"{skull_path.stem}_landmarks"]
             )
-            if landmarks is None:
+            if landmarks is None and out is None:
                 raise ValueError(
                     f"{skull_path}: no cranial landmark file next to the mesh; give it with "
                     "--landmarks FILE (.mrk.json, .fcsv, .pp, .csv or .json)"
                 )
+            if landmarks is None:
+                return _automatic_skull(skull_path, axes, Path(out) / SKULL_FOLDER, log)
             _found(log, skull_path.stem, "cranial landmarks", landmarks, "the mesh")
         skull = skull_from_files(mesh, landmarks, axes)
     else:
@@ -108,6 +118,27 @@ def load_skull(source, log=None):
     inputs = {"skull mesh": mesh, "cranial landmarks": landmarks}
     if axes is not None and Path(axes).is_file():
         inputs["soft-tissue axes"] = Path(axes)
+    return skull, inputs
+
+
+def _automatic_skull(mesh, axes, folder, log):
+    """:func:`load_skull`'s skull of a mesh without landmarks: placed by ``lilium skull`` in
+    ``folder`` (or read back from there)."""
+    from ..skull.prepare import prepared_skull
+
+    folder, reused = prepared_skull(mesh, folder)
+    if log is not None:
+        how = "read back from" if reused else "placed automatically (lilium skull) in"
+        log(
+            f"{mesh.name}: no cranial landmark file beside the mesh: landmarks {how} {folder} "
+            f"(automatic, unreviewed: check them in {folder / 'review.html'})"
+        )
+    axes = Path(axes) if axes is not None else folder / "soft_tissue_axes.json"
+    landmarks = folder / "cranial_landmarks.json"
+    skull = skull_from_files(folder / "skull.ply", landmarks, axes, skull_id=mesh.stem)
+    inputs = {"skull mesh": mesh, "cranial landmarks": landmarks}
+    if axes.is_file():
+        inputs["soft-tissue axes"] = axes
     return skull, inputs
 
 
@@ -265,7 +296,10 @@ JOINT_FOLDER = "joint"
 
 #: Names at the top of a case's output folder that are not photo folders: a photo named so
 #: gets another id (``report.html_2``), as a repeated name does.
-CASE_OWN_NAMES = ("report.html", JOINT_FOLDER)
+#: The subject folder ``lilium case`` writes for a mesh without landmarks (:func:`load_skull`).
+SKULL_FOLDER = "prepared-skull"
+
+CASE_OWN_NAMES = ("report.html", JOINT_FOLDER, SKULL_FOLDER)
 
 
 def _taken(records):

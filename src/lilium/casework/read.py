@@ -75,7 +75,7 @@ def read_case(request, log=None, out=None):
         left/right labels (:func:`~lilium.methods.checks.check_inputs`), a depth table or a
         calibration file that cannot be read.
     """
-    skull, skull_inputs = load_skull(request.skull, log=log)
+    skull, skull_inputs = load_skull(request.skull, log=log, out=out or request.out)
     skull = labelled_skull(skull, skull_inputs)
 
     def photos_of(sources, **kwargs):

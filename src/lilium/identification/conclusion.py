@@ -99,7 +99,8 @@ def material_caps(has_mandible, photos, unreviewed_automatic, pairs):
     photos : int
         Photos behind the decision.
     unreviewed_automatic : bool
-        Some landmark used was placed automatically and not reviewed.
+        Some landmark used, on the photo or on the skull, was placed automatically and not
+        reviewed.
     pairs : int
         Fewest landmark pairs of any photo behind the decision.
     """
@@ -110,7 +111,8 @@ def material_caps(has_mandible, photos, unreviewed_automatic, pairs):
         caps["single_photo"] = "a single photo (one view of the face)"
     if unreviewed_automatic:
         caps["unreviewed_landmarks"] = (
-            "automatic landmarks nobody reviewed (review them in review.html)"
+            "automatic landmarks nobody reviewed (review them in the photo's or the skull's "
+            "review.html)"
         )
     if pairs < MIN_PAIRS_UNCAPPED:
         caps["few_pairs"] = f"only {pairs} landmark pairs (fewer than {MIN_PAIRS_UNCAPPED})"

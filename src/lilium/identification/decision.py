@@ -203,6 +203,10 @@ def _caps(skull, photos):
         f for photo in photos for f in photo.landmarks_uv
         if photo.landmark_sources.get(f, "manual") != "manual"
     ]
+    used += [
+        c for c, s in skull.landmark_sources.items()
+        if s != "manual" and c in skull.landmarks_mm
+    ]
     return material_caps(
         has_mandible=any(n in skull.landmarks_mm for n in MANDIBLE_LANDMARKS),
         photos=len(photos),

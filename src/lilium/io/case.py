@@ -27,6 +27,7 @@ __all__ = [
     "check_folder",
     "find_photo_image",
     "parse_axes",
+    "cranial_landmark_file",
     "parse_cranial_landmarks",
     "parse_facial_landmarks",
     "read_depth_table",
@@ -107,22 +108,39 @@ def check_axes_file(axes_path, option="soft-tissue axes file"):
 
 
 def parse_cranial_landmarks(landmarks_path):
-    """The cranial landmarks of a ``cranial_landmarks.json`` or of any file
-    :func:`lilium.io.formats.read_landmarks` reads, as parsed: dict of str -> ndarray (3,), mm.
+    """The cranial landmarks of a landmark file, as parsed (:func:`cranial_landmark_file`'s
+    first part): dict of str -> ndarray (3,), mm."""
+    return cranial_landmark_file(landmarks_path)[0]
 
-    A ``cranial_landmarks.json`` written by ``lilium skull`` tags each point in
-    ``landmark_sources``; as on photos, a ``"quality": "template"`` point is left out unless its
-    entry says ``"confirmed": true`` (docs/method/skull.md).
+
+def cranial_landmark_file(landmarks_path):
+    """The cranial landmarks of a ``cranial_landmarks.json`` or of any file
+    :func:`lilium.io.formats.read_landmarks` reads, as parsed, and who placed each.
+
+    A ``cranial_landmarks.json`` written by ``lilium skull`` (or saved by its review page) tags
+    each point in ``landmark_sources``; as on photos, a ``"quality": "template"`` point is left
+    out unless its entry says ``"confirmed": true`` (docs/method/skull.md).
+
+    Returns
+    -------
+    landmarks : dict of str -> ndarray of shape (3,)
+        mm.
+    sources : dict of str -> str
+        Each landmark's quality (:func:`~lilium.io.prepared.landmark_qualities`: ``"located"``
+        or ``"template"`` for an automatic, unreviewed point, else ``"manual"``).
     """
-    from .prepared import _without_unconfirmed_templates
+    from .prepared import _without_unconfirmed_templates, landmark_qualities
 
     lm_path = Path(landmarks_path)
     if lm_path.name == "cranial_landmarks.json" or not lm_path.is_file():
         data = read_json(lm_path)
         raw = required_field(lm_path, data, "landmarks")
         points = points_from_object(lm_path, "landmarks", raw, "cranial")
-        return _without_unconfirmed_templates(points, data.get("landmark_sources"))
-    return read_landmarks(lm_path, "cranial")
+        sources = data.get("landmark_sources")
+        points = _without_unconfirmed_templates(points, sources)
+        return points, landmark_qualities(sources, points)
+    points = read_landmarks(lm_path, "cranial")
+    return points, dict.fromkeys(points, "manual")
 
 
 def parse_axes(axes_path):

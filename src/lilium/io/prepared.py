@@ -125,10 +125,12 @@ def _without_unconfirmed_templates(landmarks, sources):
 
 
 def landmark_qualities(sources, landmarks):
-    """Who placed each landmark (:attr:`lilium.inputs.Photo.landmark_sources`).
+    """Who placed each landmark (:attr:`lilium.inputs.Photo.landmark_sources`,
+    :attr:`lilium.inputs.Skull.landmark_sources`).
 
-    An entry ``{"source": "automatic", "quality": "tracked" | "template"}`` keeps its quality;
-    a reviewed or confirmed point, or one without an entry, is ``manual``.
+    An entry ``{"source": "automatic", "quality": ...}`` (a photo's ``"tracked"`` or
+    ``"template"``, a skull's ``"located"`` or ``"template"``) keeps its quality; a reviewed or
+    confirmed point, or one without an entry, is ``manual``.
     """
     out = {}
     for name in landmarks:
@@ -136,7 +138,7 @@ def landmark_qualities(sources, landmarks):
         quality = entry.get("quality") if isinstance(entry, dict) else None
         automatic = isinstance(entry, dict) and entry.get("source") == "automatic"
         reviewed = isinstance(entry, dict) and entry.get("confirmed") is True
-        tagged = automatic and not reviewed and quality in ("tracked", "template")
+        tagged = automatic and not reviewed and quality in ("tracked", "template", "located")
         out[name] = quality if tagged else "manual"
     return out
 

@@ -30,34 +30,17 @@ in sight (``<pre id="visible">``) and presses Save, which then fills the downloa
 (``right``, ``top``, ``front``) also works without ``test``.
 """
 
-import base64
 import html
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
 from ..geometry.mesh import decimate
-from ..photo.review import fill_template, script_json
+from ..photo.review import script_json
+from .web_pages import base64_array, web_page
 from .workbench import DEFAULT_MAX_FACES, skull_centre
 
 __all__ = ["DEFAULT_MAX_FACES", "skull_review_page", "write_skull_review"]
-
-#: The scripts inlined in the page, in order (``lilium/report/web/``).
-SCRIPTS = {
-    "__PAGE_JS__": "page.js",
-    "__MESHGL_JS__": "meshgl.js",
-    "__REVIEW_JS__": "skull_review.js",
-}
-
-
-def _web_file(name):
-    return resources.files("lilium.report").joinpath("web", name).read_text(encoding="utf-8")
-
-
-def _base64(array, dtype):
-    return base64.b64encode(np.ascontiguousarray(array, dtype=dtype).tobytes()).decode("ascii")
-
 
 def _check_mesh(vertices_mm, faces):
     vertices = np.asarray(vertices_mm, dtype=float)
@@ -106,6 +89,7 @@ def skull_review_page(
     parts=None,
     max_faces=DEFAULT_MAX_FACES,
     message="",
+    skull_axes=None,
 ):
     """The review page of a skull's cranial landmarks, as HTML text.
 
@@ -130,6 +114,10 @@ def skull_review_page(
         300,000).
     message : str
         A line shown above the skull, e.g. what was not found (escaped).
+    skull_axes : array_like of shape (3, 3), optional
+        Rows: the skull's left, up and anterior directions in the mesh's frame (the rotation
+        of ``lilium skull``'s ``mesh2skull``), for the named views of a mesh in any pose;
+        default the identity (a mesh in the skull frame: x = left, y = up, z = anterior).
 
     Returns
     -------
@@ -143,6 +131,8 @@ def skull_review_page(
     """
     vertices, faces = _check_mesh(vertices_mm, faces)
     landmarks = _check_landmarks(landmarks_mm)
+    axes = np.eye(3) if skull_axes is None else np.asarray(skull_axes, dtype=float)
+    axes = axes / np.linalg.norm(axes, axis=1, keepdims=True)
     drawn_v, drawn_f = decimate(vertices, faces, max_faces)
     origin = skull_centre(drawn_v)
     data = {
@@ -155,6 +145,7 @@ def skull_review_page(
         },
         "parts": {str(k): bool(v) for k, v in (parts or {}).items()},
         "faces": {"drawn": len(drawn_f), "of": len(faces)},
+        "axes": dict(zip(("left", "up", "anterior"), axes.tolist(), strict=True)),
     }
     faces_line = f"{len(drawn_f):,} faces drawn" + (
         f" (of {len(faces):,})" if len(drawn_f) < len(faces) else ""
@@ -165,15 +156,10 @@ def skull_review_page(
         "__FACES__": faces_line,
         "__MESSAGE__": html.escape(message),
         "__DATA__": script_json(data),
-        "__POSITIONS__": _base64(np.asarray(drawn_v, dtype=float) - origin, "<f4"),
-        "__INDICES__": _base64(drawn_f, "<u4"),
+        "__POSITIONS__": base64_array(np.asarray(drawn_v, dtype=float) - origin, "<f4"),
+        "__INDICES__": base64_array(drawn_f, "<u4"),
     }
-    for key, name in SCRIPTS.items():
-        source = _web_file(name)
-        if "</script" in source.lower():
-            raise ValueError(f"lilium/report/web/{name} must not contain '</script'")
-        values[key] = source
-    return fill_template(_web_file("skull_review.html"), values)
+    return web_page("skull_review.html", "skull_review.js", values)
 
 
 def write_skull_review(path, vertices_mm, faces, landmarks_mm, sources, **kwargs):

@@ -25,7 +25,6 @@ download link (for the headless-browser tests).
 import base64
 import html
 import io
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -34,11 +33,12 @@ from ..fitness.regions import AnatomicalFrame, anatomical_frame
 from ..geometry.camera import Camera
 from ..geometry.mesh import decimate
 from ..geometry.rotations import rotvec_to_matrix
-from ..photo.review import fill_template, script_json
+from ..photo.review import script_json
 from ..softtissue.landmarks import CORRESPONDENCES
 from .html import DEFAULT_OPACITY_PCT
 from .pictures import view_box
 from .records import method_label
+from .web_pages import base64_array, web_page
 
 #: Faces of the mesh the page draws (more are decimated): about 7 MB of base64 at 300,000.
 DEFAULT_MAX_FACES = 300_000
@@ -49,18 +49,6 @@ PAGE_SIDE_PX = 4000
 
 #: JPEG quality of the embedded photo.
 JPEG_QUALITY = 90
-
-#: The scripts inlined in the page, in order (``lilium/report/web/``).
-SCRIPTS = {
-    "__PAGE_JS__": "page.js",
-    "__MESHGL_JS__": "meshgl.js",
-    "__WORKBENCH_JS__": "workbench.js",
-}
-
-
-def _web_file(name):
-    return resources.files("lilium.report").joinpath("web", name).read_text(encoding="utf-8")
-
 
 def skull_centre(vertices_mm):
     """The point the workbench turns the skull about: its bounding box's centre (mm, (3,))."""
@@ -164,10 +152,6 @@ def _photo_data_url(image, side_px=PAGE_SIDE_PX):
     return "data:image/jpeg;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
 
 
-def _base64(array, dtype):
-    return base64.b64encode(np.ascontiguousarray(array, dtype=dtype).tobytes()).decode("ascii")
-
-
 def _points(named):
     return {str(k): [float(x) for x in v] for k, v in named.items()}
 
@@ -263,15 +247,10 @@ def workbench_page(skull, photo, result, *, max_faces=DEFAULT_MAX_FACES, title="
         "__OPACITY__": str(DEFAULT_OPACITY_PCT),
         "__IMAGE__": "data:," if photo.image is None else _photo_data_url(photo.image),
         "__DATA__": script_json(data),
-        "__POSITIONS__": _base64(np.asarray(vertices, dtype=float) - pivot, "<f4"),
-        "__INDICES__": _base64(faces, "<u4"),
+        "__POSITIONS__": base64_array(np.asarray(vertices, dtype=float) - pivot, "<f4"),
+        "__INDICES__": base64_array(faces, "<u4"),
     }
-    for key, name in SCRIPTS.items():
-        source = _web_file(name)
-        if "</script" in source.lower():
-            raise ValueError(f"lilium/report/web/{name} must not contain '</script'")
-        values[key] = source
-    return fill_template(_web_file("workbench.html"), values)
+    return web_page("workbench.html", "workbench.js", values)
 
 
 def write_workbench(path, skull, photo, result, **kwargs):

@@ -4,15 +4,16 @@
 Written in ``out`` (and nowhere else): ``skull.ply`` (the mesh in its own frame and units, welded
 and checked as ``lilium case`` reads it), ``cranial_landmarks.json`` (docs/contract.md:
 ``landmarks``, ``landmark_sources``, ``parts``, ``prepared_by``) and ``soft_tissue_axes.json``
-(the outward surface normals at the landmarks: the axes ``lilium case`` would take by default).
-The review page is not written yet (:func:`_write_review_page`).
+(the outward surface normals at the landmarks: the axes ``lilium case`` would take by default)
+and ``review.html`` (the skull in 3D, each landmark draggable along the bone:
+:mod:`lilium.report.skull_review`).
 """
 
 from pathlib import Path
 
 import numpy as np
 
-from .locate import GIVEN, LOCATED, locate_skull_landmarks
+from .locate import GIVEN, LOCATED, TEMPLATE, locate_skull_landmarks
 
 #: ``prepared_by`` of the files written here.
 PREPARED_BY = "lilium skull"
@@ -50,13 +51,45 @@ def landmark_sources(result):
     return out
 
 
-def _write_review_page(out, mesh_path, result):
-    """The 3D review page (``review.html``): not written yet.
+def _write_review_page(out, vertices, faces, result, sources, title):
+    """``review.html``: the skull in 3D, every landmark draggable along the bone
+    (:mod:`lilium.report.skull_review`), opened in a frontal view of the fitted skull frame."""
+    from ..report.skull_review import write_skull_review
 
-    The hook for the shared WebGL review module: it gets the folder, the mesh written there and
-    the :class:`~lilium.skull.locate.SkullLandmarks` (landmarks, qualities, axes).
+    parts = {"cranium": True, "mandible": result.mandible}
+    template = [n for n, q in result.quality.items() if q == TEMPLATE]
+    message = "automatic landmarks, unreviewed: check each, drag it where it belongs, Save"
+    if template:
+        message += f"; template points (off until confirmed): {', '.join(template)}"
+    write_skull_review(
+        out / "review.html", vertices, faces, result.landmarks, sources, title=title,
+        parts=parts, message=message, skull_axes=result.mesh2skull[:3, :3],
+    )
+
+
+def prepared_skull(mesh_path, out, rng=0):
+    """The subject folder ``out`` of a mesh without landmarks (``lilium case --skull MESH``):
+    the one ``lilium skull`` wrote there for this mesh (same bytes, ``mesh_sha256``), else
+    written now (:func:`prepare_skull`).
+
+    Returns
+    -------
+    folder : Path
+    reused : bool
     """
-    del out, mesh_path, result
+    from ..io.jsonio import read_json
+    from ..io.provenance import sha256_of
+
+    out = Path(out)
+    digest = sha256_of(mesh_path)
+    try:
+        stored = read_json(out / "cranial_landmarks.json").get("mesh_sha256")
+    except (ValueError, AttributeError):
+        stored = None
+    if stored == digest and (out / "skull.ply").is_file():
+        return out, True
+    prepare_skull(mesh_path, out, rng=rng)
+    return out, False
 
 
 def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
@@ -86,25 +119,28 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
     from ..geometry.mesh import clean_mesh, compact
     from ..io.jsonio import write_json
     from ..io.mesh import parse_mesh, write_mesh
+    from ..io.provenance import sha256_of
 
     mesh_path, out = Path(mesh_path), Path(out)
     vertices, faces = compact(*clean_mesh(*parse_mesh(mesh_path), source=str(mesh_path)))
     keep = _reviewed(landmarks_path) if landmarks_path is not None else None
     result = locate_skull_landmarks(vertices, faces, keep=keep, rng=rng, source=str(mesh_path))
+    sources = landmark_sources(result)
     out.mkdir(parents=True, exist_ok=True)
     skull_path = out / "skull.ply"
     write_mesh(skull_path, vertices, faces)
-    write_json(
+    write_json(out / "soft_tissue_axes.json", {"axes": result.axes, "prepared_by": PREPARED_BY})
+    _write_review_page(out, vertices, faces, result, sources, mesh_path.name)
+    write_json(  # last: a folder holding it is whole (prepared_skull)
         out / "cranial_landmarks.json",
         {
             "landmarks": result.landmarks,
-            "landmark_sources": landmark_sources(result),
+            "landmark_sources": sources,
             "parts": {"cranium": True, "mandible": result.mandible},
             "prepared_by": PREPARED_BY,
             "mesh": mesh_path.name,
+            "mesh_sha256": sha256_of(mesh_path),
             "mesh2skull": np.round(result.mesh2skull, 9),
         },
     )
-    write_json(out / "soft_tissue_axes.json", {"axes": result.axes, "prepared_by": PREPARED_BY})
-    _write_review_page(out, skull_path, result)
     return {"folder": out, "result": result, "faces": len(faces), "located": LOCATED}

@@ -44,12 +44,16 @@
   const VISIBLE_TOLERANCE_MM = 2.0;
   /** Marker radius and label size, CSS pixels; the test drag, CSS pixels. */
   const MARK_R = 6, LABEL_PX = 12, TEST_DRAG = [15, 8];
-  /** Camera looking direction and image-down direction of each view, skull frame. */
+  /** Camera looking direction and image-down direction of each view, from the skull's
+      anatomical axes in the mesh's frame (DATA.axes: left, up, anterior; the skull frame's own
+      x, y, z when the mesh is in it). */
+  const neg = (a) => a.map((x) => -x);
+  const AX = DATA.axes;
   const VIEWS = {
-    front: {forward: [0, 0, -1], down: [0, -1, 0]},
-    left: {forward: [-1, 0, 0], down: [0, -1, 0]},
-    right: {forward: [1, 0, 0], down: [0, -1, 0]},
-    top: {forward: [0, -1, 0], down: [0, 0, -1]},
+    front: {forward: neg(AX.anterior), down: neg(AX.up)},
+    left: {forward: neg(AX.left), down: neg(AX.up)},
+    right: {forward: AX.left, down: neg(AX.up)},
+    top: {forward: neg(AX.up), down: neg(AX.anterior)},
   };
 
   const mesh = G.mesh(Page.float32("mesh-positions"), Page.uint32("mesh-indices"),
