@@ -74,7 +74,7 @@ def test_the_record_names_a_misplaced_landmark(case, tmp_path):
                  "--photo", str(photo_dir), "--out", str(tmp_path / "out")]) == 0
     data = json.loads((tmp_path / "out" / "result.json").read_text())
     assert data["identification"]["worst_landmark"]["misfit"] > 0
-    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[],
+    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[], camera_source="search",
                              camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
     skull, photo = read_skull(subject_dir), read_photo(photo_dir)
     moved_name = correspondences(skull, photo).facial_names[2]
@@ -201,7 +201,7 @@ def _posest_sfo(case, tmp_path):
     assert main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
                  "--photo", str(photo_dir), "--out", str(tmp_path / "out")]) == 0
     data = json.loads((tmp_path / "out" / "result.json").read_text())
-    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[],
+    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[], camera_source="search",
                              camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
     return result, read_skull(subject_dir), read_photo(photo_dir), data
 
@@ -278,8 +278,9 @@ def test_two_photos_reuse_each_photos_own_decision(case, tmp_path, monkeypatch):
     assert main(["sfo", "--method", "posest-sfo", "--skull", str(subject_dir),
                  "--photo", str(photo_dir), "--out", str(tmp_path / "out")]) == 0
     data = json.loads((tmp_path / "out" / "result.json").read_text())
-    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[], extra={},
-                             camera=Camera.from_dict(data["camera"]), facial_landmarks_mm=None)
+    result = SimpleNamespace(method="posest-sfo", variant="", warnings=[], camera_source="search",
+                             extra={}, camera=Camera.from_dict(data["camera"]),
+                             facial_landmarks_mm=None)
     skull, frontal = read_skull(subject_dir), read_photo(photo_dir)
     lateral = replace(frontal, view="lateral_left")
     calibrations = Calibrations()

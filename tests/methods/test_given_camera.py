@@ -106,6 +106,10 @@ def test_sfo_camera_option_reproduces_lilium_from_its_result(case, tmp_path, cap
     assert own["identification"]["log10_lr"] == pytest.approx(
         result["identification"]["log10_lr"], rel=1e-9
     )
+    # A chosen camera's LR is for comparison: it concludes nothing.
+    assert "examiner_camera" in own["identification"]["caps"]
+    assert own["identification"]["conclusion"] == "undetermined"
+    assert "examiner_camera" not in result["identification"]["caps"]
 
 
 def test_sfo_camera_option(case, tmp_path, capsys):

@@ -68,6 +68,19 @@ CAMERA_FAILURES = ("view_mismatch", "head_outside_prior")
 #: Caps that allow no support at all (not one step each): the LR is an extrapolation.
 NO_SUPPORT_CAPS = ("outside_calibration",)
 
+#: Caps that leave every conclusion undetermined: a camera chosen by hand and scored
+#: (``--camera``). The calibration was fitted on the cameras the search finds; a chosen camera
+#: moves its features where no searched one lies (measured: POSEST-SFO's log10 LR rose by 0.3
+#: to 0.5 when the skull was turned 5 degrees off its SFO, docs/method/workbench.md), so its
+#: LR is shown for comparison and concludes nothing.
+UNDETERMINED_CAPS = ("examiner_camera",)
+
+#: The sentence of the ``examiner_camera`` cap.
+EXAMINER_CAMERA = (
+    "a camera chosen by hand and scored, not searched: the calibration holds for searched "
+    "cameras, so this LR is for comparison with the search's and concludes nothing"
+)
+
 #: Fewest landmark pairs that do not cap the support.
 MIN_PAIRS_UNCAPPED = 8
 
@@ -150,7 +163,8 @@ def conclude(log10_lr, caps=None, inconsistent=None):
     log10_lr : float or None
         None or NaN: no LR (a failed SFO) -> undetermined.
     caps : dict of str -> str, optional
-        :func:`material_caps`, and those of :data:`NO_SUPPORT_CAPS`.
+        :func:`material_caps`, and those of :data:`NO_SUPPORT_CAPS` and
+        :data:`UNDETERMINED_CAPS`.
     inconsistent : dict of str -> str, optional
         ``{warning code: sentence}`` of consistency failures: none is support; one of
         :data:`CAMERA_FAILURES` is no exclusion either.
@@ -168,6 +182,8 @@ def conclude(log10_lr, caps=None, inconsistent=None):
     if inconsistent or any(code in caps for code in NO_SUPPORT_CAPS):
         top = UNDETERMINED
     capped = min(raw, max(top, UNDETERMINED))
-    if any(code in inconsistent for code in CAMERA_FAILURES):
+    if any(code in inconsistent for code in CAMERA_FAILURES) or any(
+        code in caps for code in UNDETERMINED_CAPS
+    ):
         capped = UNDETERMINED
     return Conclusion(SCALE[capped][0], SCALE[raw][0], caps, inconsistent)

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from ..inputs import correspondences
 from ..methods.prior_checks import perspective_conflict, prior_conflicts
 from .calibration import VIEWS_LOG10_LR
-from .conclusion import conclude, material_caps
+from .conclusion import EXAMINER_CAMERA, conclude, material_caps
 from .score import identification_terms, nll_score, skull_beyond_head, worst_landmark_of
 
 #: Cranial landmarks on the mandible: a skull with none of them has no mandible.
@@ -244,6 +244,8 @@ def identify(skull, photos, results, calibrations, cohort, facial_landmarks_mm=N
     method, variant = results[0].method, results[0].variant
     key = decision_key(method, variant, photos, joint)
     caps = _caps(skull, photos)
+    if any(r.camera_source == "examiner" for r in results):
+        caps = {"examiner_camera": EXAMINER_CAMERA} | caps
     calibration = {"model": key, "file": str(calibrations.path)}
     if not all(results):
         verdict = conclude(None, caps)
