@@ -17,8 +17,8 @@ from .read import read_case
 
 
 def searched_line(result):
-    """One line for the search's camera scored as an examiner's is (soft tissue re-fitted
-    under it for Lilium): fitness and mean landmark error."""
+    """One line for the search's camera scored as a bare examiner's camera is (for Lilium the
+    soft tissue fitted under it): fitness and mean landmark error."""
     error = (result.landmark_error or {}).get("mean_px")
     px = "" if error is None else f", mean landmark error {error:.2f} px"
     return f"fitness {result.fitness:.4g}{px}"
@@ -212,14 +212,16 @@ class _CaseRun:
     def examined(self, method, record, searched, landmark_info):
         """The report entry of the examiner's camera of ``record`` (``--camera``) scored by
         ``method`` without search, in ``<photo>/<method tag>/examiner/``; its notes give the
-        search's camera scored the same way (:func:`searched_line`), so that the two compare."""
+        search's camera scored the same way (:func:`searched_line`) when the examiner's came
+        without its soft tissue (a bare camera: Lilium fits one under it), so that the two
+        compare; with the soft tissue of the search the search's own figures compare."""
         photo = record.photo
         folder = self.out / safe_id(photo.id) / method_tag(method, self.options.variant)
         inputs = {**record.inputs, "examiner camera": Path(record.camera.source)}
         notes = dict(record.notes)
-        if searched:
-            given = GivenCamera(searched.camera, searched.facial_landmarks_mm, "the search")
-            rescored = run_sfo(method, self.skull, photo, self.options, self.seed, given)
+        if searched and record.camera.facial_landmarks_mm is None:
+            bare = GivenCamera(searched.camera, source="the search")
+            rescored = run_sfo(method, self.skull, photo, self.options, self.seed, bare)
             notes["search's camera, scored the same way"] = searched_line(rescored)
         return self.single(
             method, photo, inputs, notes, landmark_info, record.camera, folder / "examiner"
