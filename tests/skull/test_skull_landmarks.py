@@ -162,3 +162,18 @@ def test_command_error_is_one_line(tmp_path, capsys):
     assert err.startswith("lilium skull: error: ") and "\n" not in err
     assert "metres" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_mandible_absent_on_a_partial_skull():
+    """A real-like partial skull: no mandible and the vault cut 40 mm above the orbits (as the
+    headsq CT's): no mandible, and none of its landmarks."""
+    v, f, _ = _skull(5, False)
+    keep = v[:, 1] < np.percentile(v[:, 1], 75)
+    faces = f[keep[f].all(axis=1)]
+    used = np.unique(faces)
+    index = np.full(len(v), -1)
+    index[used] = np.arange(len(used))
+    result = locate_skull_landmarks(v[used], index[faces])
+    assert not result.mandible, result.mandible_coverage
+    assert result.mandible_coverage < 0.1
+    assert not set(result.landmarks) & set(MANDIBLE_LANDMARKS)
