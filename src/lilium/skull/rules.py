@@ -12,12 +12,13 @@ Written down (docs/method/skull.md lists them too):
   3 mm below glabella (the deepest point of the nasal root);
 - ``metopion``: the profile point 36 mm above glabella;
 - ``bregma``: the highest point of the cut at the estimate's z;
-- ``subspinale``: the most posterior profile point between the anterior nasal spine (the most
-  anterior profile point within ``ANS_MM`` of the template's spine) and the prosthion
-  estimate's height + 2 mm;
-- ``pogonion``: the most anterior mandible profile point within ``CHIN_MM`` of its estimate's
-  height; ``gnathion``: the mandible profile point furthest along ``(0, -1, 1)`` within
-  ``CHIN_MM``;
+- ``subspinale``: the most posterior profile point between the anterior nasal spine (within
+  ``ANS_MM`` of the template's spine, the last profile point going up before a step back of
+  ``ANS_STEP_MM``, else the most anterior one) and the prosthion estimate's height + 2 mm;
+- ``pogonion``: the most anterior mandible profile point from 3 mm above menton to menton +
+  20 mm; when that is the window's top (a receding chin), the point farthest in front of the
+  chord from the window's top to menton; ``gnathion``: the mandible profile point furthest
+  along ``(0, -1, 1)`` within ``CHIN_MM``;
 - orbits (frontal height map, :class:`~lilium.skull.surface.FrontalMap`): the centre is the
   template's, re-centred once between the rim edges of scans up/down and in/out;
   ``ectoconchion``: the rim edge of the scan from the centre laterally (32 mm); ``orbitale``:
