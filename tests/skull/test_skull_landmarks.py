@@ -188,3 +188,18 @@ def test_case_places_the_landmarks_of_a_bare_mesh(skull, case, tmp_path, capsys)
     assert "unreviewed_landmarks" in result["identification"]["caps"]
     assert main(argv) == 0
     assert "landmarks read back from" in capsys.readouterr().out
+
+
+def test_mandible_absent_on_a_partial_skull():
+    """A real-like partial skull: no mandible and the vault cut 40 mm above the orbits (as the
+    headsq CT's): no mandible, and none of its landmarks."""
+    v, f, _ = _skull(5, False)
+    keep = v[:, 1] < np.percentile(v[:, 1], 75)
+    faces = f[keep[f].all(axis=1)]
+    used = np.unique(faces)
+    index = np.full(len(v), -1)
+    index[used] = np.arange(len(used))
+    result = locate_skull_landmarks(v[used], index[faces])
+    assert not result.mandible, result.mandible_coverage
+    assert result.mandible_coverage < 0.1
+    assert not set(result.landmarks) & set(MANDIBLE_LANDMARKS)

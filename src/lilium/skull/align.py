@@ -191,6 +191,7 @@ def align_to_template(vertices, templates, score, rng=0):
     key : the winning template's key
     fit : Alignment
     scores : dict of key -> float (each template's best score)
+    fits : dict of key -> Alignment (each template's best fit)
     """
     from scipy.spatial import cKDTree
 
@@ -199,7 +200,7 @@ def align_to_template(vertices, templates, score, rng=0):
     coarse = _sample(vertices, COARSE_POINTS, rng)
     fine = _sample(vertices, FINE_POINTS, rng)
     on_plane = vertices.mean(axis=0) - (n @ vertices.mean(axis=0) - d) * n
-    best, scores = None, {}
+    best, scores, fits_by_key = None, {}, {}
     for key, points in templates.items():
         target = _sample(points, COARSE_TEMPLATE_POINTS, rng)
         tree = cKDTree(target)
@@ -216,10 +217,11 @@ def align_to_template(vertices, templates, score, rng=0):
             mesh2skull[:3, :3], mesh2skull[:3, 3] = R, t / s
             fit = Alignment(mesh2skull, float(s), rms)
             value = score(fit, key)
-            scores[key] = min(scores.get(key, np.inf), value)
+            if value < scores.get(key, np.inf):
+                scores[key], fits_by_key[key] = value, fit
             if best is None or value < best[0]:
                 best = (value, key, fit)
-    return best[1], best[2], scores
+    return best[1], best[2], scores, fits_by_key
 
 
 def symmetrise(fit, points):

@@ -4,8 +4,9 @@ Stages (:func:`locate_skull_landmarks`, each timed in :attr:`SkullLandmarks.prof
 
 1. ``check``: the mesh's size is a skull's in millimetres (:mod:`lilium.skull.checks`);
 2. ``align``: the rigid motion (and scale) onto the template skull (:mod:`lilium.skull.align`),
-   with and without the template's mandible: the better fit (:func:`~lilium.skull.transfer.
-   mismatch_mm`) says whether the lower jaw is there;
+   with and without the template's mandible; the fit that lays the template's cranium best is
+   kept, and bone where it puts the template's mandible body says whether the lower jaw is
+   there (:func:`~lilium.skull.transfer.mandible_coverage`);
 3. ``symmetry``: the mirror plane to ``x = 0``;
 4. ``transfer``: the template's landmarks fitted patch by patch (:mod:`lilium.skull.transfer`);
    the fit checked (not a skull: an error);
@@ -27,7 +28,16 @@ from ..synthetic.subjects import MANDIBLE_LANDMARKS
 from .align import align_to_template, symmetrise
 from .checks import check_skull_extent, check_skull_fit
 from .template import mean_template
-from .transfer import SURFACE_SAMPLES, mismatch_mm, surface_samples, transfer_landmarks
+from .transfer import (
+    MANDIBLE_COVERED,
+    SURFACE_SAMPLES,
+    cranium_mismatch_mm,
+    mandible_body,
+    mandible_coverage,
+    mismatch_mm,
+    surface_samples,
+    transfer_landmarks,
+)
 
 #: Mesh surface samples the mirror plane is fitted on.
 SYMMETRY_POINTS = 6000
@@ -52,7 +62,11 @@ class SkullLandmarks:
         Whether the mesh has a mandible.
     mismatch_mm : dict of bool -> float
         The two-sided mismatch of the fits with (True) and without (False) the template's
-        mandible (:func:`~lilium.skull.transfer.mismatch_mm`); the smaller one decides.
+        mandible (:func:`~lilium.skull.transfer.mismatch_mm`), each template's best.
+    mandible_coverage : float
+        Share of the fitted template's mandible body with bone of the mesh there
+        (:func:`~lilium.skull.transfer.mandible_coverage`); ``mandible`` is whether it reaches
+        :data:`~lilium.skull.transfer.MANDIBLE_COVERED`.
     mesh2skull : ndarray of shape (4, 4)
         Rigid motion from the mesh's frame to the normalised skull frame.
     scale : float
@@ -71,6 +85,7 @@ class SkullLandmarks:
     scale: float
     fit_rms_mm: float
     profile_s: dict = field(default_factory=dict)
+    mandible_coverage: float = float("nan")
 
 
 def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
@@ -122,7 +137,15 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     def score(fit, has_mandible):
         return mismatch_mm(fit.to_skull(mesh_samples), templates[has_mandible] / fit.scale)
 
-    has_mandible, fit, mismatch = align_to_template(mesh_samples, templates, score, rng)
+    _, _, mismatch, fits = align_to_template(mesh_samples, templates, score, rng)
+    # The fit that lays the template's cranium best, and bone where it puts the mandible.
+    cranium = template.vertices[~template.mandible]
+    on_cranium = {k: cranium_mismatch_mm(f.to_skull(mesh_samples), cranium / f.scale)
+                  for k, f in fits.items()}  # fmt: skip
+    fit = fits[min(on_cranium, key=on_cranium.get)]
+    body = template.vertices[mandible_body(template.vertices, template.mandible)] / fit.scale
+    coverage = mandible_coverage(fit.to_skull(mesh_samples), body)
+    has_mandible = coverage >= MANDIBLE_COVERED
     lap("align")
     fit = symmetrise(fit, mesh_samples[:: max(1, SURFACE_SAMPLES // SYMMETRY_POINTS)])
     moved = fit.to_skull(vertices)
@@ -154,5 +177,5 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     lap("axes")
     return SkullLandmarks(
         placed, quality, axes, bool(has_mandible), mismatch, fit.mesh2skull, fit.scale,
-        fit.rms_mm, profile,
+        fit.rms_mm, profile, coverage,
     )  # fmt: skip

@@ -12,12 +12,13 @@ Written down (docs/method/skull.md lists them too):
   3 mm below glabella (the deepest point of the nasal root);
 - ``metopion``: the profile point 36 mm above glabella;
 - ``bregma``: the highest point of the cut at the estimate's z;
-- ``subspinale``: the most posterior profile point between the anterior nasal spine (the most
-  anterior profile point within ``ANS_MM`` of the template's spine) and the prosthion
-  estimate's height + 2 mm;
-- ``pogonion``: the most anterior mandible profile point within ``CHIN_MM`` of its estimate's
-  height; ``gnathion``: the mandible profile point furthest along ``(0, -1, 1)`` within
-  ``CHIN_MM``;
+- ``subspinale``: the most posterior profile point between the anterior nasal spine (within
+  ``ANS_MM`` of the template's spine, the last profile point going up before a step back of
+  ``ANS_STEP_MM``, else the most anterior one) and the prosthion estimate's height + 2 mm;
+- ``pogonion``: the most anterior mandible profile point from 3 mm above menton to menton +
+  20 mm; when that is the window's top (a receding chin), the point farthest in front of the
+  chord from the window's top to menton; ``gnathion``: the mandible profile point furthest
+  along ``(0, -1, 1)`` within ``CHIN_MM``;
 - orbits (frontal height map, :class:`~lilium.skull.surface.FrontalMap`): the centre is the
   template's, re-centred once between the rim edges of scans up/down and in/out;
   ``ectoconchion``: the rim edge of the scan from the centre laterally (32 mm); ``orbitale``:
@@ -43,9 +44,19 @@ PROFILE_BAND_MM = 0.5
 GLABELLA_MM = (-8.0, 12.0)
 NASION_MM = 12.0
 METOPION_ABOVE_GLABELLA_MM = 36.0
+#: The anterior nasal spine: searched within ANS_MM (mm) of the template's; its tip is where the
+#: profile steps back by more than ANS_STEP_MM from one row to the next (else the most anterior
+#: point there).
 ANS_MM = 6.0
+ANS_STEP_MM = 3.0
 CHIN_MM = 10.0
-CHIN_ABOVE_MENTON_MM = 10.0
+#: Pogonion: the chin's profile from this above menton (mm) up to CHIN_MM above the centre
+#: (CHIN_ABOVE_MENTON_MM[1] above menton).
+CHIN_ABOVE_MENTON_MM = (3.0, 10.0)
+#: A most anterior point this close (mm) to the window's top is no bulge (a receding chin,
+#: or a head pitched forward): pogonion is then the point farthest in front of the chord from
+#: the window's top to menton.
+CHIN_EDGE_MM = 1.5
 GNATHION_SPAN_MM = 14.0
 #: The face's midline profile: section points in front of this (mm) behind the orbits' centres.
 FRONT_BEHIND_ORBIT_MM = 25.0
@@ -101,17 +112,24 @@ def _midline(section, on_mandible, est, anchors):
     if "subspinale" in est and "prosthion" in est:
         a = anchors["ans"][1]
         spine = _profile(cranium_front, a - ANS_MM, a + ANS_MM)
-        if len(spine):
+        ans = _spine(spine)
+        if ans is None and len(spine):  # no step back: the most anterior point
             ans = spine[np.argmax(spine[:, 2])]
+        if ans is not None:
             prof = _profile(cranium_front, est["prosthion"][1] + 2.0, ans[1] - 1.0)
             if len(prof):
                 out["subspinale"] = prof[np.argmin(prof[:, 2])]
     if "pogonion" in est and len(mandible_front):
         menton = mandible_front[np.argmin(mandible_front[:, 1])]
-        centre = menton[1] + CHIN_ABOVE_MENTON_MM
-        prof = _profile(mandible_front, centre - CHIN_MM, centre + CHIN_MM)
+        centre = menton[1] + CHIN_ABOVE_MENTON_MM[1]
+        prof = _profile(mandible_front, menton[1] + CHIN_ABOVE_MENTON_MM[0],
+                        centre + CHIN_MM)  # fmt: skip
         if len(prof):
-            out["pogonion"] = _plateau(prof, np.array([0.0, 0.0, 1.0]))
+            top = prof[np.argmax(prof[:, 1])]
+            p = _plateau(prof, np.array([0.0, 0.0, 1.0]))
+            if top[1] - p[1] < CHIN_EDGE_MM:  # the window's top, no bulge: a receding chin
+                p = _behind_chord(prof, top, menton, posterior=False)
+            out["pogonion"] = p
         chin = mandible_front[
             np.abs((mandible_front - (0, centre, menton[2])) @ (0, 1, 1)) / np.sqrt(2)
             < GNATHION_SPAN_MM
@@ -119,6 +137,27 @@ def _midline(section, on_mandible, est, anchors):
         if "gnathion" in est and len(chin):
             out["gnathion"] = _plateau(chin, np.array([0.0, -1.0, 1.0]) / np.sqrt(2))
     return out
+
+
+def _spine(prof):
+    """The anterior nasal spine's tip on a cranium profile (``(K, 3)``, bottom-up): the last
+    point going up before the profile steps back by :data:`ANS_STEP_MM` (onto the nasal floor
+    or into the aperture), or None."""
+    step = prof[:-1, 2] - prof[1:, 2]
+    gap = np.diff(prof[:, 1]) > 2 * PROFILE_STEP_MM
+    k = np.flatnonzero((step > ANS_STEP_MM) | gap)
+    return prof[k[0]].copy() if len(k) and k[0] > 0 else None
+
+
+def _behind_chord(arc, a, b, posterior):
+    """The point of ``arc`` ``(K, 3)`` farthest behind (``posterior``) or in front of the chord
+    ``a -> b`` in the midsagittal view (y, z): the deepest point of a concavity, the top of a
+    bulge, whatever the head's pitch."""
+    chord = (b - a)[1:]
+    normal = np.array([-chord[1], chord[0]]) / max(np.linalg.norm(chord), 1e-9)
+    normal *= np.sign(normal[1]) or 1.0  # anterior (+z)
+    h = (arc[:, 1:] - a[1:]) @ normal
+    return arc[np.argmin(h) if posterior else np.argmax(h)].copy()
 
 
 def _orbit(fm, centre, sx):

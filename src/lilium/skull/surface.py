@@ -97,11 +97,13 @@ def frontal_map(vertices, faces, px_mm=FRONTAL_PX_MM, min_z_mm=FRONTAL_MIN_Z_MM)
     return FrontalMap(out, float(lo[0]), float(hi[1]), float(px_mm))
 
 
-def rim_edge(points, fraction=RIM_FRACTION):
+def rim_edge(points, fraction=RIM_FRACTION, from_deepest=False):
     """The edge of an opening along a scan from inside it outwards (the generator's rule).
 
     With ``crest`` the highest z of the scan and ``deep`` the lowest before it, the first point
-    whose z reaches ``deep + fraction (crest - deep)``.
+    whose z reaches ``deep + fraction (crest - deep)``. ``from_deepest``: ``deep`` the lowest z
+    of the whole scan and ``crest`` the highest after it (a scan that starts on something
+    higher than the rim, e.g. the nasal septum or the spine's base at the aperture's midline).
 
     Parameters
     ----------
@@ -117,6 +119,9 @@ def rim_edge(points, fraction=RIM_FRACTION):
     z = np.where(np.isfinite(points[:, 2]), points[:, 2], -np.inf)
     if not np.isfinite(z).any():
         return None
+    if from_deepest:
+        first = int(np.argmin(np.where(np.isfinite(z), z, np.inf)))
+        return rim_edge(points[first:], fraction)
     top = int(np.argmax(z))
     finite = z[: top + 1][np.isfinite(z[: top + 1])]
     deep = finite.min()
