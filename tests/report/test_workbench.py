@@ -282,3 +282,6 @@ def test_real_size_page_is_light_and_quick(sfo, tmp_path):
     _, vertices, faces = _embedded(path.read_text())
     box = np.array(_pre(dom, "skull-box").split(), float)
     assert box == pytest.approx(_projected_box(big.camera, vertices, faces), abs=BOX_TOLERANCE_PX)
+    # and the whole mesh's projection (the decimation keeps the silhouette within the tolerance)
+    full = _projected_box(big.camera, big_skull.vertices_mm, big_skull.faces)
+    assert box == pytest.approx(full, abs=BOX_TOLERANCE_PX)
