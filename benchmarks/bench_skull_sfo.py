@@ -47,9 +47,9 @@ def automatic_folder(subject_dir, work):
     return out
 
 
-def sfos(skull_dir, photos, case_dir, calibrations):
-    """Lilium on ``photos`` with ``skull_dir``: per photo (BPE, identification record), and the
-    decision over them all."""
+def sfos(skull_dir, photos, case_dir, calibrations, truth_dir):
+    """Lilium on ``photos`` with ``skull_dir``: per photo (BPE against the ground truth of the
+    subject folder ``truth_dir``, identification record), and the decision over them all."""
     request = CaseRequest(
         SkullSource(skull_dir, axes=Path(skull_dir) / "axes_C1.json"), case_dir,
         photos=tuple(PhotoSource(p) for p in photos), methods=("lilium",),
@@ -59,7 +59,7 @@ def sfos(skull_dir, photos, case_dir, calibrations):
     for entry, photo in zip(entries, photos, strict=True):
         folder = Path(case_dir) / entry.photo.id / "lilium-skof+pll"
         ok = entry.result.camera is not None
-        bpe = ground_truth_bpe(folder / "result.json", skull_dir, photo) if ok else np.nan
+        bpe = ground_truth_bpe(folder / "result.json", truth_dir, photo) if ok else np.nan
         rows.append((bpe, entry.result.extra["identification"]))
     pair = None
     if len(entries) > 1:
@@ -99,8 +99,12 @@ def main():
     ratios, identifications = [], []
     for name, subject_dir, photos in skulls:
         auto_dir = automatic_folder(subject_dir, work)
-        hand, hand_pair = sfos(subject_dir, photos, work / "cases" / f"{name}-hand", calibrations)
-        auto, auto_pair = sfos(auto_dir, photos, work / "cases" / f"{name}-auto", calibrations)
+        cases = work / "cases"
+        hand, hand_pair = sfos(subject_dir, photos, cases / f"{name}-hand", calibrations,
+                               subject_dir)
+        # The mesh of the automatic folder is the hand folder's, in its frame: one truth.
+        auto, auto_pair = sfos(auto_dir, photos, cases / f"{name}-auto", calibrations,
+                               subject_dir)
         bh, ba = np.array([r[0] for r in hand]), np.array([r[0] for r in auto])
         ratio = np.nanmean(ba) / np.nanmean(bh)
         ratios.append(ratio)
