@@ -185,7 +185,8 @@ def test_case_places_the_landmarks_of_a_bare_mesh(skull, case, tmp_path, capsys)
     assert (out / "prepared-skull" / "review.html").is_file()
     result = read_json(out / case[1].name / "posest-sfo" / "result.json")
     assert result["subject"] == "bare"
-    assert "unreviewed_landmarks" in result["identification"]["caps"]
+    assert "unreviewed_skull_landmarks" in result["identification"]["caps"]
+    assert result["identification"]["conclusion"] == "undetermined"
     assert main(argv) == 0
     assert "landmarks read back from" in capsys.readouterr().out
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from ..inputs import correspondences
 from ..methods.prior_checks import perspective_conflict, prior_conflicts
 from .calibration import VIEWS_LOG10_LR
-from .conclusion import EXAMINER_CAMERA, conclude, material_caps
+from .conclusion import EXAMINER_CAMERA, UNREVIEWED_SKULL, conclude, material_caps
 from .score import identification_terms, nll_score, skull_beyond_head, worst_landmark_of
 
 #: Cranial landmarks on the mandible: a skull with none of them has no mandible.
@@ -203,16 +203,16 @@ def _caps(skull, photos):
         f for photo in photos for f in photo.landmarks_uv
         if photo.landmark_sources.get(f, "manual") != "manual"
     ]
-    used += [
-        c for c, s in skull.landmark_sources.items()
-        if s != "manual" and c in skull.landmarks_mm
-    ]
-    return material_caps(
+    caps = material_caps(
         has_mandible=any(n in skull.landmarks_mm for n in MANDIBLE_LANDMARKS),
         photos=len(photos),
         unreviewed_automatic=bool(used),
         pairs=min(pairs),
     )
+    automatic = [c for c, s in skull.landmark_sources.items() if s != "manual"]
+    if any(c in skull.landmarks_mm for c in automatic):
+        caps = {"unreviewed_skull_landmarks": UNREVIEWED_SKULL} | caps
+    return caps
 
 
 def identify(skull, photos, results, calibrations, cohort, facial_landmarks_mm=None, joint=False):
