@@ -27,7 +27,6 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMB
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
-import copy  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -45,22 +44,11 @@ SPEED_FACES = 600_000
 
 
 def generated_skull(seed, index, mandible):
-    """Skull mesh and true landmarks of generated subject ``index`` of dataset ``seed`` (as
-    :func:`lilium.synthetic.subjects.make_subject` builds it, without the face)."""
-    from lilium.synthetic.anatomy.bone import build_bone
-    from lilium.synthetic.anatomy.shape import draw_shape
-    from lilium.synthetic.subjects import MANDIBLE_LANDMARKS, SKULL_FACES, _mesh, _skull
+    """Skull mesh and true landmarks of generated subject ``index`` of dataset ``seed``
+    (:func:`lilium.synthetic.subjects.make_skull`)."""
+    from lilium.synthetic.subjects import make_skull
 
-    child = np.random.SeedSequence(seed).spawn(index + 1)[index]
-    rng = np.random.default_rng(child)
-    shape = draw_shape(rng)
-    vault_rng = copy.deepcopy(rng)
-    _, _, v, f, cranial, _ = _skull(shape, rng)
-    if not mandible:
-        bone, _ = build_bone(shape, vault_rng, mandible=False)
-        v, f = _mesh(bone, SKULL_FACES)
-        cranial = {n: p for n, p in cranial.items() if n not in MANDIBLE_LANDMARKS}
-    return v, f, cranial
+    return make_skull(np.random.SeedSequence(seed).spawn(index + 1)[index], mandible)
 
 
 def real_skulls(work):

@@ -1,13 +1,12 @@
 """``lilium skull`` (:mod:`lilium.skull`): automatic cranial landmarks on generated skulls with
 known landmarks, the pose invariance, the mandible's detection and the refused meshes."""
 
-import copy
 
 import numpy as np
 import pytest
 
 from lilium.skull import locate_skull_landmarks
-from lilium.synthetic.subjects import MANDIBLE_LANDMARKS
+from lilium.synthetic.subjects import MANDIBLE_LANDMARKS, make_skull
 
 #: Located landmarks of a generated skull: median distance to the truth (mm); the
 #: rules are the generator's, so these hold well below the issue's 2 / 4 mm.
@@ -18,20 +17,8 @@ EXACT_MM = 2.0
 
 
 def _skull(seed, mandible):
-    """A generated skull (mesh, true landmarks), as make_subject builds it, without the face."""
-    from lilium.synthetic.anatomy.bone import build_bone
-    from lilium.synthetic.anatomy.shape import draw_shape
-    from lilium.synthetic.subjects import SKULL_FACES, _mesh, _skull
-
-    rng = np.random.default_rng(seed)
-    shape = draw_shape(rng)
-    vault_rng = copy.deepcopy(rng)
-    _, _, v, f, cranial, _ = _skull(shape, rng)
-    if not mandible:
-        bone, _ = build_bone(shape, vault_rng, mandible=False)
-        v, f = _mesh(bone, SKULL_FACES)
-        cranial = {n: p for n, p in cranial.items() if n not in MANDIBLE_LANDMARKS}
-    return v, f, cranial
+    """A generated skull (mesh, true landmarks), without the face."""
+    return make_skull(seed, mandible)
 
 
 @pytest.fixture(scope="module")

@@ -56,6 +56,7 @@ __all__ = [
     "SyntheticSubject",
     "distance_to_mesh",
     "draw_shape",
+    "make_skull",
     "make_subject",
     "make_subjects",
     "write_subject",
@@ -213,6 +214,36 @@ def _face(bone, design, shape, cranial, normals, rng):
     if missing:
         raise RuntimeError(f"synthetic face: could not place {missing}")
     return skin_v, skin_f, facial, depths, directions
+
+
+def make_skull(rng=None, mandible=True):
+    """A generated skull alone (no face): the skull of a :func:`make_subject` drawn from the
+    same kind of generator, quicker, for tests and benchmarks of skull-only tools
+    (``lilium skull``).
+
+    Parameters
+    ----------
+    rng : anything :func:`numpy.random.default_rng` accepts
+    mandible : bool
+        False: the same skull without its mandible (the same vault), and none of its landmarks.
+
+    Returns
+    -------
+    vertices : ndarray of shape (V, 3)
+        mm, skull frame.
+    faces : ndarray of shape (F, 3), int
+    cranial_landmarks : dict of str -> ndarray of shape (3,)
+        The true landmarks (skull frame).
+    """
+    rng = np.random.default_rng(rng)
+    shape = draw_shape(rng)
+    vault_rng = copy.deepcopy(rng)
+    _, _, vertices, faces, cranial, _ = _skull(shape, rng)
+    if not mandible:
+        bone, _ = build_bone(shape, vault_rng, mandible=False)
+        vertices, faces = _mesh(bone, SKULL_FACES)
+        cranial = {n: p for n, p in cranial.items() if n not in MANDIBLE_LANDMARKS}
+    return vertices, faces, cranial
 
 
 def make_subject(subject_id, rng=None, mandible=True):
