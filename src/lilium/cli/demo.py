@@ -48,7 +48,10 @@ def run(args):
                 bpe = ground_truth_bpe(result, subject_dir, photo)
                 print(f"  {photo.name:<10} {tag:<18} {bpe:6.2f}")
     print(f"\n  report:  {out / 'case' / 'report.html'}  (open it in a browser)")
-    print(f"  results: {out / 'case'}/<photo>/<method>[-<variant>]/result.json, overlay.png")
+    print(
+        f"  results: {out / 'case'}/<photo>/<method>[-<variant>]/result.json, overlay.png, "
+        "workbench.html (turn the skull yourself, save camera.json, score it with --camera)"
+    )
     print(f"  data:    {out / 'data'}")
     print(f"  total {time.perf_counter() - start:.0f} s")
     return code
