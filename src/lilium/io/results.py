@@ -49,6 +49,32 @@ def write_png(path, image, bilevel=False):
         raise
 
 
+def write_page(path, text):
+    """Write an HTML page (UTF-8) atomically: to a temporary file in the same folder, then
+    renamed over ``path``.
+
+    Text that is not UTF-8 (a file name's bytes held by Python as lone surrogates) is written
+    with U+FFFD in place of its bad bytes; the page is written all the same.
+
+    Raises
+    ------
+    OSError
+        Naming ``path`` (a full disk, a file-size limit, no write permission, ...).
+    """
+    data = text.encode("utf-8", "surrogateescape").decode("utf-8", "replace").encode()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:
+        with naming_errors(path):
+            _write_bytes(tmp, data)
+            os.replace(tmp, path)
+    except OSError:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path
+
+
 def _write_bytes(path, data):
     with open(path, "wb") as file:
         file.write(data)

@@ -24,6 +24,7 @@ from ..constants import MIN_PHOTO_SIDE_PX
 from ..io.case import read_image
 from ..io.formats import read_landmarks
 from ..io.jsonio import write_json
+from ..io.results import write_page
 from .analysis import analyse_face, find_faces, upright_turns
 from .folder import PREPARED_BY, check_image_path, check_photo_not_output, claim_folder
 from .headpose import implausible_distance, iris_distance_mm
@@ -339,6 +340,6 @@ def prepare_photo(
         message,
         faces=meta["faces"],
     )
-    (out / "review.html").write_text(page, encoding="utf-8")
+    write_page(out / "review.html", page)
     found = bool(analysis) or bool(profile)
     return PreparedPhoto(out, found, message, view, n_tracked, n_template, tuple(warnings))

@@ -35,11 +35,11 @@ import functools
 import html
 import urllib.parse
 from importlib import resources
-from pathlib import Path
 from string import Template
 
 import numpy as np
 
+from ..io.results import write_page
 from .conclusion_html import conclusion_section
 from .records import ReportEntry, report_record
 from .svg import curve_svg, marks_svg, skull_view_defs, skull_view_svg
@@ -558,13 +558,10 @@ def write_report(path, entries, **kwargs):
     """Write :func:`build_report` to ``path`` (UTF-8); returns the path.
 
     A file name that is not UTF-8 (held by Python as lone surrogates) is shown with U+FFFD in
-    place of its bad bytes; the report is written all the same.
+    place of its bad bytes; the report is written all the same
+    (:func:`~lilium.io.results.write_page`).
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    text = build_report(entries, **kwargs)
-    path.write_bytes(text.encode("utf-8", "surrogateescape").decode("utf-8", "replace").encode())
-    return path
+    return write_page(path, build_report(entries, **kwargs))
 
 
 __all__ = [

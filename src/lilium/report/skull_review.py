@@ -31,11 +31,11 @@ in sight (``<pre id="visible">``) and presses Save, which then fills the downloa
 """
 
 import html
-from pathlib import Path
 
 import numpy as np
 
 from ..geometry.mesh import decimate
+from ..io.results import write_page
 from ..photo.review import script_json
 from .web_pages import base64_array, web_page
 from .workbench import DEFAULT_MAX_FACES, skull_centre
@@ -167,8 +167,4 @@ def write_skull_review(path, vertices_mm, faces, landmarks_mm, sources, **kwargs
 
     Keywords go to :func:`skull_review_page`. Returns the path.
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    page = skull_review_page(vertices_mm, faces, landmarks_mm, sources, **kwargs)
-    path.write_text(page, encoding="utf-8")
-    return path
+    return write_page(path, skull_review_page(vertices_mm, faces, landmarks_mm, sources, **kwargs))

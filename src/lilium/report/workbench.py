@@ -25,7 +25,6 @@ download link (for the headless-browser tests).
 import base64
 import html
 import io
-from pathlib import Path
 
 import numpy as np
 
@@ -33,6 +32,7 @@ from ..fitness.regions import AnatomicalFrame, anatomical_frame
 from ..geometry.camera import Camera
 from ..geometry.mesh import decimate
 from ..geometry.rotations import rotvec_to_matrix
+from ..io.results import write_page
 from ..photo.review import script_json
 from ..softtissue.landmarks import CORRESPONDENCES
 from .html import DEFAULT_OPACITY_PCT
@@ -258,7 +258,4 @@ def write_workbench(path, skull, photo, result, **kwargs):
 
     Keywords go to :func:`workbench_page`. Returns the path.
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(workbench_page(skull, photo, result, **kwargs), encoding="utf-8")
-    return path
+    return write_page(path, workbench_page(skull, photo, result, **kwargs))
