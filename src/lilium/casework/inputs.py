@@ -59,7 +59,8 @@ def load_skull(source, log=None, out=None):
     A mesh without a landmark file (none given, none beside it) gets its cranial landmarks
     placed automatically (``lilium skull``, :func:`~lilium.skull.prepare.prepared_skull`) into
     ``out/prepared-skull/`` (reused while the mesh is unchanged), with its ``review.html``;
-    they are automatic and unreviewed, which caps every conclusion (docs/method/skull.md).
+    they are automatic and unreviewed, which leaves every conclusion undetermined until they are
+    reviewed (``unreviewed_skull_landmarks``, docs/method/skull.md).
 
     Parameters
     ----------

@@ -71,8 +71,7 @@ def register(subparsers):
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_options(p, "skull", "landmarks", "axes", "photo", "auto_landmarks", *PHOTO_FILES, "camera",
-                "out",
-                *SFO, *PRIORS, "depth_table", required=("skull", "photo", "out"),
+                "out", *SFO, *PRIORS, "depth_table", required=("skull", "photo", "out"),
                 shown={"method": "lilium"})
     p.add_argument(
         "--joint",
