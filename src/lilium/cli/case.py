@@ -7,14 +7,16 @@ Inputs are docs/contract.md folders or the files a practitioner already has::
     lilium case --skull skull.stl --landmarks skull.mrk.json \\
         --photo front.jpg --photo-landmarks front.csv [--mask front_mask.png] \\
         [--face-curve front_face_curve.json] --out DIR
+    lilium case --skull skull.ply --photo PHOTO_DIR --camera PHOTO_DIR=camera.json --out DIR
 
 Sidecar files stand in for an option that is not given, and each one found is printed
 (:data:`EPILOG`). Priors: ``--focal-px``/``--scd-mm`` override ``photo.json``; without either,
 the focal prior comes from the photo's EXIF when it has one.
 
 Writes ``DIR/report.html`` and, per photo and method, ``DIR/<photo>/<method>[-<variant>]/``
-with ``result.json`` and ``overlay.png`` (:func:`lilium.methods.method_tag`), whatever the
-number of methods.
+with ``result.json``, ``overlay.png`` and ``workbench.html`` (:func:`lilium.methods.method_tag`),
+whatever the number of methods; a mesh without landmarks gets them placed into
+``DIR/prepared-skull/``; a ``--camera`` is scored into ``.../examiner/``.
 """
 
 import argparse
@@ -49,13 +51,21 @@ automatic landmarks (lilium photo, docs/method/photo.md): a folder written by li
   image itself into OUT/<photo>/prepared/ (nothing is written beside the image); the report
   says the landmarks are automatic and unreviewed and links the review page (docs/method/photo.md).
 
+skull without landmarks (a mesh, none given, none beside it): lilium skull places them into
+  OUT/prepared-skull/ with its review.html (docs/method/skull.md); until they are reviewed
+  (--landmarks with the file review.html saves) every conclusion stays undetermined.
+
+examiner's camera (--camera PHOTO=FILE, workbench.html's Save or a result.json): scored
+  without search beside the photo's SFOs, in DIR/<photo>/<method>/examiner/, labelled in the
+  report; its LR is for comparison only (docs/method/workbench.md).
+
 facial curve (face_curve.json format): {"chin_jaw": [[u, v], ...]} for a frontal photo,
   {"forehead": [[u, v], ...]} for a lateral one (pixels); without one, the pll variants
   derive it from the face mask.
 
 outputs: DIR/report.html, and one folder per photo and method whatever their number,
-  DIR/<photo>/<method>[-<variant>]/result.json and overlay.png, e.g. DIR/front/posest-sfo/
-  and DIR/front/lilium-skof+pll/.
+  DIR/<photo>/<method>[-<variant>]/result.json, overlay.png and workbench.html, e.g.
+  DIR/front/posest-sfo/ and DIR/front/lilium-skof+pll/.
 """
 
 

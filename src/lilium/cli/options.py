@@ -30,7 +30,9 @@ _DE = DEOptions()
 #: Option name -> (flags, ``add_argument`` keywords). ``help`` may hold ``{default}``.
 OPTIONS = {
     "skull": (("--skull",), dict(
-        type=Path, help="subject folder or skull mesh (PLY/OBJ/STL, mm; with --landmarks)"
+        type=Path,
+        help="subject folder or skull mesh (PLY/OBJ/STL, mm; its landmarks with --landmarks or "
+        "beside it, else placed automatically into OUT/prepared-skull/, unreviewed)",
     )),
     "landmarks": (("--landmarks",), dict(
         type=Path,
