@@ -1,5 +1,5 @@
-"""SPEC section 10's rules over a whole generated dataset (``check_rules.py``): no generated
-case trips a rule, neither its true camera nor POSEST-SFO's."""
+"""The consistency rules (docs/checks.md) over a whole generated dataset (``check_rules.py``):
+no generated case trips a rule, neither its true camera nor POSEST-SFO's."""
 
 import pytest
 from check_rules import main

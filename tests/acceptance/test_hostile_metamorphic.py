@@ -25,8 +25,7 @@ KNOWN_LIMITS = {
     ),
     "metamorphic s01 frontal resampled x2.0": (
         "known limit: POSEST-SFO at the 10,000 px focal cap on a photo at twice the size "
-        "(docs/method.md, 'POSEST-SFO and the 10,000 px cap at high resolution'); kept as SPEC "
-        "states it"
+        "(docs/method/pose.md, the focal cap); kept as the method states it"
     ),
     "metamorphic s01 frontal resampled x0.5, lilium": (
         _ON_MAIN + "focal 3742 -> 3605 px (tol 0.0357); the resolution limit above"
