@@ -139,6 +139,19 @@ def test_command_writes_a_folder_lilium_sfo_reads(skull, tmp_path, capsys):
     }
 
 
+def test_command_never_writes_over_its_input(skull, tmp_path, capsys):
+    from lilium.cli.main import main
+    from lilium.io.mesh import write_mesh
+
+    v, f, _, _ = skull
+    write_mesh(tmp_path / "skull.ply", v, f)
+    before = (tmp_path / "skull.ply").read_bytes()
+    assert main(["skull", str(tmp_path / "skull.ply"), "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "over the input mesh" in err[0]
+    assert (tmp_path / "skull.ply").read_bytes() == before
+
+
 def test_command_error_is_one_line(tmp_path, capsys):
     import trimesh
 

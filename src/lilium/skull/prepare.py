@@ -122,6 +122,11 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
     from ..io.provenance import sha256_of
 
     mesh_path, out = Path(mesh_path), Path(out)
+    if (out / "skull.ply").resolve() == mesh_path.resolve():
+        raise ValueError(
+            f"{mesh_path}: --out {out} would write skull.ply over the input mesh; give another "
+            "output folder"
+        )
     vertices, faces = compact(*clean_mesh(*parse_mesh(mesh_path), source=str(mesh_path)))
     keep = _reviewed(landmarks_path) if landmarks_path is not None else None
     result = locate_skull_landmarks(vertices, faces, keep=keep, rng=rng, source=str(mesh_path))
