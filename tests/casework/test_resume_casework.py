@@ -184,7 +184,8 @@ def test_a_lineup_resumed_without_a_whole_overlay_runs_the_sfo_again(case, tmp_p
     assert png_readable(overlay)
 
 
-def test_a_file_size_limit_names_the_overlay(case, tmp_path, capsys, monkeypatch):
+def test_a_file_size_limit_names_the_file(case, tmp_path, capsys, monkeypatch):
+    """The first file an SFO writes (its workbench page, then its overlay) names the limit."""
     from lilium.io import results
 
     def full(path, data):
@@ -193,7 +194,7 @@ def test_a_file_size_limit_names_the_overlay(case, tmp_path, capsys, monkeypatch
     monkeypatch.setattr(results, "_write_bytes", full)
     monkeypatch.delenv("LILIUM_DEBUG")
     out = tmp_path / "out"
-    line = _one_line_error(capsys, _lineup(case, out), "overlay.png")
+    line = _one_line_error(capsys, _lineup(case, out), "workbench.html")
     assert str(_stored(out, case).parent) in line
     assert not _stored(out, case).exists()
 
