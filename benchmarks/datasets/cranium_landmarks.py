@@ -114,15 +114,14 @@ lies 6-7 mm lateral of and 15-17 mm in front of this narrow bony aperture, beyon
 
 import numpy as np
 
-from headsq_landmarks import _deep_regions, _height_map, _over, _pixel_vertex
+from frontal_maps import (
+    _alare,
+    _aperture,
+    _Map,
+    _orbit_landmarks,
+    _over,
+)
 
-RIM_FRACTION = 0.75
-ALARE_FRACTION = 0.9
-ORBIT_SCAN_MM = 30.0
-ECTOCONCHION_SCAN_MM = 40.0
-CREST_PLATEAU_MM = 0.5
-DACRYON_BEHIND_MM = 4.0
-ALARE_SCAN_MM = 25.0
 ENAMEL_HU = 1900.0
 ENAMEL_PROBE_MM = (1.0, 2.0, 3.0)
 METOPION_ABOVE_GLABELLA_MM = 36.0
@@ -166,58 +165,6 @@ def sanity_figures(cranial):
     return out
 
 
-def rim_edge(heights, fraction=RIM_FRACTION):
-    """Index of the rim edge of a scan line (see the module notes), or None."""
-    z = np.where(np.isfinite(heights), heights, -np.inf)
-    if not np.isfinite(z).any():
-        return None
-    top = int(np.argmax(z))
-    deep = np.min(z[: top + 1][np.isfinite(z[: top + 1])])
-    reached = z[: top + 1] >= deep + fraction * (z[top] - deep)
-    return int(np.argmax(reached))
-
-
-class _Map:
-    """The frontal height map of a mesh (with its deep regions when ``regions``) and its
-    pixel <-> frame conversions (1 mm pixels; u to +x, v to -y)."""
-
-    def __init__(self, skull, faces, regions=True):
-        self.skull, self.faces = skull, faces
-        self.height, self.index, self.xy = _height_map(skull, faces)
-        if regions:
-            self.labels, self.n = _deep_regions(self.height)
-        self.x0 = self.xy(0, 0)[0]
-        self.y0 = self.xy(0, 0)[1]
-
-    def u_of(self, x):
-        return int(round(x - self.x0))
-
-    def v_of(self, y):
-        return int(round(self.y0 - y))
-
-    def scan(self, u, v, du, dv, length_mm):
-        """Pixels (u, v) and heights of a scan line from (u, v) in steps (du, dv)."""
-        H, W = self.height.shape
-        steps = np.arange(int(length_mm) + 1)
-        us, vs = u + du * steps, v + dv * steps
-        ok = (us >= 0) & (us < W) & (vs >= 0) & (vs < H)
-        us, vs = us[ok], vs[ok]
-        return us, vs, self.height[vs, us]
-
-    def vertex(self, u, v):
-        return _pixel_vertex(self.skull, self.faces, self.index, self.xy, int(u), int(v))
-
-    def profile(self, x):
-        """The midline profile at ``x``: the vertex of every row's pixel, top-down (K, 3)."""
-        u = self.u_of(x)
-        rows = np.flatnonzero(np.isfinite(self.height[:, u]))
-        return np.array([self.vertex(u, v) for v in rows])
-
-    def region(self, lab):
-        v, u = np.nonzero(self.labels == lab)
-        return u, v
-
-
 def _orbits(m):
     """The two orbits' regions (u, v) and the midline x (see the module notes)."""
     centre = 0.5 * (m.skull.min(axis=0) + m.skull.max(axis=0))
@@ -233,79 +180,6 @@ def _orbits(m):
         orbits[side] = (u, v)
     x_mid = float(np.mean([m.xy(u.mean(), 0)[0] for u, _ in orbits.values()]))
     return orbits, x_mid
-
-
-def _orbit_landmarks(m, orbits, x_mid):
-    """Ectoconchion, dacryon, orbitale of both sides; the superior margins' mean y and the
-    transverse axis' mean y."""
-    cranial, tops, axes = {}, [], []
-    u_mid = m.u_of(x_mid)
-    for side, sign in (("l", 1.0), ("r", -1.0)):
-        u, v = orbits[side]
-        uc, vc = int(round(u.mean())), int(round(v.mean()))
-        us, vs, h = m.scan(uc, vc, 0, -1, ORBIT_SCAN_MM)
-        v_top = vs[rim_edge(h)]
-        us, vs, h = m.scan(uc, vc, 0, 1, ORBIT_SCAN_MM)
-        v_bottom = vs[rim_edge(h)]
-        v_ax = int(round(0.5 * (v_top + v_bottom)))
-        tops.append(m.xy(0, v_top)[1])
-        axes.append(m.xy(0, v_ax)[1])
-        step = 1 if sign > 0 else -1  # +u is +x (the subject's left)
-        us, vs, h = m.scan(uc, v_ax, step, 0, ECTOCONCHION_SCAN_MM)
-        z = np.where(np.isfinite(h), h, -np.inf)
-        crest = int(np.flatnonzero(z >= z.max() - CREST_PLATEAU_MM)[0])
-        cranial[f"ectoconchion_{side}"] = m.vertex(us[crest], v_ax)
-        us, vs, h = m.scan(uc, v_ax, -step, 0, abs(uc - u_mid))
-        k = rim_edge(h)
-        margin = m.vertex(us[k], v_ax)
-        target = margin - np.array([0.0, 0.0, DACRYON_BEHIND_MM])
-        near = np.argmin(np.linalg.norm(m.skull - target, axis=1))
-        cranial[f"dacryon_{side}"] = m.skull[near].copy()
-        lo, hi = np.percentile(u, [25, 75])
-        best = None
-        for col in range(int(lo), int(hi) + 1):
-            rows = v[u == col]
-            if len(rows) == 0:
-                continue
-            us, vs, h = m.scan(col, int(rows.mean()), 0, 1, ORBIT_SCAN_MM)
-            k = rim_edge(h)
-            if k is not None and (best is None or vs[k] > best[1]):
-                best = (col, vs[k])
-        cranial[f"orbitale_{side}"] = m.vertex(*best)
-    return cranial, float(np.mean(tops)), float(np.mean(axes))
-
-
-def _aperture(m, x_mid, axis_y):
-    """The nasal aperture's region (u, v): the deep region on the midline column nearest below
-    the orbits' transverse axis."""
-    u_mid = m.u_of(x_mid)
-    best = None
-    for lab in range(1, m.n + 1):
-        u, v = m.region(lab)
-        if (u == u_mid).any() and m.xy(0, v.mean())[1] < axis_y:
-            if best is None or v.mean() < best[1].mean():
-                best = (u, v)
-    return best
-
-
-def _alare(m, aperture, x_mid):
-    """The cranial alare of both sides (see the module notes)."""
-    u, v = aperture
-    u_mid = m.u_of(x_mid)
-    out = {}
-    for side, sign in (("l", 1.0), ("r", -1.0)):
-        step = 1 if sign > 0 else -1
-        edges = []
-        for row in np.unique(v):
-            us, _, h = m.scan(u_mid, row, step, 0, ALARE_SCAN_MM)
-            k = rim_edge(h, ALARE_FRACTION)
-            if k is not None:
-                edges.append((abs(int(us[k]) - u_mid), int(us[k]), int(row)))
-        widest = max(e[0] for e in edges)
-        rows = [e for e in edges if e[0] == widest]
-        _, col, row = rows[len(rows) // 2]  # the middle of a vertical stretch of the margin
-        out[f"alare_{side}"] = m.vertex(col, row)
-    return out
 
 
 def _midline(m, x_mid, top_y, axis_y, aperture, hu_at):

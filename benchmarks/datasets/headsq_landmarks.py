@@ -93,9 +93,14 @@ midline ones are unchanged.
 
 import numpy as np
 
-HEIGHT_MAP_PX_MM = 1.0
-CLOSING_RADIUS_MM = 20.0
-DEEP_MM = 8.0
+from frontal_maps import (
+    _alare,
+    _aperture,
+    _Map,
+    _orbit_landmarks,
+    _over,
+)
+
 #: Orbit candidates: deep regions whose centroid lies this far off the bounding box's centre.
 ORBIT_OFF_MIDLINE_MM = 12.0
 #: Gonion: the hull edges of the ramus' posterior border have an outward normal within
@@ -108,56 +113,6 @@ GONION_NEAR_MM = 3.0
 CANTHUS_RAY_MM = 60.0
 
 
-def _height_map(vertices, faces):
-    """Frontal height map of a mesh: (z per pixel or NaN, triangle per pixel, pixel -> x, y)."""
-    from lilium.geometry.camera import Camera
-    from lilium.synthetic import photos, render
-
-    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
-    centre = 0.5 * (lo + hi)
-    size = np.ceil((hi[:2] - lo[:2]) / HEIGHT_MAP_PX_MM).astype(int) + 21
-    distance = 1e6
-    focal = distance / HEIGHT_MAP_PX_MM
-    R = photos.R_FRONTAL
-    t = np.array([0.0, 0.0, distance]) - R @ centre
-    pp = 0.5 * (size - 1)
-    camera = Camera.from_rt(R, t, focal, pp)
-    faces_index = render.render_mesh(vertices, faces, camera, tuple(int(s) for s in size))
-    index = faces_index.face_index
-    z_tri = vertices[faces].mean(axis=1)[:, 2]
-    height = np.where(index >= 0, z_tri[np.maximum(index, 0)], np.nan)
-
-    def xy(u, v):
-        return np.array(
-            [centre[0] + (u - pp[0]) * HEIGHT_MAP_PX_MM, centre[1] - (v - pp[1]) * HEIGHT_MAP_PX_MM]
-        )
-
-    return height, index, xy
-
-
-def _pixel_vertex(vertices, faces, index, xy, u, v):
-    """The vertex of the triangle at pixel (u, v) nearest to it in x, y."""
-    tri = faces[index[v, u]]
-    d = np.linalg.norm(vertices[tri, :2] - xy(u, v), axis=1)
-    return vertices[tri[int(np.argmin(d))]].copy()
-
-
-def _deep_regions(height):
-    import cv2
-    from scipy import ndimage as ndi
-
-    inside = np.isfinite(height)
-    floor = np.nanmin(height) - 1.0
-    h = np.where(inside, height, floor).astype(np.float32)
-    r = int(round(CLOSING_RADIUS_MM / HEIGHT_MAP_PX_MM))
-    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
-    closed = cv2.morphologyEx(h, cv2.MORPH_CLOSE, kernel)
-    hull = cv2.morphologyEx(inside.astype(np.uint8), cv2.MORPH_CLOSE, kernel).astype(bool)
-    deep = hull & ((closed - h) > DEEP_MM)
-    labels, n = ndi.label(deep)
-    return labels, n
-
-
 def _profile(vertices, band_mm, bin_mm, x0=0.0):
     """Front-most vertex per height bin within ``band_mm`` of x = x0: (K, 3) sorted top-down."""
     near = vertices[np.abs(vertices[:, 0] - x0) < band_mm]
@@ -168,22 +123,6 @@ def _profile(vertices, band_mm, bin_mm, x0=0.0):
         out.append(sel[np.argmax(sel[:, 2])])
     out = np.array(out)
     return out[np.argsort(-out[:, 1])]
-
-
-def _over(skin, point, direction, radius_mm=2.0, max_t_mm=35.0, outermost=True):
-    """The outermost (or first) skin vertex within ``radius_mm`` of the ray
-    ``point + t direction``, ``0 < t < max_t_mm`` (outermost: the outer skin, not the airway
-    surfaces a ray from inside the face crosses first)."""
-    d = np.asarray(direction, float) / np.linalg.norm(direction)
-    rel = skin - point
-    t = rel @ d
-    perp = np.linalg.norm(rel - t[:, None] * d, axis=1)
-    for radius in radius_mm + np.arange(8.0):
-        ok = (t > 0) & (t < max_t_mm) & (perp < radius)
-        if ok.any():
-            k = np.flatnonzero(ok)
-            return skin[k[np.argmax(t[k]) if outermost else np.argmin(t[k])]].copy()
-    raise ValueError(f"no skin over {point} along {d}")
 
 
 def _orbit_regions(m):
@@ -260,7 +199,6 @@ def place_landmarks(skull, skull_faces, skin, skin_faces, mandible_mask):
     x_mid : float
         The midline's x (between the orbits).
     """
-    from cranium_landmarks import _alare, _aperture, _Map, _orbit_landmarks
     from lilium.softtissue.normals import landmark_normals
 
     m = _Map(skull, skull_faces)
