@@ -166,3 +166,23 @@ def test_case_scores_the_examiner_camera_beside_the_search(case, tmp_path, capsy
         capsys, [*argv[:-2], "--camera", f"nophoto={camera}", "--out", tmp_path / "o2"],
         "--camera", "nophoto",
     )
+
+
+def test_case_scores_a_workbench_camera_with_its_soft_tissue(case, tmp_path, capsys):
+    """A camera saved by the workbench carries the search's soft tissue: Lilium scores it as
+    given (the search's own figures compare, so no re-scored search line)."""
+    subject_dir, photo_dir = case
+    out = tmp_path / "out"
+    argv = ["case", "--skull", subject_dir, "--photo", photo_dir, "--method", "lilium",
+            "--generations", "30", "--population", "12", "--out", out]
+    assert _run(argv, capsys)[0] == 0
+    folder = out / photo_dir.name / "lilium-skof+pll"
+    searched = json.loads((folder / "result.json").read_text())
+    saved = {**searched["camera"], "facial_landmarks_3d": searched["facial_landmarks_3d"]}
+    camera = tmp_path / "camera.json"
+    camera.write_text(json.dumps(saved))
+    assert _run([*argv, "--camera", f"{photo_dir.name}={camera}"], capsys)[0] == 0
+    examiner = json.loads((folder / "examiner" / "result.json").read_text())
+    assert examiner["soft_tissue"] == "given" and examiner["camera_source"] == "examiner"
+    assert examiner["fitness"] == pytest.approx(searched["fitness"], rel=1e-9)
+    assert "scored the same way" not in (out / "report.html").read_text()
