@@ -37,16 +37,7 @@ def write_png(path, image, bilevel=False):
     encoded, data = cv2.imencode(".png", image, params)
     if not encoded:
         raise ValueError(f"{path}: an image of shape {image.shape} cannot be written as PNG")
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    try:
-        with naming_errors(path):
-            _write_bytes(tmp, data)
-            os.replace(tmp, path)
-    except OSError:
-        tmp.unlink(missing_ok=True)
-        raise
+    _write_atomic(path, data)
 
 
 def write_page(path, text):
@@ -62,6 +53,12 @@ def write_page(path, text):
         Naming ``path`` (a full disk, a file-size limit, no write permission, ...).
     """
     data = text.encode("utf-8", "surrogateescape").decode("utf-8", "replace").encode()
+    return _write_atomic(path, data)
+
+
+def _write_atomic(path, data):
+    """Write ``data`` (bytes) to a temporary file beside ``path``, then rename it over
+    ``path``; an ``OSError`` names ``path`` and leaves no temporary file. Returns the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp")
