@@ -251,16 +251,14 @@ def apply_rules(vertices, faces, on_mandible, estimates, anchors):
             )
             if (box & cranium).any():
                 out[name] = _plateau(vertices[box & cranium], np.array([sx, 0.0, 0.0]))
-        name = "gonion" + sfx
-        if name in est:
-            d = np.array(GONION_DIRECTION) * (sx, 1, 1)
-            p = _support(vertices, on_mandible, est[name], GONION_MM, d)
-            if p is not None:
-                out[name] = p
-        name = "frontotemporale" + sfx
-        if name in est:
-            d = np.array(FRONTOTEMPORALE_DIRECTION) * (sx, 1, 1)
-            p = _support(vertices, cranium, est[name], FRONTOTEMPORALE_MM, d)
-            if p is not None:
-                out[name] = p
+        extremes = (
+            ("gonion", on_mandible, GONION_MM, GONION_DIRECTION),
+            ("frontotemporale", cranium, FRONTOTEMPORALE_MM, FRONTOTEMPORALE_DIRECTION),
+        )
+        for base, part, spans_mm, direction in extremes:
+            if base + sfx in est:
+                d = np.array(direction) * (sx, 1, 1)
+                p = _support(vertices, part, est[base + sfx], spans_mm, d)
+                if p is not None:
+                    out[base + sfx] = p
     return {k: np.asarray(v, float) for k, v in out.items() if np.all(np.isfinite(v))}
