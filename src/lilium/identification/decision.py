@@ -209,8 +209,7 @@ def _caps(skull, photos):
         unreviewed_automatic=bool(used),
         pairs=min(pairs),
     )
-    automatic = [c for c, s in skull.landmark_sources.items() if s != "manual"]
-    if any(c in skull.landmarks_mm for c in automatic):
+    if any(source != "manual" for source in skull.landmark_sources.values()):
         caps = {"unreviewed_skull_landmarks": UNREVIEWED_SKULL} | caps
     return caps
 
