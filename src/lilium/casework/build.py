@@ -110,30 +110,44 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
             path_id(mesh_path.parent, "skull") if mesh_path.stem == "skull" else mesh_path.stem
         )
     skull_id = safe_id(skull_id, "skull")
-    vertices, faces = clean_mesh(*parse_mesh(mesh_path), source=str(mesh_path))
+    mesh = parse_mesh(mesh_path)
     landmarks, sources = cranial_landmark_file(lm_path)
-    vertices, faces, warnings = _skull_part(mesh_path, vertices, faces, landmarks)
-    extent = np.ptp(vertices, axis=0).max()
-    _check_on_mesh(lm_path, landmarks, vertices, faces, 0.1 * extent)
-    check_landmark_layout(lm_path, landmarks, extent * MIN_CRANIAL_EXTENT_FRACTION, "mm")
-    axes = {}
-    for name, a in parse_axes(axes_path).items():
-        norm = np.linalg.norm(a)
-        if norm == 0:
-            raise ValueError(f"{Path(axes_path)}: axes.{name} is the zero vector; give a direction")
-        axes[name] = a / norm
+    axes = parse_axes(axes_path)
+    vertices, faces, warnings = _skull_surface(mesh_path, mesh, landmarks)
     missing = [n for n in landmarks if n not in axes and n in CRANIAL_TO_FACIAL]
     if missing:
         axes.update(landmark_normals(vertices, faces, {n: landmarks[n] for n in missing}))
+    extent = np.ptp(vertices, axis=0).max()
+    _check_on_mesh(lm_path, landmarks, vertices, faces, 0.1 * extent)
+    check_landmark_layout(lm_path, landmarks, extent * MIN_CRANIAL_EXTENT_FRACTION, "mm")
     return Skull(
         skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings),
         landmark_sources=sources,
     )
 
 
-def _skull_part(mesh_path, vertices, faces, landmarks):
-    """The mesh without the parts apart from its cranial landmarks' part (:data:`PART_APART_MM`)
-    and without unreferenced vertices; and the warning that names what was left out."""
+def _skull_surface(mesh_path, mesh, landmarks):
+    """The skull's surface from a parsed mesh: cleaned (:func:`~lilium.geometry.mesh.clean_mesh`),
+    without the parts apart from its cranial landmarks' part (:data:`PART_APART_MM`) and without
+    unreferenced vertices; and the warning that names what was left out.
+
+    Parameters
+    ----------
+    mesh_path : Path
+        The mesh file, for the messages.
+    mesh : tuple
+        ``(vertices, faces, shared)`` as :func:`~lilium.io.mesh.parse_mesh` parsed it
+        (millimetres).
+    landmarks : dict of str -> ndarray of shape (3,), millimetres
+
+    Returns
+    -------
+    vertices : ndarray of shape (V', 3)
+    faces : ndarray of shape (F', 3)
+    warnings : list of CaseWarning
+        ``mesh_part_left_out`` when parts were left out.
+    """
+    vertices, faces = clean_mesh(*mesh, source=str(mesh_path))
     apart, parts = parts_apart(vertices, faces, np.array(list(landmarks.values())), PART_APART_MM)
     warnings = []
     if parts:

@@ -25,11 +25,11 @@ from ..io.case import (
 from ..io.curves import read_face_curve
 from ..io.formats import find_landmark_file
 from ..io.mesh import MESH_SUFFIXES
-from ..io.paths import safe_id
+from ..io.paths import path_id, safe_id
 from ..io.prepared import read_prepared
 from ..methods.photo_checks import check_distinct_photos, check_landmarks_in_mask
 from ..validation import check_prior, fmt_range
-from .build import photo_from_files, read_photo, read_skull, skull_from_files
+from .build import photo_from_files, read_photo, skull_from_files
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 from .request import PriorOverrides
 
@@ -75,6 +75,7 @@ def load_skull(source, log=None, out=None):
     Returns
     -------
     skull : Skull
+        Its ``landmarks_file`` named (for the left/right messages).
     inputs : dict of str -> Path
         The files used, labelled, for the provenance.
 
@@ -83,15 +84,51 @@ def load_skull(source, log=None, out=None):
     ValueError
         Also when ``source.axes`` is given but is not a file (it is never ignored).
     """
+    files = skull_files(source, log=log, out=out)
+    skull = skull_from_files(files.mesh, files.landmarks, files.axes, skull_id=files.skull_id)
+    return replace(skull, landmarks_file=str(files.landmarks)), files.inputs
+
+
+class SkullFiles(NamedTuple):
+    """The files a skull is built from (:func:`skull_files`).
+
+    Attributes
+    ----------
+    mesh, landmarks : Path
+        The mesh to read (millimetres) and its cranial landmark file.
+    axes : Path or None
+        The soft-tissue axes file (absent or None: the skull-surface normals).
+    skull_id : str or None
+        None: :func:`~lilium.casework.build.skull_from_files`'s default.
+    inputs : dict of str -> Path
+        The files used, labelled, for the provenance (``"skull mesh"`` is the mesh given).
+    """
+
+    mesh: Path
+    landmarks: Path
+    axes: Path | None
+    skull_id: str | None
+    inputs: dict
+
+
+def skull_files(source, log=None, out=None):
+    """The files of the skull ``source`` names (:func:`load_skull`), found beside it or, for a
+    mesh without landmarks, prepared in ``out/prepared-skull/`` (:func:`_automatic_skull`).
+
+    Returns
+    -------
+    SkullFiles
+    """
     landmarks, axes = source.landmarks, source.axes
     skull_path = Path(source.path)
     if axes is not None:
         check_axes_file(axes)
+    skull_id = None
     if skull_path.is_dir():
         mesh, found = subject_files(skull_path)
         landmarks = Path(landmarks) if landmarks is not None else found
-        skull = read_skull(skull_path, axes_path=axes, landmarks_path=landmarks)
         axes = Path(axes) if axes else skull_path / "soft_tissue_axes.json"
+        skull_id = path_id(skull_path, "skull")
     elif skull_path.is_file():
         mesh = skull_path
         if skull_path.suffix.lower() not in MESH_SUFFIXES:
@@ -111,20 +148,19 @@ def load_skull(source, log=None, out=None):
             if landmarks is None:
                 return _automatic_skull(skull_path, axes, Path(out) / SKULL_FOLDER, log)
             _found(log, skull_path.stem, "cranial landmarks", landmarks, "the mesh")
-        skull = skull_from_files(mesh, landmarks, axes)
     else:
         raise ValueError(
             f"{skull_path}: --skull not found; give a subject folder or a skull mesh file"
         )
-    inputs = {"skull mesh": mesh, "cranial landmarks": landmarks}
+    inputs = {"skull mesh": mesh, "cranial landmarks": Path(landmarks)}
     if axes is not None and Path(axes).is_file():
         inputs["soft-tissue axes"] = Path(axes)
-    return skull, inputs
+    return SkullFiles(mesh, Path(landmarks), axes, skull_id, inputs)
 
 
 def _automatic_skull(mesh, axes, folder, log):
-    """:func:`load_skull`'s skull of a mesh without landmarks: placed by ``lilium skull`` in
-    ``folder`` (or read back from there)."""
+    """:func:`skull_files` of a mesh without landmarks: its subject folder placed by ``lilium
+    skull`` in ``folder`` (or read back from there)."""
     from ..skull.prepare import prepared_skull
 
     folder, reused = prepared_skull(mesh, folder)
@@ -136,11 +172,10 @@ def _automatic_skull(mesh, axes, folder, log):
         )
     axes = Path(axes) if axes is not None else folder / "soft_tissue_axes.json"
     landmarks = folder / "cranial_landmarks.json"
-    skull = skull_from_files(folder / "skull.ply", landmarks, axes, skull_id=mesh.stem)
     inputs = {"skull mesh": mesh, "cranial landmarks": landmarks}
     if axes.is_file():
         inputs["soft-tissue axes"] = axes
-    return skull, inputs
+    return SkullFiles(folder / "skull.ply", landmarks, axes, mesh.stem, inputs)
 
 
 def _sibling(image_path, stems, suffixes):

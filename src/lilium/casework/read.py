@@ -76,7 +76,6 @@ def read_case(request, log=None, out=None):
         calibration file that cannot be read.
     """
     skull, skull_inputs = load_skull(request.skull, log=log, out=out or request.out)
-    skull = labelled_skull(skull, skull_inputs)
 
     def photos_of(sources, **kwargs):
         # A lilium photo folder's automatic head orientation is paired with this skull's frame.
@@ -115,9 +114,3 @@ def with_depth_table(options, path, photos):
         warning = CaseWarning("implausible_depth", message)
         photos = [replace(p, warnings=(*p.warnings, warning)) for p in photos]
     return replace(options, depth_table=table), list(photos)
-
-
-def labelled_skull(skull, inputs):
-    """The skull with its cranial landmark file named (for the left/right messages)."""
-    path = inputs.get("cranial landmarks")
-    return skull if path is None else replace(skull, landmarks_file=str(path))

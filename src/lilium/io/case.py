@@ -9,6 +9,8 @@ message names the file, the field and the fix.
 import csv
 from pathlib import Path
 
+import numpy as np
+
 from ..softtissue.depths import DepthStats, check_depth_table
 from .curves import read_face_curve
 from .formats import find_landmark_file, points_from_object, read_landmarks
@@ -144,13 +146,25 @@ def cranial_landmark_file(landmarks_path):
 
 
 def parse_axes(axes_path):
-    """The soft-tissue axes of ``soft_tissue_axes.json`` as given (not normalised): dict of
-    str -> ndarray (3,); empty when ``axes_path`` is None or not a file."""
+    """The soft-tissue axes of ``soft_tissue_axes.json``, made unit directions: dict of str ->
+    ndarray (3,); empty when ``axes_path`` is None or not a file.
+
+    Raises
+    ------
+    ValueError
+        Naming the file: a malformed file, or an axis that is the zero vector.
+    """
     axes_path = Path(axes_path) if axes_path else None
     if axes_path is None or not axes_path.is_file():
         return {}
     raw = required_field(axes_path, read_json(axes_path), "axes")
-    return points_from_object(axes_path, "axes", raw, "cranial", allow_empty=True)
+    axes = {}
+    for name, a in points_from_object(axes_path, "axes", raw, "cranial", allow_empty=True).items():
+        norm = np.linalg.norm(a)
+        if norm == 0:
+            raise ValueError(f"{axes_path}: axes.{name} is the zero vector; give a direction")
+        axes[name] = a / norm
+    return axes
 
 
 def find_photo_image(folder):
