@@ -21,7 +21,7 @@ from ..constants import (
     PART_APART_MM,
     VIEWS,
 )
-from ..geometry.mesh import clean_mesh, compact, parts_apart, point_surface_distance
+from ..geometry.mesh import clean_mesh, compact, gaps_beyond, parts_apart
 from ..inputs import CaseWarning, Photo, Priors, Skull
 from ..io.case import (
     check_axes_file,
@@ -118,7 +118,13 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
     if missing:
         axes.update(landmark_normals(vertices, faces, {n: landmarks[n] for n in missing}))
     extent = np.ptp(vertices, axis=0).max()
-    _check_on_mesh(lm_path, landmarks, vertices, faces, 0.1 * extent)
+    off_mesh = gaps_beyond(landmarks, vertices, faces, 0.1 * extent)
+    if off_mesh:  # the first, in the file's order
+        name, gap = next(iter(off_mesh.items()))
+        raise ValueError(
+            f"{lm_path}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
+            "must be in the mesh's frame and units"
+        )
     check_landmark_layout(lm_path, landmarks, extent * MIN_CRANIAL_EXTENT_FRACTION, "mm")
     return Skull(
         skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings),
@@ -164,23 +170,6 @@ def _skull_surface(mesh_path, mesh, landmarks):
         )
     vertices, faces = compact(vertices, faces)
     return vertices, faces, warnings
-
-
-def _check_on_mesh(lm_path, landmarks, vertices, faces, tolerance_mm):
-    """Raise when a cranial landmark lies farther than ``tolerance_mm`` from the skull's surface
-    (its triangles, not only its vertices: a coarse mesh has vertices far apart)."""
-    sample = vertices[:: max(1, len(vertices) // 20_000)]  # a CT skull's: a sample first
-    for name, p in landmarks.items():
-        gap = np.min(np.linalg.norm(sample - p, axis=1))  # >= the whole mesh's gap
-        if gap > tolerance_mm:
-            gap = np.min(np.linalg.norm(vertices - p, axis=1))
-        if gap > tolerance_mm:
-            gap = point_surface_distance(p[None], vertices, faces)[0]
-        if gap > tolerance_mm:
-            raise ValueError(
-                f"{lm_path}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
-                "must be in the mesh's frame and units"
-            )
 
 
 def read_photo(folder, load_image=True):

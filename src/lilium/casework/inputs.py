@@ -28,7 +28,7 @@ from ..io.mesh import MESH_SUFFIXES
 from ..io.paths import path_id, safe_id
 from ..io.prepared import read_prepared
 from ..methods.photo_checks import check_distinct_photos, check_landmarks_in_mask
-from ..validation import check_prior, fmt_range
+from ..validation import fmt_range
 from .build import photo_from_files, read_photo, skull_from_files
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 from .request import PriorOverrides
@@ -192,10 +192,6 @@ def _found(log, owner, what, path, beside):
         log(f"{owner}: using {what} {Path(path).name} (found beside {beside})")
 
 
-def _check_interval(values, option, key):
-    return None if values is None else check_prior(values, key, f"command line: {option}")
-
-
 def load_photos(
     sources, priors=PriorOverrides(), log=None, skull=None, auto_landmarks=False, out=None
 ):
@@ -236,8 +232,7 @@ def load_photos(
         landmarks (None for landmarks placed by hand). Each photo carries its priors' sources
         (``prior_sources``), its ``landmarks_file`` and its input warnings (:func:`with_priors`).
     """
-    focal_cli = _check_interval(priors.focal_px, "--focal-px", "focal_px")
-    scd_cli = _check_interval(priors.scd_mm, "--scd-mm", "scd_mm")
+    focal_cli, scd_cli = priors.focal_px, priors.scd_mm  # checked intervals
     use_exif, sensor_width_mm = priors.use_exif, priors.sensor_width_mm
     records = []
     for source in sources:
@@ -309,6 +304,7 @@ def load_photos(
                 inputs["face mask"] = mask
             if curve is not None:
                 inputs["face curve"] = curve
+        photo_id = unique_id(photo.id, _taken(records))
         photo, notes = with_priors(
             photo, image, focal_cli, scd_cli, use_exif=use_exif, sensor_width_mm=sensor_width_mm
         )
@@ -319,9 +315,7 @@ def load_photos(
             photo, landmarks_file=str(inputs.get("facial landmarks") or inputs["photo.json"])
         )
         off_mask = check_landmarks_in_mask(photo)  # an error, or warnings the result keeps
-        photo = replace(
-            photo, id=unique_id(photo.id, _taken(records)), warnings=(*photo.warnings, *off_mask)
-        )
+        photo = replace(photo, id=photo_id, warnings=(*photo.warnings, *off_mask))
         records.append(PhotoRecord(photo, inputs, notes, origin))
     check_distinct_photos([r.photo for r in records])
     return records

@@ -91,9 +91,9 @@ def read_case(request, log=None, out=None):
     if request.depth_table is not None:
         options, photos = with_depth_table(options, request.depth_table, [r.photo for r in records])
         records = [r._replace(photo=p) for r, p in zip(records, photos, strict=True)]
+    calibrations = Calibrations(request.calibration)
     for record in [*records, *(r for _, rs in candidates for r in rs)]:
         check_inputs(skull, record.photo)
-    calibrations = Calibrations(request.calibration)
     return CaseInputs(skull, skull_inputs, tuple(records), candidates, options, calibrations)
 
 

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from ..methods.options import SfoOptions
+from ..validation import check_prior
 
 
 @dataclass(frozen=True)
@@ -76,12 +77,14 @@ class PhotoSource:
 
 @dataclass(frozen=True)
 class PriorOverrides:
-    """Camera priors given for every photo of the request.
+    """Camera priors given for every photo of the request, checked when made.
 
     Attributes
     ----------
     focal_px, scd_mm : (float, float) or None
-        Win over each photo's ``photo.json`` and EXIF.
+        Win over each photo's ``photo.json`` and EXIF; checked intervals
+        (:func:`~lilium.validation.check_prior`, named as the options ``--focal-px`` and
+        ``--scd-mm``).
     use_exif : bool
         Take a focal prior from the image's EXIF when there is no other.
     sensor_width_mm : float or None
@@ -92,6 +95,13 @@ class PriorOverrides:
     scd_mm: tuple[float, float] | None = None
     use_exif: bool = True
     sensor_width_mm: float | None = None
+
+    def __post_init__(self):
+        for key, option in (("focal_px", "--focal-px"), ("scd_mm", "--scd-mm")):
+            value = getattr(self, key)
+            if value is not None:
+                checked = check_prior(value, key, f"command line: {option}")
+                object.__setattr__(self, key, checked)
 
 
 @dataclass(frozen=True)

@@ -170,6 +170,40 @@ def compact(vertices, faces):
     return vertices[used], index[faces]
 
 
+def gaps_beyond(points, vertices, faces, tolerance_mm):
+    """The points farther than ``tolerance_mm`` from a triangle surface, with their distance.
+
+    Cheap first: a point within ``tolerance_mm`` of a sample of the vertices (a CT skull's mesh
+    has hundreds of thousands), or of some vertex, is near enough; the rest are measured to the
+    triangles themselves (:func:`point_surface_distance`: a coarse mesh has vertices far apart).
+
+    Parameters
+    ----------
+    points : dict of str -> ndarray of shape (3,)
+        Named points, in the mesh's frame and units.
+    vertices : ndarray of shape (V, 3)
+    faces : ndarray of shape (F, 3), int
+    tolerance_mm : float
+
+    Returns
+    -------
+    dict of str -> float
+        The points farther than ``tolerance_mm`` and their distance to the surface, in the
+        order of ``points``.
+    """
+    sample = vertices[:: max(1, len(vertices) // 20_000)]
+    far = {}
+    for name, p in points.items():
+        gap = np.min(np.linalg.norm(sample - p, axis=1))  # >= the whole mesh's gap
+        if gap > tolerance_mm:
+            gap = np.min(np.linalg.norm(vertices - p, axis=1))
+        if gap > tolerance_mm:
+            gap = point_surface_distance(p[None], vertices, faces)[0]
+        if gap > tolerance_mm:
+            far[name] = gap
+    return far
+
+
 def point_surface_distance(points, vertices, faces):
     """Distance of each point to the nearest point of a triangle surface (not only its vertices).
 

@@ -132,10 +132,9 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
     result = locate_skull_landmarks(vertices, faces, keep=keep, rng=rng, source=str(mesh_path))
     sources = landmark_sources(result)
     out.mkdir(parents=True, exist_ok=True)
-    skull_path = out / "skull.ply"
-    write_mesh(skull_path, vertices, faces)
-    write_json(out / "soft_tissue_axes.json", {"axes": result.axes, "prepared_by": PREPARED_BY})
     _write_review_page(out, vertices, faces, result, sources, mesh_path.name)
+    write_mesh(out / "skull.ply", vertices, faces)
+    write_json(out / "soft_tissue_axes.json", {"axes": result.axes, "prepared_by": PREPARED_BY})
     write_json(  # last: a folder holding it is whole (prepared_skull)
         out / "cranial_landmarks.json",
         {
