@@ -124,7 +124,11 @@ def config(args, dataset_seed, joint=False):
         out = out / f"seed-{dataset_seed}"
     return ExperimentConfig(
         name="bench-identification",
-        dataset=DatasetConfig(out / "dataset", True, subjects, 1, dataset_seed),
+        dataset=DatasetConfig(
+            out / "dataset", True, subjects, 1, dataset_seed,
+            no_mandible_share=0.0 if joint else args.no_mandible_share,
+            drop_landmark_rate=0.0 if joint else args.drop_landmark_rate,
+        ),
         experiments=("C",),
         methods=parse_methods(methods.split(",")) if methods else ALL_METHODS,
         repetitions=1,
@@ -386,6 +390,14 @@ def main(argv=None):
         help="also a joint-SFO database of this many subjects (OUT/joint), pooled in the LR tables",
     )
     parser.add_argument("--joint-dataset-seed", type=int, default=2)
+    parser.add_argument(
+        "--no-mandible-share", type=float, default=0.0,
+        help="share of the generated skulls without the mandible (default 0)",
+    )
+    parser.add_argument(
+        "--drop-landmark-rate", type=float, default=0.0,
+        help="probability that a visible photo landmark is left unmarked (default 0)",
+    )
     parser.add_argument("--print-only", action="store_true", help="only print the stored rows")
     parser.add_argument(
         "--db", action="append", default=[], help="more databases to pool in the LR tables"
