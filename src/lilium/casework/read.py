@@ -10,13 +10,13 @@ after that but the resume machinery (:mod:`~lilium.casework.folders`).
 from dataclasses import dataclass, field, replace
 
 from ..inputs import CaseWarning
+from ..io.calibration import Calibrations
 from ..io.case import read_depth_table
 from ..io.results import read_camera
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.registry import check_runnable
 from ..softtissue.depths import depth_table_warning
-from .identify import Calibrations
 from .inputs import load_photos, load_skull
 
 
