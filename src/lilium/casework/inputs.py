@@ -19,6 +19,7 @@ from ..inputs import CaseWarning
 from ..io.case import (
     IMAGE_NAMES,
     check_axes_file,
+    first_file,
     read_mask,
     subject_files,
 )
@@ -46,11 +47,6 @@ class PhotoRecord(NamedTuple):
     notes: dict
     origin: object = None
     camera: object = None
-
-
-def first_file(folder, names):
-    """The first of ``names`` that is a file in ``folder``; None when none is."""
-    return next((folder / n for n in names if (folder / n).is_file()), None)
 
 
 def load_skull(source, log=None, out=None):
