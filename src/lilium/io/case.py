@@ -2,8 +2,9 @@
 
 Each function here reads one file (or finds one in a folder) into plain arrays and dicts; the
 typed :class:`~lilium.inputs.Skull` and :class:`~lilium.inputs.Photo` are built and checked
-across files by :mod:`lilium.casework.build`. Every problem found is a ``ValueError`` whose
-message names the file, the field and the fix.
+across files by :mod:`lilium.casework.build`. A request's photos are compared as files here too
+(:func:`check_distinct_photos`: the same path, or the same image byte for byte). Every problem
+found is a ``ValueError`` whose message names the file, the field and the fix.
 """
 
 import csv
