@@ -10,11 +10,11 @@ import shutil
 import pytest
 
 from cli_helpers import _one_line_error, _run
-from lilium.casework.folders import check_distinct_photos
 from lilium.casework.lineup import check_candidates
 from lilium.experiments.store import ResultStore
 from lilium.identification.calibration import Calibration
 from lilium.io.calibration import read_calibration, shipped_path
+from lilium.io.case import check_distinct_photos
 from standin_case import terms_database
 
 # -- calibration files -------------------------------------------------------------------------

@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from lilium.casework.build import read_photo, read_skull
-from lilium.casework.inputs import check_runnable
 from lilium.cli.main import main
 from lilium.experiments.report import write_report
 from lilium.experiments.terms_off import terms_off_rows, terms_off_table
@@ -28,6 +27,7 @@ from lilium.methods.lilium_terms import (
     pll_off_reason,
     prior_terms_off,
 )
+from lilium.methods.registry import check_runnable
 from lilium.optimisation.de import DEOptions
 from lilium.synthetic import dataset as ds
 from lilium.synthetic import incomplete
@@ -236,14 +236,14 @@ def test_prior_parts_off_without_their_prior(pair):
 def test_check_runnable_says_what_is_switched_off(pair):
     subject_dir, photo_dir = _case(pair[0], "no_mandible", "frontal")
     skull, photo = read_skull(subject_dir), read_photo(photo_dir)
-    inputs = {"photo.json": photo_dir / "photo.json"}
-    off = check_runnable(skull, photo, ["lilium"], "skof+pll", {}, inputs)
+    photo_file = photo_dir / "photo.json"
+    off = check_runnable(skull, photo, ["lilium"], "skof+pll", photo_file)
     assert list(off) == ["p_pll"]
-    assert check_runnable(skull, photo, ["posest-sfo"], "skof+pll", {}, inputs) == {}
+    assert check_runnable(skull, photo, ["posest-sfo"], "skof+pll", photo_file) == {}
     # Fewer than four pairs: the one case no term set can run.
     three = replace(photo, landmarks_uv=dict(list(photo.landmarks_uv.items())[:3]))
     with pytest.raises(ValueError, match="photo.json: only 3 usable landmark pairs"):
-        check_runnable(skull, three, ["lilium"], "skof+pll", {}, inputs)
+        check_runnable(skull, three, ["lilium"], "skof+pll", photo_file)
 
 
 # -- the user's case and the experiment report ------------------------------------------------

@@ -13,8 +13,8 @@
 - :mod:`~lilium.casework.case`: every SFO of a case and its HTML report (``lilium case``);
 - :mod:`~lilium.casework.lineup`: one skull against several candidates (``lilium lineup``);
 - :mod:`~lilium.casework.folders`: the output folders' machinery (resume, lock, joint files);
-- :mod:`~lilium.casework.identify`: the calibration file read once, each result's
-  identification.
+- :mod:`~lilium.casework.identify`: each result's identification, with the calibration file
+  read once (:class:`~lilium.io.calibration.Calibrations`).
 
 The flow runs down once: cli -> casework -> methods (:func:`lilium.methods.run_sfo`) -> pose /
 fitness -> geometry; reading and writing files is :mod:`lilium.io`'s job.

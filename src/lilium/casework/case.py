@@ -5,12 +5,12 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..inputs import GivenCamera
+from ..io.case import check_distinct_photos
 from ..io.paths import safe_id
 from ..methods.registry import check_method, method_tag, run_sfo
 from .console import log_warnings, status_text
-from .folders import check_distinct_photos, output_lock, resumed_sfo, sfo_fingerprint, sfo_outputs
+from .folders import output_lock, resumed_sfo, sfo_fingerprint, sfo_outputs
 from .identify import conclusion_line, decide
-from .inputs import check_runnable
 from .joint_case import check_joint_case, joint_entry, run_joint_methods
 from .prepared import check_photo_extra
 from .read import read_case
@@ -102,24 +102,24 @@ def run_case(request, log=print):
     report as a run that was not stopped; any other stored SFO runs again (the log says why).
 
     Before the first SFO, ``log`` gets one line per term Lilium will switch off for a photo
-    (:func:`~lilium.casework.inputs.check_runnable`): ``<photo>: lilium <variant>: P_pll
+    (:func:`~lilium.methods.registry.check_runnable`): ``<photo>: lilium <variant>: P_pll
     switched off: <why>``; each SFO's line ends with the terms it ran without.
     """
     from ..report.html import write_report
 
     methods, seed = list(request.methods), request.seed
+    paths = [source.path for source in request.photos]
+    check_distinct_photos(paths)  # each photo given once, by path and by the image's bytes
     for method in methods:
         check_method(method, request.options.variant)
     if request.auto_landmarks:
         check_photo_extra()
-    paths = [source.path for source in request.photos]
-    check_distinct_photos(paths)
     if request.joint:
         check_joint_case(paths, methods)
     out = Path(request.out)
     with output_lock(out):
-        inputs = read_case(request, log=log, out=out)
-        _check_records(inputs, methods, log)
+        inputs = read_case(request, log=log, out=out, plan=True)
+        _log_plan(inputs, log)
         joints = {}  # method -> (JointSfoResult, folder), for the joint methods
         if request.joint:
             joints = run_joint_methods(inputs, methods, seed, out, log)
@@ -134,16 +134,11 @@ def run_case(request, log=print):
     return entries
 
 
-def _check_records(inputs, methods, log):
-    """Every problem of the photos before any long run; log the terms switched off and the
-    photos with unreviewed automatic landmarks."""
+def _log_plan(inputs, log):
+    """Log the terms switched off (``inputs.terms_off``) and the photos with unreviewed
+    automatic landmarks, before any long run."""
     variant = inputs.options.variant
-    planned = {}
-    for record in inputs.records:
-        planned[record.photo.id] = check_runnable(
-            inputs.skull, record.photo, methods, variant, inputs.skull_inputs, record.inputs
-        )
-    for photo_id, off in planned.items():
+    for photo_id, off in inputs.terms_off.items():
         for term, why in off.items():
             log(f"{photo_id}: lilium {variant}: {term_label(term)} switched off: {why}")
     for record in inputs.records:

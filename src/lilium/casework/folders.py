@@ -1,11 +1,10 @@
 """The output folders of a case (docs/contract.md): what lets ``lilium case`` and ``lilium
 lineup`` resume (each stored result's input fingerprint, :func:`sfo_fingerprint`; the test that
-a stored result is this SFO's, :func:`stored_result`), the joint SFO's files, the refusal of a
-photo given twice, and the lock that keeps a second run off an output folder
-(:func:`output_lock`).
+a stored result is this SFO's, :func:`stored_result`), the joint SFO's files and the lock that
+keeps a second run off an output folder (:func:`output_lock`); a photo given twice is refused
+by :func:`lilium.io.case.check_distinct_photos`.
 """
 
-import filecmp
 import hashlib
 import json
 from contextlib import contextmanager
@@ -15,7 +14,6 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..io.case import IMAGE_NAMES
 from ..io.jsonio import write_json
 from ..io.locks import RunLock
 from ..io.paths import printable, safe_id
@@ -27,7 +25,6 @@ from ..methods.registry import (
     run_sfo,
 )
 from .identify import with_identification
-from .inputs import first_file
 
 #: Name of one SFO's workbench page in its folder (:func:`write_sfo`).
 WORKBENCH = "workbench.html"
@@ -90,60 +87,6 @@ def write_joint_result(out_dir, result, skull, photos, overlay=True):
         _workbench(out_dir / joint_workbench_name(photo.id), skull, photo, single)
     write_json(written["result.json"], result.to_dict())
     return written
-
-
-def _image_of(path):
-    """The image file of a photo folder or an image path; None when there is none (yet)."""
-    path = Path(path)
-    if path.is_dir():
-        return first_file(path, IMAGE_NAMES)
-    return path if path.is_file() else None
-
-
-def repeated_photo(paths):
-    """The first photo of ``paths`` that repeats an earlier one: the same path, or the same
-    image byte for byte (a copied photo folder, the image under another name).
-
-    Returns
-    -------
-    (int, int, str) or None
-        The later index, the earlier one and how they are the same (``"the same photo as"``
-        or ``"the same image (byte for byte) as"``); None when every photo differs.
-    """
-    seen, by_size = {}, {}
-    for k, path in enumerate(paths):
-        key = Path(path).resolve()
-        if key in seen:
-            return k, seen[key], "the same photo as"
-        seen[key] = k
-        image = _image_of(path)
-        if image is None:
-            continue
-        size = image.stat().st_size
-        for j in by_size.get(size, []):
-            if filecmp.cmp(image, _image_of(paths[j]), shallow=False):
-                return k, j, "the same image (byte for byte) as"
-        by_size.setdefault(size, []).append(k)
-    return None
-
-
-def check_distinct_photos(paths):
-    """Refuse a photo given twice to a case or a joint SFO, by path or as a copy of its image
-    (a joint SFO would count its landmarks twice, and the identification of several photos
-    would count it as a second view and lift the single-photo cap).
-
-    Raises
-    ------
-    ValueError
-        Naming the repeated path.
-    """
-    repeat = repeated_photo(paths)
-    if repeat is not None:
-        k, j, how = repeat
-        raise ValueError(
-            f"--photo {paths[k]}: {how} --photo {paths[j]}; give each photo of the person once "
-            "(a repeated photo is no second view)"
-        )
 
 
 #: ``result.json`` key of the SFO's input fingerprint (:func:`sfo_fingerprint`).

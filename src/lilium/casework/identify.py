@@ -1,5 +1,5 @@
-"""The identification in a case's workflow: the calibration file read once, each result's
-``"identification"`` record, and its console line.
+"""The identification in a case's workflow: each result's ``"identification"`` record, and its
+console line, with the calibration file read once (:class:`~lilium.io.calibration.Calibrations`).
 
 The decision itself (which model, the terms, the caps) is
 :func:`lilium.identification.decision.identify`; here it gets the calibration file the user
@@ -10,20 +10,9 @@ from dataclasses import replace
 
 from ..identification.conclusion import NO_SUPPORT_CAPS
 from ..identification.decision import identify
-from ..io.calibration import read_calibration, shipped_cohort, shipped_path
+from ..io.calibration import Calibrations
 
-
-class Calibrations:
-    """The calibration models of a file, read once (the shipped file by default), and the
-    cohort they were fitted with (the shipped one)."""
-
-    def __init__(self, path=None):
-        self.path = shipped_path() if path is None else path
-        self.models, self.provenance = read_calibration(path)
-        self.cohort = shipped_cohort()
-
-    def get(self, key):
-        return self.models.get(key)
+__all__ = ["Calibrations", "conclusion_line", "decide", "with_identification"]
 
 
 def decide(skull, photos, results, calibrations, facial_landmarks_mm=None, joint=False):

@@ -19,6 +19,7 @@ from ..inputs import CaseWarning
 from ..io.case import (
     IMAGE_NAMES,
     check_axes_file,
+    first_file,
     read_mask,
     subject_files,
 )
@@ -46,11 +47,6 @@ class PhotoRecord(NamedTuple):
     notes: dict
     origin: object = None
     camera: object = None
-
-
-def first_file(folder, names):
-    """The first of ``names`` that is a file in ``folder``; None when none is."""
-    return next((folder / n for n in names if (folder / n).is_file()), None)
 
 
 def load_skull(source, log=None, out=None):
@@ -455,43 +451,3 @@ def _json_keys(path):
 
     data = read_json(path)
     return data.keys() if isinstance(data, dict) else ()
-
-
-def check_runnable(skull, photo, methods, variant, skull_inputs, photo_inputs):
-    """Check that an SFO of ``photo`` can run, before any SFO runs; say what it will switch off.
-
-    The landmarks must pair (:func:`lilium.inputs.correspondences`: at least four pairs, the
-    one case no term set can run); otherwise the ``ValueError`` starts with the file to fix.
-    For Lilium, a term the variant asks for whose inputs are missing (P_skof without a face
-    mask; P_pll without the cranial landmarks that cut its region, e.g. a skull without its
-    mandible, or without a facial curve) is switched off, not an error (docs/method/lilium.md), and
-    so is each P_cam part without its prior.
-
-    Parameters
-    ----------
-    skull : Skull
-    photo : Photo
-    methods : sequence of str
-    variant : str
-        Lilium's variant.
-    skull_inputs, photo_inputs : dict of str -> Path
-        The labelled files of :func:`load_skull` and :func:`load_photos`.
-
-    Returns
-    -------
-    dict of str -> str
-        What Lilium's SFO of this photo will switch off, and why (empty when Lilium does not
-        run); the same as its ``result.json``'s ``terms_off``.
-    """
-    from ..inputs import correspondences
-    from ..methods.lilium import VARIANTS
-    from ..methods.lilium_terms import planned_terms_off
-
-    photo_file = photo_inputs.get("facial landmarks") or photo_inputs.get("photo.json")
-    try:
-        correspondences(skull, photo)
-    except ValueError as exc:
-        raise ValueError(f"{photo_file}: {exc}") from None
-    if "lilium" not in methods:
-        return {}
-    return planned_terms_off(skull, photo, VARIANTS[variant])

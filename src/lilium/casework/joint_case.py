@@ -27,7 +27,7 @@ from .inputs import JOINT_FOLDER
 
 def check_joint_case(photos, methods):
     """Refuse a ``--joint`` case that cannot run, before any file is read (a photo given
-    twice is refused for every case, :func:`~lilium.casework.folders.check_distinct_photos`).
+    twice is refused for every case, :func:`~lilium.io.case.check_distinct_photos`).
 
     Raises
     ------

@@ -22,12 +22,12 @@ second run on the same ``--out`` is refused while one runs
 from dataclasses import replace
 from pathlib import Path
 
+from ..io.case import repeated_photo
 from ..io.jsonio import write_json
 from ..io.paths import printable, safe_id
 from ..methods.registry import check_method, method_tag, run_sfo
 from .folders import (
     output_lock,
-    repeated_photo,
     resumed_sfo,
     sfo_fingerprint,
     sfo_outputs,

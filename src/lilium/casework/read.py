@@ -7,15 +7,16 @@ options with the request's depth table, and the calibration models.
 after that but the resume machinery (:mod:`~lilium.casework.folders`).
 """
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 from ..inputs import CaseWarning
+from ..io.calibration import Calibrations
 from ..io.case import read_depth_table
 from ..io.results import read_camera
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
+from ..methods.registry import check_runnable
 from ..softtissue.depths import depth_table_warning
-from .identify import Calibrations
 from .inputs import load_photos, load_skull
 
 
@@ -37,6 +38,9 @@ class CaseInputs:
     options : SfoOptions
         The request's, with its depth table.
     calibrations : Calibrations
+    terms_off : dict of str -> dict of str -> str
+        Read with ``plan``: by photo id of :attr:`records`, what Lilium's SFO of it will switch
+        off, and why (:func:`~lilium.methods.registry.check_runnable`); else empty.
     """
 
     skull: object
@@ -45,6 +49,7 @@ class CaseInputs:
     candidates: tuple
     options: SfoOptions
     calibrations: Calibrations
+    terms_off: dict = field(default_factory=dict)
 
     @property
     def photos(self):
@@ -52,7 +57,7 @@ class CaseInputs:
         return [record.photo for record in self.records]
 
 
-def read_case(request, log=None, out=None):
+def read_case(request, log=None, out=None, plan=False):
     """Read and check every input of ``request``.
 
     Parameters
@@ -63,6 +68,9 @@ def read_case(request, log=None, out=None):
         (:func:`~lilium.casework.inputs.load_photos`).
     out : Path, optional
         The output folder photos are prepared in (``request.auto_landmarks``); hold its lock.
+    plan : bool
+        Also check that every SFO of the request's photos can run, and find what Lilium's
+        will switch off (:func:`~lilium.methods.registry.check_runnable`; ``lilium case``).
 
     Returns
     -------
@@ -73,7 +81,7 @@ def read_case(request, log=None, out=None):
     ValueError
         An invalid input, naming the file: a skull or a photo that cannot be read, mirrored
         left/right labels (:func:`~lilium.methods.checks.check_inputs`), a depth table or a
-        calibration file that cannot be read.
+        calibration file that cannot be read; with ``plan``, landmarks that do not pair.
     """
     skull, skull_inputs = load_skull(request.skull, log=log, out=out or request.out)
 
@@ -94,7 +102,15 @@ def read_case(request, log=None, out=None):
     calibrations = Calibrations(request.calibration)
     for record in [*records, *(r for _, rs in candidates for r in rs)]:
         check_inputs(skull, record.photo)
-    return CaseInputs(skull, skull_inputs, tuple(records), candidates, options, calibrations)
+    terms_off = {}
+    for record in records if plan else ():
+        photo_file = record.inputs.get("facial landmarks") or record.inputs.get("photo.json")
+        terms_off[record.photo.id] = check_runnable(
+            skull, record.photo, request.methods, options.variant, photo_file
+        )
+    return CaseInputs(
+        skull, skull_inputs, tuple(records), candidates, options, calibrations, terms_off
+    )
 
 
 def with_depth_table(options, path, photos):

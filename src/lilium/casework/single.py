@@ -3,8 +3,9 @@
 joint SFO of two or more photos of one person (:func:`joint_sfo`).
 """
 
+from ..io.case import check_distinct_photos
 from ..methods.registry import check_joint_method, check_method, run_joint_sfo, run_sfo
-from .folders import check_distinct_photos, write_joint_result, write_sfo
+from .folders import write_joint_result, write_sfo
 from .identify import with_identification
 from .read import read_case
 

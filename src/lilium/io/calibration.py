@@ -118,6 +118,42 @@ def read_calibration(path=None):
     return models, dict(data.get("provenance") or {})
 
 
+class Calibrations:
+    """The calibration models of a file, read once (the shipped file by default), and the
+    cohort they were fitted with (the shipped one): what a case identifies its results with.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        A calibration file (``--calibration``); None: the shipped one.
+
+    Attributes
+    ----------
+    path : Path
+        The file read.
+    models : dict of str -> Calibration
+        By ``"<method>/<variant>/<decision>"`` (:func:`read_calibration`).
+    provenance : dict
+        The file's ``provenance``.
+    cohort : Cohort
+        The shipped cohort (:func:`shipped_cohort`).
+
+    Raises
+    ------
+    ValueError
+        Not a calibration file, or a malformed model, naming the file.
+    """
+
+    def __init__(self, path=None):
+        self.path = shipped_path() if path is None else path
+        self.models, self.provenance = read_calibration(path)
+        self.cohort = shipped_cohort()
+
+    def get(self, key):
+        """The model of ``key`` (``"<method>/<variant>/<decision>"``), None when absent."""
+        return self.models.get(key)
+
+
 def write_calibration(path, models, provenance):
     """Write ``{key: Calibration}`` as a calibration file."""
     write_json(

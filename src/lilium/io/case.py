@@ -2,11 +2,13 @@
 
 Each function here reads one file (or finds one in a folder) into plain arrays and dicts; the
 typed :class:`~lilium.inputs.Skull` and :class:`~lilium.inputs.Photo` are built and checked
-across files by :mod:`lilium.casework.build`. Every problem found is a ``ValueError`` whose
-message names the file, the field and the fix.
+across files by :mod:`lilium.casework.build`. A request's photos are compared as files here too
+(:func:`check_distinct_photos`: the same path, or the same image byte for byte). Every problem
+found is a ``ValueError`` whose message names the file, the field and the fix.
 """
 
 import csv
+import filecmp
 from pathlib import Path
 
 import numpy as np
@@ -26,8 +28,10 @@ from .prepared import (
 __all__ = [
     "IMAGE_NAMES",
     "check_axes_file",
+    "check_distinct_photos",
     "check_folder",
     "find_photo_image",
+    "first_file",
     "parse_axes",
     "cranial_landmark_file",
     "parse_cranial_landmarks",
@@ -38,10 +42,16 @@ __all__ = [
     "read_image_or_size",
     "read_mask",
     "read_photo_meta",
+    "repeated_photo",
     "required_field",
 ]
 
 IMAGE_NAMES = ("image.png", "image.jpg", "image.jpeg")
+
+
+def first_file(folder, names):
+    """The first of ``names`` that is a file in ``folder``; None when none is."""
+    return next((folder / n for n in names if (folder / n).is_file()), None)
 
 
 def _find(folder, stems_or_names, what, fix):
@@ -251,3 +261,57 @@ def read_depth_table(path):
                 ) from None
             table[(row["landmark"] or "").strip()] = stats
     return check_depth_table(table, source=str(path))
+
+
+def _image_of(path):
+    """The image file of a photo folder or an image path; None when there is none (yet)."""
+    path = Path(path)
+    if path.is_dir():
+        return first_file(path, IMAGE_NAMES)
+    return path if path.is_file() else None
+
+
+def repeated_photo(paths):
+    """The first photo of ``paths`` that repeats an earlier one: the same path, or the same
+    image byte for byte (a copied photo folder, the image under another name).
+
+    Returns
+    -------
+    (int, int, str) or None
+        The later index, the earlier one and how they are the same (``"the same photo as"``
+        or ``"the same image (byte for byte) as"``); None when every photo differs.
+    """
+    seen, by_size = {}, {}
+    for k, path in enumerate(paths):
+        key = Path(path).resolve()
+        if key in seen:
+            return k, seen[key], "the same photo as"
+        seen[key] = k
+        image = _image_of(path)
+        if image is None:
+            continue
+        size = image.stat().st_size
+        for j in by_size.get(size, []):
+            if filecmp.cmp(image, _image_of(paths[j]), shallow=False):
+                return k, j, "the same image (byte for byte) as"
+        by_size.setdefault(size, []).append(k)
+    return None
+
+
+def check_distinct_photos(paths):
+    """Refuse a photo given twice to a case or a joint SFO, by path or as a copy of its image
+    (a joint SFO would count its landmarks twice, and the identification of several photos
+    would count it as a second view and lift the single-photo cap).
+
+    Raises
+    ------
+    ValueError
+        Naming the repeated path.
+    """
+    repeat = repeated_photo(paths)
+    if repeat is not None:
+        k, j, how = repeat
+        raise ValueError(
+            f"--photo {paths[k]}: {how} --photo {paths[j]}; give each photo of the person once "
+            "(a repeated photo is no second view)"
+        )

@@ -114,39 +114,58 @@ def pll_off_reason(skull, photo):
     return ""
 
 
-def _region_cut(skull, photo):
-    """P_pll's skull region of ``photo``'s view: ``(vertices_mm (K, 3), faces (G, 3))``, cut
-    from the full mesh (:class:`TermOff` when it cannot be)."""
-    reason = pll_off_reason(skull, photo)
-    if reason:
-        raise TermOff(reason)
-    lm, region_name = skull.landmarks_mm, _region_name(photo.view)
-    try:
-        frame = anatomical_frame(lm)
-    except ValueError as exc:
-        raise TermOff(f"skull {skull.id!r}: {exc}") from None
-    cut = chin_jaw_region if photo.view == "frontal" else forehead_region
-    region = cut(skull.vertices_mm, skull.faces, lm, frame)
-    if len(region.faces) == 0:
-        raise TermOff(
-            f"skull {skull.id!r}: the {region_name} region between its landmarks holds no "
-            "triangle of the mesh (check the landmarks against skull.ply)"
-        )
-    return skull.vertices_mm[region.vertex_index], region.faces
+def _pll_inputs(skull, photo, cut=None):
+    """P_pll's inputs for ``photo``, found once: the skull's region of its view, cut from the
+    full mesh (``cut`` when given: a region already cut from this skull for another photo of
+    the same view), and the photo's facial curve (``face_curve.json``, else from the face mask).
 
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    cut : (ndarray of shape (K, 3), ndarray of shape (G, 3)), optional
+        A region cut already (millimetres, faces): only the facial curve is found.
 
-def _facial_curve(photo):
-    """The photo's facial curve ``(M, 2)``: ``face_curve.json``, else from the face mask."""
-    if photo.face_curve_uv is not None:
-        face_curve = photo.face_curve_uv
-    else:
-        face_curve = face_curve_from_mask(photo.face_mask, photo.view, photo.landmarks_uv)
+    Returns
+    -------
+    cut : (ndarray of shape (K, 3), ndarray of shape (G, 3))
+        The region's vertices (millimetres) and faces.
+    face_curve : ndarray of shape (M, 2)
+        The facial curve (pixels).
+
+    Raises
+    ------
+    TermOff
+        P_pll cannot apply (:func:`pll_off_reason`; the skull's landmarks cannot orient the
+        head; the region holds no triangle; the facial curve is empty); the message says why.
+    """
+    view, region_name = photo.view, _region_name(photo.view)
+    if cut is None:
+        reason = pll_off_reason(skull, photo)
+        if reason:
+            raise TermOff(reason)
+        lm = skull.landmarks_mm
+        try:
+            frame = anatomical_frame(lm)
+        except ValueError as exc:
+            raise TermOff(f"skull {skull.id!r}: {exc}") from None
+        region_of = chin_jaw_region if view == "frontal" else forehead_region
+        region = region_of(skull.vertices_mm, skull.faces, lm, frame)
+        if len(region.faces) == 0:
+            raise TermOff(
+                f"skull {skull.id!r}: the {region_name} region between its landmarks holds no "
+                "triangle of the mesh (check the landmarks against skull.ply)"
+            )
+        cut = skull.vertices_mm[region.vertex_index], region.faces
+    face_curve = photo.face_curve_uv
+    if face_curve is None:
+        face_curve = face_curve_from_mask(photo.face_mask, view, photo.landmarks_uv)
     if len(face_curve) < 2:
         raise TermOff(
-            f"photo {photo.id!r}: the facial {_region_name(photo.view)} curve is empty (check "
+            f"photo {photo.id!r}: the facial {region_name} curve is empty (check "
             "face_mask.png and the landmarks, or give face_curve.json)"
         )
-    return face_curve
+    return cut, face_curve
 
 
 class PllTerm:
@@ -178,15 +197,11 @@ class PllTerm:
 
     def __init__(self, skull, photo, centre, region_fraction=1.0, reuse=None):
         view, lm = photo.view, skull.landmarks_mm
-        if reuse is None:
-            self.cut = _region_cut(skull, photo)
-            face_curve = _facial_curve(photo)
-            face_index = None
+        if reuse is not None and reuse.photo is photo:  # the working term's curve and index
+            self.cut, face_curve, face_index = reuse.cut, None, reuse.context.face_index
         else:
-            self.cut = reuse.cut
-            same_photo = reuse.photo is photo
-            face_curve = None if same_photo else _facial_curve(photo)
-            face_index = reuse.context.face_index if same_photo else None
+            self.cut, face_curve = _pll_inputs(skull, photo, None if reuse is None else reuse.cut)
+            face_index = None
         vertices_mm, faces = self.cut
         if region_fraction < 1.0 and len(faces) * region_fraction >= 4:
             vertices_mm, faces = decimate(vertices_mm, faces, len(faces) * region_fraction)
@@ -307,16 +322,16 @@ def planned_terms_off(skull, photo, variant_terms):
         Term -> reason, the image terms first, then the P_cam parts (:func:`prior_terms_off`).
     """
     use_skof, use_pll = variant_terms
+    priors_off = prior_terms_off(photo.priors)
     off = {}
     if use_skof and skof_off_reason(photo):
         off["p_skof"] = skof_off_reason(photo)
     if use_pll:
         try:
-            _region_cut(skull, photo)
-            _facial_curve(photo)
+            _pll_inputs(skull, photo)
         except TermOff as exc:
             off["p_pll"] = str(exc)
-    return {**off, **prior_terms_off(photo.priors)}
+    return {**off, **priors_off}
 
 
 def full_image_terms(skull, photo, camera, use_skof, use_pll, working_pll=None):

@@ -140,11 +140,11 @@ def check_landmarks_in_mask(photo):
         More than half of the landmarks off the mask, naming the landmark file (or the photo),
         their number and the fix (:data:`MASK_FIX`).
     """
+    where, mask = _where(photo)  # the files the messages name
     ratios = landmark_mask_ratios(photo)
     off = sorted((n for n, r in ratios.items() if r > MASK_OFF_FRACTION), key=ratios.get)[::-1]
     if not off:
         return []
-    where, mask = _where(photo)
     worst = f"up to {ratios[off[0]]:.2f} of the mask's bounding-box diagonal"
     counted = f"{len(off)} of {len(ratios)} facial landmarks lie outside {mask}"
     if 2 * len(off) > len(ratios):

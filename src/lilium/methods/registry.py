@@ -7,10 +7,12 @@ runs a method through :func:`run_sfo` with one :class:`~lilium.methods.options.S
 
 from dataclasses import dataclass, replace
 
+from ..inputs import correspondences
 from .checks import check_given_camera, check_inputs, finish_result
 from .given_camera import lilium_at, posest_sfo_at
 from .joint import joint_lilium_sfo
 from .lilium import VARIANTS, lilium_sfo
+from .lilium_terms import planned_terms_off
 from .options import SfoOptions
 from .posest_sfo import posest_sfo
 
@@ -182,3 +184,40 @@ def run_joint_sfo(method, skull, photos, options=SfoOptions(), seed=0):
         finish_result(r, skull, photo) for r, photo in zip(result.photos, photos, strict=True)
     )
     return replace(result, photos=finished)
+
+
+def check_runnable(skull, photo, methods, variant, photo_file):
+    """Check that an SFO of ``photo`` can run, before any SFO runs; say what it will switch off.
+
+    The landmarks must pair (:func:`lilium.inputs.correspondences`: at least four pairs, the
+    one case no term set can run); otherwise the ``ValueError`` starts with the file to fix.
+    For Lilium, a term the variant asks for whose inputs are missing (P_skof without a face
+    mask; P_pll without the cranial landmarks that cut its region, e.g. a skull without its
+    mandible, or without a facial curve) is switched off, not an error (docs/method/lilium.md), and
+    so is each P_cam part without its prior.
+
+    Parameters
+    ----------
+    skull : Skull
+    photo : Photo
+    methods : sequence of str
+        Keys of :data:`METHODS`.
+    variant : str
+        Lilium's variant.
+    photo_file : Path or str
+        The file the photo's landmarks came from (its landmark file, else its ``photo.json``),
+        named by the error.
+
+    Returns
+    -------
+    dict of str -> str
+        What Lilium's SFO of this photo will switch off, and why (empty when Lilium does not
+        run); the same as its ``result.json``'s ``terms_off``.
+    """
+    try:
+        correspondences(skull, photo)
+    except ValueError as exc:
+        raise ValueError(f"{photo_file}: {exc}") from None
+    if "lilium" not in methods:
+        return {}
+    return planned_terms_off(skull, photo, VARIANTS[variant])
