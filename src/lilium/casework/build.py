@@ -26,10 +26,9 @@ from ..inputs import CaseWarning, Photo, Priors, Skull
 from ..io.case import (
     check_axes_file,
     check_folder,
-    cranial_landmark_file,
     find_photo_image,
-    parse_axes,
     parse_facial_landmarks,
+    parse_skull_files,
     read_image_or_size,
     read_photo_meta,
     required_field,
@@ -39,7 +38,6 @@ from ..io.curves import read_face_curve
 from ..io.formats import read_landmarks
 from ..io.images import read_mask
 from ..io.keys import unknown_key_warnings
-from ..io.mesh import parse_mesh
 from ..io.paths import path_id, safe_id
 from ..io.prepared import face_only_mask, written_by_lilium_photo
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
@@ -48,6 +46,7 @@ from ..validation import check_prior, is_real
 
 __all__ = [
     "check_in_image",
+    "build_skull",
     "check_landmark_layout",
     "parse_priors",
     "photo_from_files",
@@ -89,7 +88,8 @@ def read_skull(folder, axes_path=None, landmarks_path=None):
 
 
 def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
-    """A :class:`Skull` from a mesh file and a landmark file of any supported format.
+    """A :class:`Skull` from a mesh file and a landmark file of any supported format: the files
+    parsed (:func:`~lilium.io.case.parse_skull_files`), then built (:func:`build_skull`).
 
     Parameters
     ----------
@@ -104,16 +104,34 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
         Defaults to the mesh's folder name for ``skull.*`` and to the mesh's stem otherwise;
         made a safe folder name either way (:func:`lilium.io.paths.safe_id`).
     """
-    mesh_path, lm_path = Path(mesh_path), Path(landmarks_path)
-    if skull_id is None:
-        skull_id = (
-            path_id(mesh_path.parent, "skull") if mesh_path.stem == "skull" else mesh_path.stem
-        )
-    skull_id = safe_id(skull_id, "skull")
-    mesh = parse_mesh(mesh_path)
-    landmarks, sources = cranial_landmark_file(lm_path)
-    axes = parse_axes(axes_path)
-    vertices, faces, warnings = _skull_surface(mesh_path, mesh, landmarks)
+    parsed = parse_skull_files(mesh_path, landmarks_path, axes_path, skull_id)
+    return build_skull(parsed)
+
+
+def build_skull(parsed):
+    """A :class:`Skull` built and checked from its parsed files.
+
+    The surface cleaned (:func:`_skull_surface`), the axes missing from the file set to the
+    outward skull-surface normal, and the landmarks checked to lie on the mesh and to spread.
+
+    Parameters
+    ----------
+    parsed : ParsedSkull
+        :func:`~lilium.io.case.parse_skull_files`'s (its files, parsed, and the skull's id).
+
+    Returns
+    -------
+    Skull
+
+    Raises
+    ------
+    ValueError
+        A landmark off the mesh, landmarks all at one place or on one line (naming the landmark
+        file), or a mesh :func:`~lilium.geometry.mesh.clean_mesh` refuses.
+    """
+    mesh_path, lm_path = parsed.mesh_path, parsed.landmarks_path
+    landmarks, axes = parsed.landmarks, dict(parsed.axes)
+    vertices, faces, warnings = _skull_surface(mesh_path, parsed.mesh, landmarks)
     missing = [n for n in landmarks if n not in axes and n in CRANIAL_TO_FACIAL]
     if missing:
         axes.update(landmark_normals(vertices, faces, {n: landmarks[n] for n in missing}))
@@ -127,8 +145,8 @@ def skull_from_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
         )
     check_landmark_layout(lm_path, landmarks, extent * MIN_CRANIAL_EXTENT_FRACTION, "mm")
     return Skull(
-        skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings),
-        landmark_sources=sources,
+        parsed.skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings),
+        landmark_sources=parsed.sources,
     )
 
 

@@ -20,6 +20,7 @@ from ..io.case import (
     IMAGE_NAMES,
     check_axes_file,
     first_file,
+    parse_skull_files,
     read_mask,
     subject_files,
 )
@@ -30,7 +31,7 @@ from ..io.paths import path_id, safe_id
 from ..io.prepared import read_prepared
 from ..methods.photo_checks import check_distinct_photos, check_landmarks_in_mask
 from ..validation import fmt_range
-from .build import photo_from_files, read_photo, skull_from_files
+from .build import build_skull, photo_from_files, read_photo
 from .prepared import landmark_origin, prepare_bare_photo, with_automatic_priors
 from .request import PriorOverrides
 
@@ -81,7 +82,8 @@ def load_skull(source, log=None, out=None):
         Also when ``source.axes`` is given but is not a file (it is never ignored).
     """
     files = skull_files(source, log=log, out=out)
-    skull = skull_from_files(files.mesh, files.landmarks, files.axes, skull_id=files.skull_id)
+    parsed = parse_skull_files(files.mesh, files.landmarks, files.axes, files.skull_id)
+    skull = build_skull(parsed)
     return replace(skull, landmarks_file=str(files.landmarks)), files.inputs
 
 
@@ -95,7 +97,7 @@ class SkullFiles(NamedTuple):
     axes : Path or None
         The soft-tissue axes file (absent or None: the skull-surface normals).
     skull_id : str or None
-        None: :func:`~lilium.casework.build.skull_from_files`'s default.
+        None: :func:`~lilium.io.case.parse_skull_files`'s default.
     inputs : dict of str -> Path
         The files used, labelled, for the provenance (``"skull mesh"`` is the mesh given).
     """

@@ -10,6 +10,7 @@ found is a ``ValueError`` whose message names the file, the field and the fix.
 import csv
 import filecmp
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -19,7 +20,8 @@ from .formats import find_landmark_file, points_from_object, read_landmarks
 from .images import image_size_wh, read_image, read_mask
 from .jsonio import read_json
 from .keys import json_type
-from .mesh import MESH_SUFFIXES
+from .mesh import MESH_SUFFIXES, parse_mesh
+from .paths import path_id, safe_id
 from .prepared import (
     _without_unconfirmed_templates,
     landmark_qualities,
@@ -153,6 +155,73 @@ def cranial_landmark_file(landmarks_path):
         return points, landmark_qualities(sources, points)
     points = read_landmarks(lm_path, "cranial")
     return points, dict.fromkeys(points, "manual")
+
+
+class ParsedSkull(NamedTuple):
+    """A skull's files parsed to arrays (:func:`parse_skull_files`), before anything is built
+    or checked across them (:func:`lilium.casework.build.build_skull`).
+
+    Attributes
+    ----------
+    skull_id : str
+        The skull's id, a safe folder name (:func:`~lilium.io.paths.safe_id`).
+    mesh_path, landmarks_path : Path
+        The files, for the messages.
+    mesh : tuple
+        ``(vertices, faces, shared)`` as :func:`~lilium.io.mesh.parse_mesh` parsed it:
+        ndarray of shape (V, 3), millimetres, ndarray of shape (F, 3), and the flag it returns.
+    landmarks : dict of str -> ndarray of shape (3,)
+        The cranial landmarks, mm (:func:`cranial_landmark_file`).
+    sources : dict of str -> str
+        Who placed each landmark.
+    axes : dict of str -> ndarray of shape (3,)
+        The soft-tissue axes given, unit directions (:func:`parse_axes`; empty without a file).
+    """
+
+    skull_id: str
+    mesh_path: Path
+    landmarks_path: Path
+    mesh: tuple
+    landmarks: dict
+    sources: dict
+    axes: dict
+
+
+def parse_skull_files(mesh_path, landmarks_path, axes_path=None, skull_id=None):
+    """Parse a skull's mesh, cranial landmark file and soft-tissue axes file, in that order,
+    and name the skull.
+
+    Parameters
+    ----------
+    mesh_path : str or Path
+        PLY, OBJ or STL (millimetres).
+    landmarks_path : str or Path
+        Any file :func:`cranial_landmark_file` reads.
+    axes_path : str or Path, optional
+        ``soft_tissue_axes.json`` (absent or None: no axes given).
+    skull_id : str, optional
+        Defaults to the mesh's folder name for ``skull.*`` and to the mesh's stem otherwise;
+        made a safe folder name either way (:func:`lilium.io.paths.safe_id`).
+
+    Returns
+    -------
+    ParsedSkull
+
+    Raises
+    ------
+    ValueError
+        A file that cannot be parsed, naming it.
+    """
+    mesh_path, landmarks_path = Path(mesh_path), Path(landmarks_path)
+    if skull_id is None:
+        skull_id = (
+            path_id(mesh_path.parent, "skull") if mesh_path.stem == "skull" else mesh_path.stem
+        )
+    skull_id = safe_id(skull_id, "skull")
+    mesh = parse_mesh(mesh_path)
+    landmarks, sources = cranial_landmark_file(landmarks_path)
+    axes = parse_axes(axes_path)
+    return ParsedSkull(skull_id, mesh_path, landmarks_path, mesh, landmarks, sources, axes)
 
 
 def parse_axes(axes_path):
