@@ -59,8 +59,9 @@ def joint_overlay_name(photo_id):
 
 
 def write_joint_result(out_dir, result, skull, photos, overlay=True):
-    """Write a joint SFO's ``overlay_<photo id>.png`` per photo (the photo's plain image when
-    its camera failed), then its ``result.json`` (docs/method/joint.md).
+    """Write a joint SFO's files per photo, as :func:`write_sfo` writes a single one's: its
+    workbench page, then ``overlay_<photo id>.png`` (the photo's plain image when its camera
+    failed); then its ``result.json`` (docs/method/joint.md).
 
     As :func:`~lilium.io.results.write_result`: an earlier ``result.json`` and the overlays of
     an earlier SFO (:func:`~lilium.io.results.remove_overlays`, a single one's too) are removed
@@ -79,12 +80,12 @@ def write_joint_result(out_dir, result, skull, photos, overlay=True):
     written = {"result.json": out_dir / "result.json"}
     written["result.json"].unlink(missing_ok=True)
     remove_overlays(out_dir)
-    for single, photo in zip(result.photos, photos, strict=True):
+    for single, photo in zip(result.photos, photos, strict=True):  # as write_sfo's
+        _workbench(out_dir / joint_workbench_name(photo.id), skull, photo, single)
         if overlay:
             path = out_dir / joint_overlay_name(photo.id)
             write_png(path, result_overlay(single, skull, photo))
             written[photo.id] = path
-        _workbench(out_dir / joint_workbench_name(photo.id), skull, photo, single)
     write_json(written["result.json"], result.to_dict())
     return written
 
