@@ -248,3 +248,44 @@ def test_the_ridge_is_a_prior_worth_a_fixed_number_of_same_person_pairs():
     assert np.linalg.norm([default.weights[n] for n in noise]) < 0.9 * np.linalg.norm(
         [weak.weights[n] for n in noise]
     )
+
+
+def test_a_misfit_term_never_speaks_for_the_same_person():
+    """A term that measures a misfit (here the skull outside the head) keeps a weight at or
+    below 0 even where the training pairs would reward it (it rises with the same-person
+    pairs here): read beyond those pairs, such a weight would support a skull for leaving
+    the head. A reference term (the centred cohort's mean) is free either way."""
+    from lilium.identification.calibration import AGAINST
+
+    rng = np.random.default_rng(11)
+    pairs = _synthetic_pairs(rng)
+    for p in pairs:
+        lift = 1.0 if p["same"] else 0.0
+        p["terms"]["outside_fraction"] = 0.02 * (lift + rng.uniform())
+        p["terms"]["centred_mean"] = lift + rng.normal(0.0, 0.5)
+    model = fit([p["terms"] for p in pairs], [p["same"] for p in pairs])
+    assert "outside_fraction" in AGAINST and "centred_mean" not in AGAINST
+    assert model.weights["outside_fraction"] == pytest.approx(0.0, abs=1e-9)
+    assert model.weights["centred_mean"] > 0.1
+    assert model.weights["landmark_chi2"] < -0.1
+
+
+def test_a_missing_term_reads_as_neither_kind_of_pair():
+    """A term missing from a decision (a photo without P_pll) takes the value halfway between
+    the same-person and the different-person median, not the pooled median (a
+    different-person value, with 11 of them to each same-person pair here)."""
+    from lilium.identification.calibration import neutral_value
+
+    rng = np.random.default_rng(12)
+    pairs = _synthetic_pairs(rng)
+    for p in pairs:
+        p["terms"]["pll_face"] = float(np.expm1(rng.normal(0.5 if p["same"] else 2.5, 0.2)) / 10)
+    same = np.array([p["same"] for p in pairs])
+    model = fit([p["terms"] for p in pairs], same)
+    column = np.log1p(10 * np.array([p["terms"]["pll_face"] for p in pairs]))
+    assert model.fill["pll_face"] == pytest.approx(
+        0.5 * (np.median(column[same]) + np.median(column[~same])))
+    assert abs(model.fill["pll_face"] - 1.5) < 0.2  # the pooled median would be near 2.5
+    # Only one kind of pair holds the term: its median.
+    only_diff = np.where(same, np.nan, column)
+    assert neutral_value(only_diff, same) == pytest.approx(np.nanmedian(only_diff))

@@ -50,6 +50,12 @@ import numpy as np
 from .conclusion import UNDETERMINED, level
 from .terms import CALIBRATED_TERMS, DERIVED_TERMS
 
+#: The features that can only speak against the same person: each measures a misfit (the
+#: landmarks', the outline's, the camera's against its priors), so its weight is held at or
+#: below 0 in the fit (:func:`fit`).
+AGAINST = frozenset({"landmark_chi2", "outside_fraction", "pll_face", "prior_excess",
+                     "landmark_tension", "outside_refit", "landmark_worst", "landmark_cnorm"})
+
 #: The feature of :data:`VIEWS_TERMS`.
 VIEWS_LOG10_LR = "views_log10_lr"
 
@@ -332,6 +338,29 @@ def _read_warp(warp):
     return {"knots": knots.tolist(), "ln_lr": ln_lr.tolist()}
 
 
+def neutral_value(column, same):
+    """The value a missing feature takes: halfway between its same-person and its
+    different-person median (each class's median over the pairs where it is finite; the
+    pooled median when a class has none).
+
+    A missing term (no P_pll on a photo whose vault is cut, no mask) says nothing about the
+    pair, so it must read as neither class. The pooled median did not: with twenty
+    different-person pairs to each same-person one it is a different-person value, and every
+    decision missing a discriminating term was pushed towards exclusion.
+
+    Parameters
+    ----------
+    column : ndarray of shape (P,)
+        The feature (transformed), NaN or infinite where missing.
+    same : ndarray of bool, shape (P,)
+    """
+    finite = np.isfinite(column)
+    medians = [np.median(column[finite & m]) for m in (same, ~same) if (finite & m).any()]
+    if len(medians) < 2:
+        return float(np.median(column[finite]))
+    return float(0.5 * (medians[0] + medians[1]))
+
+
 def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, warp=False,
         keep_ranges=True):
     """Fit a :class:`Calibration` on term dictionaries and their labels.
@@ -369,7 +398,7 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, w
         if np.isfinite(col).sum() >= 2 and np.nanstd(np.where(np.isfinite(col), col, np.nan)) > 0:
             raw[name] = col
     used = tuple(raw)
-    fill = {n: float(np.nanmedian(np.where(np.isfinite(raw[n]), raw[n], np.nan))) for n in used}
+    fill = {n: neutral_value(raw[n], same) for n in used}
     X = features(terms_list, used, fill)
     # Measured on the terms as given (a missing term is not at its median for the range).
     ranges = feature_ranges(np.column_stack([raw[n] for n in used]), same)
@@ -390,7 +419,8 @@ def fit(terms_list, same, names=CALIBRATED_TERMS, provenance=None, ridge=None, w
 
     from scipy.optimize import minimize  # 0.12 s to import: fitting only, not scoring
 
-    p = minimize(loss, np.zeros(len(used) + 1), jac=True, method="L-BFGS-B").x
+    bounds = [(None, 0.0) if n in AGAINST else (None, None) for n in used] + [(None, None)]
+    p = minimize(loss, np.zeros(len(used) + 1), jac=True, method="L-BFGS-B", bounds=bounds).x
     # Fitted with the classes weighing half each, the logit is the natural-log LR itself.
     warped = bigaussian_warp(Z @ p[:-1] + p[-1], same) if warp else None
     # Stored with the training prior's log odds, as :meth:`Calibration.log10_lr` reads it.
