@@ -7,7 +7,8 @@ of Cllr; with the pairs' own 1:20 prior the fit served the different-person pair
 calibrated the same-person ones worse: Cllr 0.675 -> 0.654 frontal, 0.620 -> 0.561 lateral
 on 40 generated subjects). Its log LR is the posterior log odds minus the prior log odds:
 ``log10 LR = (w . x + b - ln(n_same / n_diff)) / ln 10``, ``b`` stored with the training
-prior.
+prior. The weights of the misfit terms (:data:`AGAINST`) are held at or below 0, and a missing
+term reads as neither kind of pair (:func:`neutral_value`).
 A model is fitted per method, variant and view (``frontal``, ``lateral``, ``joint``), and one
 per method and variant for a frontal and a lateral photo's separate SFOs: the same logistic
 regression on one feature, the sum of the two photos' log10 LRs (:data:`VIEWS_TERMS`), which
@@ -129,9 +130,9 @@ def _column(terms_list, name):
 def features(terms_list, names, fill):
     """Feature matrix ``(P, len(names))`` of several term dictionaries.
 
-    A term that is None (its input missing) or not finite takes ``fill[name]``, the feature's
-    training median; a landmark term of ``inf`` (a landmark behind the camera) takes the
-    largest finite value instead.
+    A term that is None (its input missing) or not finite takes ``fill[name]``, the
+    feature's neutral value (:func:`neutral_value`); a landmark term of ``inf`` (a landmark
+    behind the camera) takes the largest finite value instead.
     """
     X = np.empty((len(terms_list), len(names)))
     for j, name in enumerate(names):
@@ -153,7 +154,7 @@ class Calibration:
     names : tuple of str
         The terms used (those that vary in the training data).
     centre, scale, fill : dict of str -> float
-        Standardisation and the value of a missing term (training median of the feature).
+        Standardisation and the value of a missing term (:func:`neutral_value`).
     weights : dict of str -> float
         On the standardised features.
     intercept : float
@@ -209,7 +210,7 @@ class Calibration:
         """The features of one decision's term dictionary that lie outside
         :attr:`ranges`: ``[(name, value, (lo, hi)), ...]`` in the model's order, empty when
         every feature is inside (or the model has no ranges). A missing term takes the
-        training median and is never outside; one of ``inf`` (a landmark behind the camera)
+        neutral value and is never outside; one of ``inf`` (a landmark behind the camera)
         is."""
         if not self.ranges:
             return []
