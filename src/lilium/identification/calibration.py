@@ -51,9 +51,8 @@ import numpy as np
 from .conclusion import UNDETERMINED, level
 from .terms import CALIBRATED_TERMS, DERIVED_TERMS
 
-#: The features that can only speak against the same person: each measures a misfit (the
-#: landmarks', the outline's, the camera's against its priors), so its weight is held at or
-#: below 0 in the fit (:func:`fit`).
+#: The features that measure a misfit (the landmarks', the outline's, the camera's against its
+#: priors): their weights are held at or below 0 in the fit (:func:`fit`).
 AGAINST = frozenset({"landmark_chi2", "outside_fraction", "pll_face", "prior_excess",
                      "landmark_tension", "outside_refit", "landmark_worst", "landmark_cnorm"})
 
@@ -341,13 +340,9 @@ def _read_warp(warp):
 
 def neutral_value(column, same):
     """The value a missing feature takes: halfway between its same-person and its
-    different-person median (each class's median over the pairs where it is finite; the
-    pooled median when a class has none).
-
-    A missing term (no P_pll on a photo whose vault is cut, no mask) says nothing about the
-    pair, so it must read as neither class. The pooled median did not: with twenty
-    different-person pairs to each same-person one it is a different-person value, and every
-    decision missing a discriminating term was pushed towards exclusion.
+    different-person median over the pairs where it is finite (the pooled median when a class
+    has none). A missing term says nothing about the pair, so it reads as neither class; the
+    pooled median, a different-person value, pushed such decisions towards exclusion.
 
     Parameters
     ----------
