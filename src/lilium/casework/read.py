@@ -8,6 +8,7 @@ after that but the resume machinery (:mod:`~lilium.casework.folders`).
 """
 
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 from ..inputs import CaseWarning
 from ..io.calibration import Calibrations
@@ -112,9 +113,9 @@ def read_case(request, log=None, out=None, plan=False):
         # The table checked, and its warning ``implausible_depth`` when some of its mean depths
         # are implausible put into the photos (a photo's warnings are its results'): into the
         # result of every SFO that uses it.
-        source = str(request.depth_table)
-        options = replace(options, depth_table=check_depth_table(table, source=source))
-        message = depth_table_warning(options.depth_table, source)
+        table = check_depth_table(table, source=str(Path(request.depth_table)))
+        options = replace(options, depth_table=table)
+        message = depth_table_warning(table, str(request.depth_table))
         if message:
             warning = CaseWarning("implausible_depth", message)
             records = [
