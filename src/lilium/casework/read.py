@@ -8,15 +8,16 @@ after that but the resume machinery (:mod:`~lilium.casework.folders`).
 """
 
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 from ..inputs import CaseWarning
 from ..io.calibration import Calibrations
-from ..io.case import read_depth_table
+from ..io.case import parse_depth_table
 from ..io.results import read_camera
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
 from ..methods.registry import check_runnable
-from ..softtissue.depths import depth_table_warning
+from ..softtissue.depths import check_depth_table, depth_table_warning
 from .inputs import load_photos, load_skull
 
 
@@ -95,10 +96,9 @@ def read_case(request, log=None, out=None, plan=False):
         for r, s in zip(records, request.photos, strict=True)
     ]
     candidates = tuple((c.name, tuple(photos_of(c.photos))) for c in request.candidates)
-    options = request.options
-    if request.depth_table is not None:
-        options, photos = with_depth_table(options, request.depth_table, [r.photo for r in records])
-        records = [r._replace(photo=p) for r, p in zip(records, photos, strict=True)]
+    # The request's tables, parsed together: its depth table (checked once the photos are) and
+    # its calibration models.
+    table = None if request.depth_table is None else parse_depth_table(request.depth_table)
     calibrations = Calibrations(request.calibration)
     for record in [*records, *(r for _, rs in candidates for r in rs)]:
         check_inputs(skull, record.photo)
@@ -106,27 +106,23 @@ def read_case(request, log=None, out=None, plan=False):
     for record in records if plan else ():
         photo_file = record.inputs.get("facial landmarks") or record.inputs.get("photo.json")
         terms_off[record.photo.id] = check_runnable(
-            skull, record.photo, request.methods, options.variant, photo_file
+            skull, record.photo, request.methods, request.options.variant, photo_file
         )
+    options = request.options
+    if table is not None:
+        # The table checked, and its warning ``implausible_depth`` when some of its mean depths
+        # are implausible put into the photos (a photo's warnings are its results'): into the
+        # result of every SFO that uses it.
+        table = check_depth_table(table, source=str(Path(request.depth_table)))
+        options = replace(options, depth_table=table)
+        message = depth_table_warning(table, str(request.depth_table))
+        if message:
+            warning = CaseWarning("implausible_depth", message)
+            records = [
+                r._replace(photo=replace(r.photo, warnings=(*r.photo.warnings, warning)))
+                for r in records
+            ]
     return CaseInputs(
         skull, skull_inputs, tuple(records), candidates, options, calibrations, terms_off
     )
 
-
-def with_depth_table(options, path, photos):
-    """``options`` with the depth table read from ``path``, and ``photos`` with its warning
-    ``implausible_depth`` when some of its mean depths are implausible
-    (:func:`~lilium.softtissue.depths.depth_table_warning`): the table's warning goes into the
-    result of every SFO that uses it (a photo's warnings are its results').
-
-    Returns
-    -------
-    options : SfoOptions
-    photos : list of Photo
-    """
-    table = read_depth_table(path)
-    message = depth_table_warning(table, str(path))
-    if message:
-        warning = CaseWarning("implausible_depth", message)
-        photos = [replace(p, warnings=(*p.warnings, warning)) for p in photos]
-    return replace(options, depth_table=table), list(photos)

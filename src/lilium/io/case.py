@@ -38,6 +38,7 @@ __all__ = [
     "cranial_landmark_file",
     "parse_cranial_landmarks",
     "parse_facial_landmarks",
+    "parse_depth_table",
     "read_depth_table",
     "read_face_curve",
     "read_image",
@@ -305,12 +306,30 @@ def parse_facial_landmarks(folder, meta_path, meta):
 
 
 def read_depth_table(path):
-    """Read a user's soft-tissue depth table (CSV with ``landmark,mean,sd,min,max``, mm).
+    """Read a user's soft-tissue depth table (CSV with ``landmark,mean,sd,min,max``, mm) and
+    check it (:func:`~lilium.softtissue.depths.check_depth_table`).
 
     Returns
     -------
     dict of str -> DepthStats
         Keyed by cranial base name; see :func:`lilium.softtissue.check_depth_table`.
+    """
+    return check_depth_table(parse_depth_table(path), source=str(path))
+
+
+def parse_depth_table(path):
+    """Parse a user's soft-tissue depth table (CSV with ``landmark,mean,sd,min,max``, mm), its
+    values not yet checked (:func:`read_depth_table` checks them).
+
+    Returns
+    -------
+    dict of str -> DepthStats
+        Keyed by the landmark column, stripped.
+
+    Raises
+    ------
+    ValueError
+        No such file, a header without those columns, a value that is not a number.
     """
     path = Path(path)
     if not path.is_file():
@@ -329,7 +348,7 @@ def read_depth_table(path):
                     f"{path}: line {line}: mean, sd, min and max must be numbers"
                 ) from None
             table[(row["landmark"] or "").strip()] = stats
-    return check_depth_table(table, source=str(path))
+    return table
 
 
 def _image_of(path):
