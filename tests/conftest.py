@@ -1,6 +1,14 @@
+import signal
+
 import pytest
 
 from standin_case import make_standin_case
+
+# A pytest started in the background of a non-interactive shell (``cmd &``) inherits SIGINT
+# ignored, and so would every command the tests start: the Ctrl-C tests would then see no
+# interrupt at all. A handler (not the ignored disposition) is what a started command resets.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(autouse=True)
