@@ -327,8 +327,9 @@ def headsq_conclusions(out_dir, calibration, other_skull, file=sys.stdout):
     pair's conclusion. Skipped without the CT."""
     from headsq_case import build_headsq_dataset
     from lilium.casework.case import run_case
-    from lilium.casework.identify import Calibrations, decide
+    from lilium.casework.identify import decide
     from lilium.casework.request import CaseRequest, PhotoSource, SkullSource
+    from lilium.io.calibration import Calibrations
 
     root = build_headsq_dataset(Path(out_dir) / "dataset", 1, 0, variants=("hq", "hq_nm"))
     if root is None:

@@ -80,9 +80,10 @@ def run_pairs(datasets, out, n_photos, log=print):
         skull ``outside`` (:func:`lilium.identification.score.outside_depths`).
     """
     from lilium.casework.case import run_case
-    from lilium.casework.identify import Calibrations, decide
+    from lilium.casework.identify import decide
     from lilium.casework.request import CaseRequest, PhotoSource, SkullSource
     from lilium.identification.score import outside_depths
+    from lilium.io.calibration import Calibrations
 
     calibrations = Calibrations()
     skulls = {sid: (head, datasets[head] / "subjects" / sid)

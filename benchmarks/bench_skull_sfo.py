@@ -30,9 +30,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent / "datasets"))
 
 from bench_real_anatomy import HEADS, photo_pairs, real_datasets  # noqa: E402
 from lilium.casework.case import run_case  # noqa: E402
-from lilium.casework.identify import Calibrations, decide  # noqa: E402
+from lilium.casework.identify import decide  # noqa: E402
 from lilium.casework.request import CaseRequest, PhotoSource, SkullSource  # noqa: E402
 from lilium.demo import ground_truth_bpe  # noqa: E402
+from lilium.io.calibration import Calibrations  # noqa: E402
 from lilium.skull.prepare import prepare_skull  # noqa: E402
 
 

@@ -126,7 +126,8 @@ def main(argv=None):
 
 def identify_paths(root, paths, seed):
     """Each path's identification: every photo against every skull, ranked by log10 LR."""
-    from lilium.casework.identify import Calibrations, decide
+    from lilium.casework.identify import decide
+    from lilium.io.calibration import Calibrations
 
     calibrations = Calibrations()
     photos = [(label, photo, truth) for label, _, photo, truth, _ in cases(root, 0, 0.0)]

@@ -9,10 +9,11 @@ import json
 import numpy as np
 import pytest
 
-from lilium.casework.identify import Calibrations, conclusion_line, decide
+from lilium.casework.identify import conclusion_line, decide
 from lilium.cli.main import main
 from lilium.geometry.camera import Camera
 from lilium.identification.conclusion import conclude, level, material_caps
+from lilium.io.calibration import Calibrations
 from standin_case import scaled_photo
 
 

@@ -10,9 +10,8 @@ from dataclasses import replace
 
 from ..identification.conclusion import NO_SUPPORT_CAPS
 from ..identification.decision import identify
-from ..io.calibration import Calibrations
 
-__all__ = ["Calibrations", "conclusion_line", "decide", "with_identification"]
+__all__ = ["conclusion_line", "decide", "with_identification"]
 
 
 def decide(skull, photos, results, calibrations, facial_landmarks_mm=None, joint=False):
