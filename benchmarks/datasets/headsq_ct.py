@@ -27,6 +27,15 @@ What is built here, all through the project's own code:
    module's docstring; each one a vertex of its mesh); the true soft tissue of each pair is
    ``F - C``: ``soft_tissue_axes.json`` holds its direction (like the generator's true axes),
    ``subject.json`` its depth.
+4. The head continued above the cut: the skin's lid (its vertices within :data:`LID_BAND_MM` of
+   its top, the flat cap marching cubes closes the cut with) raised into a dome, each vertex by
+   ``DOME_MM * sqrt(1 - r^2)`` with ``r`` its place in the lid's ellipse (0 at the centre, 1 on
+   the rim; the half-widths of the lid in x and z): a photo shows the whole head, and a skull
+   cut above the orbits lies well inside its outline. Cut flat at the skull's own cut (0.4 mm
+   above it), the outline had no margin there: a camera refitted to a lateral photo's 5-9
+   landmarks put the skull's cut rim 8-15 % of its pixels above the head (``outside_refit``,
+   2026-12-07), which no photo of a person shows. :data:`DOME_MM` is the head's height above
+   the cut, about: the vault rises 70-90 mm above the brows' level.
 """
 
 import os
@@ -54,6 +63,10 @@ CHIN_SLICES_FROM = 75  # the vertebrae, medial of the mandible's rami
 TUBE_SLICES_FROM = 64
 TUBE_ROWS_BEFORE = 22
 TUBE_COLUMNS = (20, 44)
+
+#: The skin's lid: its vertices this close to its top (mm); the dome's height over its centre.
+LID_BAND_MM = 0.6
+DOME_MM = 70.0
 
 #: LPS -> generator skull frame (x = left, y = up, z = anterior): a proper rotation.
 LPS_TO_SKULL = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
@@ -139,6 +152,18 @@ def true_soft_tissue(skull, skull_f, cranial, facial):
     return axes, depths, landmark_normals(skull, skull_f, cranial)
 
 
+def _domed(skin):
+    """The skin (V, 3) with its flat lid raised into a dome (module notes, 4)."""
+    lid = skin[:, 1] > skin[:, 1].max() - LID_BAND_MM
+    xz = skin[lid][:, [0, 2]]
+    centre = 0.5 * (xz.min(axis=0) + xz.max(axis=0))
+    half = 0.5 * (xz.max(axis=0) - xz.min(axis=0))
+    r2 = np.clip((((xz - centre) / half) ** 2).sum(axis=1), 0.0, 1.0)
+    out = skin.copy()
+    out[lid, 1] += DOME_MM * np.sqrt(1.0 - r2)
+    return out
+
+
 _CACHE = {}
 
 
@@ -166,6 +191,7 @@ def headsq_subjects(path=None, work_dir=None):
         return v @ LPS_TO_SKULL.T - origin
 
     skull, skin, nm = frame(skull), frame(skin), frame(nm)
+    skin = _domed(skin)  # the head goes on above the cut (module notes, 4)
     # mandible vertices: complete-skull vertices with no cranium vertex within 2 mm
     mandible_mask = cKDTree(nm).query(skull)[0] > 2.0
     mandible_mask &= skull[:, 1] < np.percentile(skull[:, 1], 60)
