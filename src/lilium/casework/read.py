@@ -84,8 +84,8 @@ def read_case(request, log=None, out=None, plan=False):
         photo given twice, by path or by the image's bytes; an unknown method or variant;
         ``--joint`` with fewer than two photos or no joint method), the depth table and the
         calibration files, then a skull or a photo that cannot be read, mirrored
-        left/right labels (:func:`~lilium.methods.checks.check_inputs`), a depth table or a
-        calibration file that cannot be read; with ``plan``, landmarks that do not pair.
+        left/right labels (:func:`~lilium.methods.checks.check_inputs`); with ``plan``,
+        landmarks that do not pair.
     """
     # The request itself, and its small files, before the skull and the photos: the photos
     # given once each, the methods known, the depth table and the calibration models parsed.
