@@ -5,13 +5,12 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..inputs import GivenCamera
-from ..io.case import check_distinct_photos
 from ..io.paths import safe_id
-from ..methods.registry import check_method, method_tag, run_sfo
+from ..methods.registry import method_tag, run_sfo
 from .console import log_warnings, status_text
 from .folders import output_lock, resumed_sfo, sfo_fingerprint, sfo_outputs
 from .identify import conclusion_line, decide
-from .joint_case import check_joint_case, joint_entry, run_joint_methods
+from .joint_case import joint_entry, run_joint_methods
 from .prepared import check_photo_extra
 from .read import read_case
 
@@ -108,14 +107,8 @@ def run_case(request, log=print):
     from ..report.html import write_report
 
     methods, seed = list(request.methods), request.seed
-    paths = [source.path for source in request.photos]
-    check_distinct_photos(paths)  # each photo given once, by path and by the image's bytes
-    for method in methods:
-        check_method(method, request.options.variant)
     if request.auto_landmarks:
         check_photo_extra()
-    if request.joint:
-        check_joint_case(paths, methods)
     out = Path(request.out)
     with output_lock(out):
         inputs = read_case(request, log=log, out=out, plan=True)

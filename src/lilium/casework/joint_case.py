@@ -25,28 +25,6 @@ from .identify import conclusion_line, with_identification
 from .inputs import JOINT_FOLDER
 
 
-def check_joint_case(photos, methods):
-    """Refuse a ``--joint`` case that cannot run, before any file is read (a photo given
-    twice is refused for every case, :func:`~lilium.io.case.check_distinct_photos`).
-
-    Raises
-    ------
-    ValueError
-        Fewer than two photos, no method with a joint form among ``methods``.
-    """
-    if len(photos) < 2:
-        raise ValueError(
-            f"--joint needs two or more --photo of the same person, got {len(photos)}; drop "
-            "--joint for one photo"
-        )
-    if not any(METHODS[m].run_joint is not None for m in methods):
-        joint = [name for name, m in METHODS.items() if m.run_joint is not None]
-        raise ValueError(
-            f"--joint: none of the methods ({', '.join(methods)}) has a joint SFO; add --method "
-            f"{' or --method '.join(joint)}"
-        )
-
-
 def run_joint_methods(inputs, methods, seed, out, log=print):
     """Run every joint-capable method of ``methods`` once on all the photos; write each.
 

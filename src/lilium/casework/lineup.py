@@ -25,7 +25,7 @@ from pathlib import Path
 from ..io.case import repeated_photo
 from ..io.jsonio import write_json
 from ..io.paths import printable, safe_id
-from ..methods.registry import check_method, method_tag, run_sfo
+from ..methods.registry import method_tag, run_sfo
 from .folders import (
     output_lock,
     resumed_sfo,
@@ -120,8 +120,6 @@ def run_lineup(request, log=print):
     candidates = [(c.name, [source.path for source in c.photos]) for c in request.candidates]
     check_candidates(candidates)
     methods, seed = list(request.methods), request.seed
-    for method in methods:
-        check_method(method, request.options.variant)
     out = Path(request.out)
     inputs = read_case(request, log=log)  # every input checked before the first SFO
     with output_lock(out):

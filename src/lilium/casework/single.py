@@ -3,8 +3,7 @@
 joint SFO of two or more photos of one person (:func:`joint_sfo`).
 """
 
-from ..io.case import check_distinct_photos
-from ..methods.registry import check_joint_method, check_method, run_joint_sfo, run_sfo
+from ..methods.registry import check_joint_method, run_joint_sfo, run_sfo
 from .folders import write_joint_result, write_sfo
 from .identify import with_identification
 from .read import read_case
@@ -41,7 +40,6 @@ def single_sfo(request, log=None):
         An invalid input (naming the file), including mirrored skull or photo labels.
     """
     (method,) = request.methods
-    check_method(method, request.options.variant)
     inputs = read_case(request, log=log)
     skull, (record,) = inputs.skull, inputs.records
     photo = record.photo
@@ -77,7 +75,6 @@ def joint_sfo(request, log=None):
             "--camera scores one photo's camera: give one --photo with it (lilium sfo), or "
             "use lilium case, which scores each photo's --camera beside its SFO"
         )
-    check_distinct_photos([source.path for source in request.photos])
     inputs = read_case(request, log=log)
     skull, photos = inputs.skull, inputs.photos
     result = run_joint_sfo(method, skull, photos, inputs.options, request.seed)

@@ -149,6 +149,27 @@ def check_joint_method(method, variant=None):
     return m
 
 
+def check_joint_methods(methods, n_photos):
+    """Refuse a joint case (``lilium case --joint``) that cannot run, before any file is read.
+
+    Raises
+    ------
+    ValueError
+        Fewer than two photos, or no method with a joint form among ``methods``.
+    """
+    if n_photos < 2:
+        raise ValueError(
+            f"--joint needs two or more --photo of the same person, got {n_photos}; drop "
+            "--joint for one photo"
+        )
+    if not any(METHODS[m].run_joint is not None for m in methods):
+        joint = [name for name, m in METHODS.items() if m.run_joint is not None]
+        raise ValueError(
+            f"--joint: none of the methods ({', '.join(methods)}) has a joint SFO; add --method "
+            f"{' or --method '.join(joint)}"
+        )
+
+
 def run_joint_sfo(method, skull, photos, options=SfoOptions(), seed=0):
     """Run one joint SFO: several photos of one person, one shared soft tissue
     (docs/method/joint.md).
