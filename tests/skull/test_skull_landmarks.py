@@ -43,8 +43,9 @@ def test_placement_on_a_generated_skull(skull):
 
 
 def test_invariant_to_a_rigid_motion(skull):
-    """The same accuracy after a random rigid motion (the fit starts from another pose, so the
-    points move by a fraction of a mm, not nothing)."""
+    """The same points after a random rigid motion: the fit's turns start from a direction of
+    the mesh itself (its principal axis in the mirror plane), not from a coordinate axis, so a
+    moved mesh gets the same fit and the same landmarks, moved (to rounding)."""
     from scipy.spatial.transform import Rotation
 
     v, f, truth, result = skull
@@ -53,6 +54,9 @@ def test_invariant_to_a_rigid_motion(skull):
     moved = locate_skull_landmarks(v @ R.T + t, f)
     assert moved.mandible
     back = {n: R.T @ (p - t) for n, p in moved.landmarks.items()}
+    assert moved.quality == result.quality
+    for name, p in result.landmarks.items():
+        assert np.linalg.norm(back[name] - p) < 1e-6, name
     errors = {n: np.linalg.norm(back[n] - truth[n]) for n in truth}
     located = [errors[n] for n in truth if moved.quality[n] == "located"]
     assert np.median(located) <= LOCATED_MEDIAN_MM
