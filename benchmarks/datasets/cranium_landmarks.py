@@ -56,9 +56,12 @@ Cranial landmarks:
   number 1, 2 and 3 mm inside the surface (along -z) reaches 1900 HU (enamel; the alveolar bone
   and the roots stay below 1850 here); ``subspinale``: the midline profile point between ANS
   and prosthion farthest behind their chord (the deepest point of the concavity);
-- ``zygion``: the skull vertex of largest |x| at most 20 mm below and 5 mm above ``orbitale``,
-  5-50 mm behind ``ectoconchion`` (the arch);
-- ``frontotemporale``: the support point of the frontal bone in the direction
+- ``zygion``: the most lateral (largest |x|) skull point at most 20 mm below and 5 mm above
+  ``orbitale``, 5-50 mm behind ``ectoconchion`` (the arch); like every extreme point here taken
+  at the centre of its plateau (``lilium.skull.rules.plateau_point``: the vertices within 0.5 mm
+  of the extreme), not the single farthest vertex, which on the flat arch wanders along it
+  (zygion_r moved 4.5 mm, z 39.9 -> 35.7, zygion_l and frontotemporale_l 1.2 mm);
+- ``frontotemporale``: the support point (its plateau's centre) of the frontal bone in the direction
   ``(+-1, 0, 0.8)`` (the anterolateral corner where the temporal line turns, the generator's
   direction) among the skull vertices 15-21 mm above the superior orbital margin, 25-60 mm off
   the midline, in front of ``ectoconchion``;
@@ -121,6 +124,7 @@ from frontal_maps import (
     _orbit_landmarks,
     _over,
 )
+from lilium.skull.rules import plateau_point
 
 ENAMEL_HU = 1900.0
 ENAMEL_PROBE_MM = (1.0, 2.0, 3.0)
@@ -219,7 +223,7 @@ def _zygion_frontotemporale(skull, cranial, top_y, x_mid):
             & (skull[:, 2] < e[2] - 5.0)
             & (skull[:, 2] > e[2] - 50.0)
         ]
-        out[f"zygion_{side}"] = c[np.argmax(sign * (c[:, 0] - x_mid))].copy()
+        out[f"zygion_{side}"] = plateau_point(c, np.array([sign, 0.0, 0.0]))
         off = sign * (skull[:, 0] - x_mid)
         c = skull[
             (skull[:, 1] > top_y + 15.0)
@@ -228,8 +232,8 @@ def _zygion_frontotemporale(skull, cranial, top_y, x_mid):
             & (off < 60.0)
             & (skull[:, 2] > e[2])
         ]
-        score = sign * (c[:, 0] - x_mid) + 0.8 * c[:, 2]
-        out[f"frontotemporale_{side}"] = c[np.argmax(score)].copy()
+        direction = np.array([sign, 0.0, 0.8]) / np.hypot(1.0, 0.8)
+        out[f"frontotemporale_{side}"] = plateau_point(c, direction)
     return out
 
 

@@ -50,8 +50,10 @@ ectoconchion, 20.5 mm at alare).
   the angle). Before, "the largest -y - z in the posterior 35 %" fell on the body's lower
   border (go-go 67.4 mm): in this CT's frame the head is bent forward and the lower border
   runs 40 degrees from the horizontal;
-- ``zygion``: the cranium vertex of largest |x| at most 20 mm below and 5 mm above
-  ``orbitale``, 5-50 mm behind ``ectoconchion``.
+- ``zygion``: the most lateral (largest |x|) cranium point at most 20 mm below and 5 mm above
+  ``orbitale``, 5-50 mm behind ``ectoconchion``, at the centre of its plateau
+  (``lilium.skull.rules.plateau_point``: the single farthest vertex of a flat arch wanders
+  along it; zygion_l moved 3.5 mm, zygion_r not at all).
 
 Facial (skin) landmarks; "over C along d": the skin vertex within 2 mm of the ray
 ``C + t d``, ``0 < t < 35 mm`` (the radius grows by 1 mm until there is one), the first one
@@ -100,6 +102,7 @@ from frontal_maps import (
     _orbit_landmarks,
     _over,
 )
+from lilium.skull.rules import plateau_point
 
 #: Orbit candidates: deep regions whose centroid lies this far off the bounding box's centre.
 ORBIT_OFF_MIDLINE_MM = 12.0
@@ -237,7 +240,7 @@ def place_landmarks(skull, skull_faces, skin, skin_faces, mandible_mask):
             & (cranium[:, 2] < e[2] - 5.0)
             & (cranium[:, 2] > e[2] - 50.0)
         ]
-        cranial[f"zygion_{side}"] = c[np.argmax(sign * c[:, 0])]
+        cranial[f"zygion_{side}"] = plateau_point(c, np.array([sign, 0.0, 0.0]))
 
     # facial
     normals = landmark_normals(skull, skull_faces, cranial)

@@ -126,7 +126,7 @@ def _midline(section, on_mandible, est, anchors):
                         centre + CHIN_MM)  # fmt: skip
         if len(prof):
             top = prof[np.argmax(prof[:, 1])]
-            p = _plateau(prof, np.array([0.0, 0.0, 1.0]))
+            p = plateau_point(prof, np.array([0.0, 0.0, 1.0]))
             if top[1] - p[1] < CHIN_EDGE_MM:  # the window's top, no bulge: a receding chin
                 p = _behind_chord(prof, top, menton, posterior=False)
             out["pogonion"] = p
@@ -135,7 +135,7 @@ def _midline(section, on_mandible, est, anchors):
             < GNATHION_SPAN_MM
         ]
         if "gnathion" in est and len(chin):
-            out["gnathion"] = _plateau(chin, np.array([0.0, -1.0, 1.0]) / np.sqrt(2))
+            out["gnathion"] = plateau_point(chin, np.array([0.0, -1.0, 1.0]) / np.sqrt(2))
     return out
 
 
@@ -193,9 +193,12 @@ def _alare(fm, centre, sx):
     return best
 
 
-def _plateau(points, direction):
-    """The point of ``points`` nearest to the centre of those within :data:`PLATEAU_MM` of
-    the extreme along ``direction``."""
+def plateau_point(points, direction):
+    """The extreme point of ``points`` (N, 3) along the unit ``direction``, taken at the centre
+    of its plateau: the point nearest to the centre of those within :data:`PLATEAU_MM` of the
+    extreme. On a flat stretch (a zygomatic arch seen from the side) the single farthest vertex
+    wanders by centimetres with a fraction of a degree of pose; the plateau's centre does not.
+    The benchmarks' hand placements take their extreme points the same way."""
     h = points @ direction
     top = points[h >= h.max() - PLATEAU_MM]
     return points[np.argmin(np.linalg.norm(points - top.mean(axis=0), axis=1))].copy()
@@ -206,7 +209,7 @@ def _support(vertices, mask, centre, radius, direction):
     if not near.any():
         return None
     d = np.asarray(direction, float)
-    return _plateau(vertices[near], d / np.linalg.norm(d))
+    return plateau_point(vertices[near], d / np.linalg.norm(d))
 
 
 def apply_rules(vertices, faces, on_mandible, estimates, anchors):
@@ -250,7 +253,7 @@ def apply_rules(vertices, faces, on_mandible, estimates, anchors):
                 np.abs(vertices[:, 2] - e[2]) < ZYGION_BOX_MM[1]
             )
             if (box & cranium).any():
-                out[name] = _plateau(vertices[box & cranium], np.array([sx, 0.0, 0.0]))
+                out[name] = plateau_point(vertices[box & cranium], np.array([sx, 0.0, 0.0]))
         extremes = (
             ("gonion", on_mandible, GONION_MM, GONION_DIRECTION),
             ("frontotemporale", cranium, FRONTOTEMPORALE_MM, FRONTOTEMPORALE_DIRECTION),
