@@ -150,7 +150,14 @@ def check_joint_method(method, variant=None):
 
 
 def check_joint_methods(methods, n_photos):
-    """Refuse a joint case (``lilium case --joint``) that cannot run, before any file is read.
+    """Refuse a joint case (``lilium case --joint``) that cannot run, before the skull and the
+    photos are read (:func:`lilium.casework.read.read_case`).
+
+    Parameters
+    ----------
+    methods : sequence of str
+        Keys of :data:`METHODS`.
+    n_photos : int
 
     Raises
     ------
