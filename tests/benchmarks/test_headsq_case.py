@@ -90,6 +90,23 @@ def test_landmarks_are_anatomically_ordered(case):
             assert p[2] > c[2], name
 
 
+def test_photos_show_a_whole_head(case):
+    """The CT's cut above the orbits is domed over in the skin (headsq_ct, module notes 4): the
+    skin rises DOME_MM above the cut skull at its top, and its rim stays where the cut was."""
+    from lilium.io.mesh import read_mesh
+
+    folder = case / "subjects" / "hq"
+    skull = read_mesh(folder / "skull.ply")[0]
+    skin = read_mesh(folder / "face.ply")[0]
+    rise = skin[:, 1].max() - skull[:, 1].max()
+    assert headsq_ct.DOME_MM - 2.0 < rise < headsq_ct.DOME_MM + 2.0
+    # the cut skull's rim lies inside the skin's outline seen from the front and the side
+    top = skull[skull[:, 1] > skull[:, 1].max() - 2.0]
+    near = skin[np.abs(skin[:, 1] - top[:, 1].mean()) < 3.0]
+    assert np.abs(top[:, 0]).max() < np.abs(near[:, 0]).max()
+    assert near[:, 2].min() < top[:, 2].min() and top[:, 2].max() < near[:, 2].max()
+
+
 def test_posest_sfo_recovers_the_frontal_camera(case, tmp_path, capsys):
     from lilium.cli.main import main
     from lilium.evaluation.metrics import back_projection_error_from_dicts
