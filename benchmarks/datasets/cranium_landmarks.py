@@ -57,7 +57,7 @@ Cranial landmarks:
   and the roots stay below 1850 here); ``subspinale``: the midline profile point between ANS
   and prosthion farthest behind their chord (the deepest point of the concavity);
 - ``zygion``: the most lateral (largest |x|) skull point at most 20 mm below and 5 mm above
-  ``orbitale``, 5-50 mm behind ``ectoconchion`` (the arch); like every extreme point here taken
+  ``orbitale``, 5-50 mm behind ``ectoconchion`` (the arch), taken, as ``frontotemporale`` is,
   at the centre of its plateau (``lilium.skull.rules.plateau_point``: the vertices within 0.5 mm
   of the extreme), not the single farthest vertex, which on the flat arch wanders along it
   (zygion_r moved 4.5 mm, z 39.9 -> 35.7, zygion_l and frontotemporale_l 1.2 mm);
