@@ -78,6 +78,9 @@ METHODS = {
     ),
 }
 
+#: The methods with a joint form (one SFO of several photos of one person).
+JOINT_METHODS = tuple(name for name, m in METHODS.items() if m.run_joint is not None)
+
 
 def check_method(method, variant=None):
     """Validate a method name (and variant); returns the :class:`Method`."""
@@ -141,9 +144,9 @@ def check_joint_method(method, variant=None):
     :class:`Method`."""
     m = check_method(method, variant)
     if m.run_joint is None:
-        joint = [name for name, other in METHODS.items() if other.run_joint is not None]
         raise ValueError(
-            f"method {method!r} has no joint SFO of several photos; use {', '.join(joint)}, or "
+            f"method {method!r} has no joint SFO of several photos; use "
+            f"{', '.join(JOINT_METHODS)}, or "
             "give one photo"
         )
     return m
@@ -169,11 +172,10 @@ def check_joint_methods(methods, n_photos):
             f"--joint needs two or more --photo of the same person, got {n_photos}; drop "
             "--joint for one photo"
         )
-    if not any(METHODS[m].run_joint is not None for m in methods):
-        joint = [name for name, m in METHODS.items() if m.run_joint is not None]
+    if not set(methods) & set(JOINT_METHODS):
         raise ValueError(
             f"--joint: none of the methods ({', '.join(methods)}) has a joint SFO; add --method "
-            f"{' or --method '.join(joint)}"
+            f"{' or --method '.join(JOINT_METHODS)}"
         )
 
 
