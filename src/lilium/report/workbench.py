@@ -258,5 +258,4 @@ def write_workbench(path, skull, photo, result, **kwargs):
 
     Keywords go to :func:`workbench_page`. Returns the path.
     """
-    page = workbench_page(skull, photo, result, **kwargs)
-    return write_page(path, page)
+    return write_page(path, workbench_page(skull, photo, result, **kwargs))
