@@ -162,7 +162,7 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     anchors = {k: v / fit.scale for k, v in template.anchors.items()}
     _, nearest = cKDTree(tpl).query(moved)
     on_mandible = template.mandible[nearest] if has_mandible else np.zeros(len(moved), bool)
-    located = apply_rules(moved, faces, on_mandible, found, anchors)
+    located = apply_rules(moved, faces, on_mandible, found, anchors, fit.scale)
     lap("rules")
     placed, quality = {}, {}
     for name in CRANIAL_NAMES:
