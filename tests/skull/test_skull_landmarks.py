@@ -45,6 +45,20 @@ def test_placement_on_a_generated_skull(skull):
         assert np.isclose(np.linalg.norm(axis), 1.0)
 
 
+def test_eye_corner_axes_lie_medial_of_the_bone_normal(skull):
+    """``lilium skull``'s axes in its fitted frame: the lateral eye corners' medial of the front
+    (the generator's own frame here: x left, z front), where the bone normal points away from
+    the midline (:func:`lilium.softtissue.normals.fitted_axes`)."""
+    from lilium.softtissue.normals import landmark_normals
+
+    v, f, _, result = skull
+    normals = landmark_normals(v, f, result.landmarks)
+    for name, sx in (("ectoconchion_l", 1.0), ("ectoconchion_r", -1.0)):
+        assert sx * result.axes[name][0] < -0.3 and result.axes[name][2] > 0.8, name
+        assert sx * normals[name][0] > 0, name
+    np.testing.assert_allclose(result.axes["nasion"], normals["nasion"])
+
+
 def test_invariant_to_a_rigid_motion(skull):
     """The same points after a random rigid motion: the fit's turns start from a direction of
     the mesh itself (its principal axis in the mirror plane), not from a coordinate axis, so a

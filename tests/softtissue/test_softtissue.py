@@ -117,3 +117,30 @@ def test_depth_table_checks():
         check_depth_table({"nose": DepthStats(1, 1, 0, 2)})
     with pytest.raises(ValueError, match="min <= mean <= max"):
         check_depth_table({"nasion": DepthStats(12, 1, 3, 10)})
+
+
+def test_fitted_axes_of_eye_corners_and_alae_lie_beside_the_normal():
+    """The eye corners' and the alae's axes in an oriented head: the offset along the head's lateral
+    direction, the rest of the mean depth to the front; every other landmark's is its normal,
+    and without the head's directions every axis is."""
+    import trimesh
+
+    from lilium.softtissue.normals import LATERAL_OFFSET_MM, fitted_axes
+
+    sphere = trimesh.creation.icosphere(subdivisions=4, radius=80.0)
+    v, f = sphere.vertices, sphere.faces
+    points = {"ectoconchion_l": v[5], "dacryon_r": v[40], "alare_l": v[60], "nasion": v[80]}
+    normals = landmark_normals(v, f, points)
+    left, anterior = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    axes = fitted_axes(v, f, points, left, anterior)
+    assert list(axes) == list(points)
+    np.testing.assert_allclose(axes["nasion"], normals["nasion"])
+    for name, lateral in (("ectoconchion_l", left), ("dacryon_r", -left), ("alare_l", left)):
+        base = name[:-2]
+        expected = LATERAL_OFFSET_MM[base] / BUILTIN_DEPTHS[base].mean_mm
+        assert np.isclose(axes[name] @ lateral, expected), name  # medial eye corner: < 0
+        assert axes[name] @ anterior > 0.8 and abs(axes[name][1]) < 1e-12, name
+    assert axes["ectoconchion_l"] @ left < 0 < axes["alare_l"] @ left
+    bare = fitted_axes(v, f, points)
+    for name in points:
+        np.testing.assert_allclose(bare[name], normals[name])

@@ -12,8 +12,9 @@ Stages (:func:`locate_skull_landmarks`, each timed in :attr:`SkullLandmarks.prof
    the fit checked (not a skull: an error);
 5. ``rules``: each landmark's own definition on the normalised mesh (:mod:`lilium.skull.rules`):
    quality ``"located"``; where a rule finds nothing, the transfer stays, ``"template"``;
-6. ``axes``: the outward surface normals at the landmarks
-   (:func:`lilium.softtissue.normals.landmark_normals`, the default axes of ``lilium case``).
+6. ``axes``: the cone axes at the landmarks in the fitted frame
+   (:func:`lilium.softtissue.normals.fitted_axes`: the outward surface normals, ``lilium
+   case``'s default, but the eye corners' and the alae's, which lie beside them).
 
 Landmarks given (``keep``, e.g. reviewed ones) are kept as they are and not placed again.
 """
@@ -114,7 +115,7 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     """
     from scipy.spatial import cKDTree
 
-    from ..softtissue.normals import landmark_normals
+    from ..softtissue.normals import fitted_axes
     from .rules import apply_rules
 
     vertices = np.asarray(vertices, float)
@@ -173,7 +174,8 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
         elif name in found:
             placed[name], quality[name] = fit.to_mesh(found[name][None])[0], TEMPLATE
     with_axes = {n: p for n, p in placed.items() if n in CRANIAL_TO_FACIAL}
-    axes = landmark_normals(vertices, faces, with_axes) if with_axes else {}
+    to_mesh = fit.mesh2skull[:3, :3].T  # the fitted frame: x the head's left, z its front
+    axes = fitted_axes(vertices, faces, with_axes, to_mesh[:, 0], to_mesh[:, 2])
     lap("axes")
     return SkullLandmarks(
         placed, quality, axes, bool(has_mandible), mismatch, fit.mesh2skull, fit.scale,

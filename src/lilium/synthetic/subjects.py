@@ -24,7 +24,8 @@ targets, and finally corrected by small Gaussian bumps so that its zero level pa
 every target.
 
 ``soft_tissue_axes`` holds these true directions (the axes given to the methods; Exp. C perturbs
-them); ``bone_normals`` holds the default axes a method would compute from the skull mesh.
+them); ``bone_normals`` holds the default axes a method would compute from the skull mesh (the
+outward bone normals the directions are drawn about).
 
 Incomplete skulls (``make_subject(..., mandible=False)``): a skull found without its mandible.
 The person is the same (same shape, bone field, soft tissue, face and photos as with
