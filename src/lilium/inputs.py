@@ -31,7 +31,8 @@ class CaseWarning:
         ``exif_focal_unusable``, ``implausible_prior``, ``focal_cap``, ``chin_unconstrained``
         (no chin pair and no chin-jaw curve), ``unknown_key`` (a key of ``photo.json`` that
         Lilium does not read), ``mesh_part_left_out`` (parts of the skull mesh apart from the
-        skull, left out); docs/checks.md lists them all.
+        skull, left out), ``normal_axes`` (the eye corners' or the alae's cone axes left to
+        the bone normal); docs/checks.md lists them all.
     message : str
         What is wrong and what fixes it.
     """
@@ -61,7 +62,8 @@ class Skull:
         The cranial landmark file, named in the messages about its labels (None: unknown, the
         messages then name the skull).
     warnings : tuple of CaseWarning
-        Found while reading the skull (``mesh_part_left_out``); every result on it repeats them.
+        Found while reading the skull (``mesh_part_left_out``, ``normal_axes``); every result
+        on it repeats them.
     landmark_sources : dict of str -> str
         Who placed each cranial landmark: ``"located"`` or ``"template"`` for an automatic,
         unreviewed point (``lilium skull``), else ``"manual"`` (missing = manual).

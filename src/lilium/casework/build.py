@@ -40,8 +40,8 @@ from ..io.images import read_mask
 from ..io.keys import unknown_key_warnings
 from ..io.paths import path_id, safe_id
 from ..io.prepared import face_only_mask, written_by_lilium_photo
-from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from ..softtissue.normals import landmark_normals
+from ..softtissue.landmarks import CRANIAL_TO_FACIAL, base_name
+from ..softtissue.normals import LATERAL_OFFSET_MM, landmark_normals
 from ..validation import check_prior, is_real
 
 __all__ = [
@@ -112,7 +112,9 @@ def build_skull(parsed):
     """A :class:`Skull` built and checked from its parsed files.
 
     The surface cleaned (:func:`_skull_surface`), the axes missing from the file set to the
-    outward skull-surface normal, and the landmarks checked to lie on the mesh and to spread.
+    outward skull-surface normal (with warning ``normal_axes`` where the facial landmark lies
+    beside the bone's, :data:`~lilium.softtissue.normals.LATERAL_OFFSET_MM`: the eye corners and
+    the alae), and the landmarks checked to lie on the mesh and to spread.
 
     Parameters
     ----------
@@ -135,6 +137,14 @@ def build_skull(parsed):
     missing = [n for n in landmarks if n not in axes and n in CRANIAL_TO_FACIAL]
     if missing:
         axes.update(landmark_normals(vertices, faces, {n: landmarks[n] for n in missing}))
+    beside = [n for n in missing if base_name(n) in LATERAL_OFFSET_MM]
+    if beside:
+        warnings.append(CaseWarning("normal_axes", (
+            f"{mesh_path}: no soft-tissue axes for {', '.join(beside)}: their cone axes are the "
+            "bone normals, but on a real face the eye corners and the alae lie beside them "
+            "(on the real CT heads the true person's log10 LR came out 1.0 to 1.9 lower, "
+            "docs/method/identification.md); give --axes (lilium skull writes such axes)"
+        )))  # fmt: skip
     extent = np.ptp(vertices, axis=0).max()
     off_mesh = gaps_beyond(landmarks, vertices, faces, 0.1 * extent)
     if off_mesh:  # the first, in the file's order
