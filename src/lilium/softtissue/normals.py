@@ -13,8 +13,9 @@ lateral of the nasal aperture's margin (the nose some 10 mm wider than the apert
 axis is that offset along the head's lateral direction plus what is left of the built-in mean
 depth (:data:`~lilium.softtissue.depths.BUILTIN_DEPTHS`) towards the front. Measured on the two
 real CT heads of the benchmarks (the Cranium and headsq, their true axes from their own skin):
-the bone normal lies 13-107 degrees from the true axis at these landmarks (46-61 at
-ectoconchion), this axis 5-34 degrees; the other landmarks' normals 4-35 degrees. The generator
+the bone normal lies 13-107 degrees from the true axis at these landmarks (46-107 at
+ectoconchion), this axis 5-34 degrees; at the other landmarks the normal lies 4-53 degrees off
+(subspinale 13-53, prosthion 30-35: left to the normal, no guideline offset here). The generator
 builds its faces along the bone normals
 (:func:`lilium.synthetic.anatomy.soft_tissue.draw_soft_tissue`: its eye corners lie lateral of
 the orbits), so its subjects carry their own axes files.
