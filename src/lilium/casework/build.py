@@ -143,7 +143,8 @@ def build_skull(parsed):
             f"{mesh_path}: no soft-tissue axes for {', '.join(beside)}: their cone axes are the "
             "bone normals, but on a real face the eye corners and the alae lie beside them "
             "(on the real CT heads the true person's log10 LR came out 1.0 to 1.9 lower, "
-            "docs/method/identification.md); give --axes (lilium skull writes such axes)"
+            "docs/method/identification.md); give --axes: `lilium skull MESH --landmarks "
+            "FILE --out DIR` keeps your landmarks and writes them to DIR/soft_tissue_axes.json"
         )))  # fmt: skip
     extent = np.ptp(vertices, axis=0).max()
     off_mesh = gaps_beyond(landmarks, vertices, faces, 0.1 * extent)
