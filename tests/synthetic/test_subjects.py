@@ -174,3 +174,21 @@ def test_shape_priors_cover_every_parameter_and_bound_the_draws():
         for name, value in asdict(draw_shape(seed)).items():
             prior = SHAPE_PRIORS[name]
             assert prior.lo <= value <= prior.hi, name
+
+
+def test_a_skull_without_eye_corner_axes_is_warned(tmp_path, subjects):
+    """A subject folder without axes is read with the bone normals (the file contract's default)
+    and warning ``normal_axes`` naming the eye corners' and the alae's landmarks; with its axes
+    file, no warning."""
+    from lilium.casework.build import read_skull
+
+    s = subjects[0]
+    folder = write_subject(tmp_path / s.subject_id, s)
+    assert not [w for w in read_skull(folder).warnings if w.code == "normal_axes"]
+    (folder / "soft_tissue_axes.json").unlink()
+    skull = read_skull(folder)
+    (warning,) = [w for w in skull.warnings if w.code == "normal_axes"]
+    for name in ("ectoconchion_l", "dacryon_r", "alare_l"):
+        assert name in warning.message
+        np.testing.assert_allclose(skull.axes[name], s.bone_normals[name], atol=0.05)
+    assert "nasion" not in warning.message and "--landmarks" in warning.message
