@@ -257,7 +257,9 @@ def metamorphic_probes():
     plain_ref = Run("case", S, (_plain,), rel="front/posest-sfo/result.json", extra=("--view", "frontal"))  # noqa: E501
     for fmt in ("json", "tsv-xy"):
         p.append(metamorphic(f"standin case photo landmarks as {fmt} instead of a permuted CSV", plain_ref, _photo_file(P, fmt), IDENTITY, ST, key="standin case plain csv", common=_photo_file(P, "csv"), new_run=plain(fmt)))  # noqa: E501
-    case_lm = lambda name: Run("case", lambda ws: ws.skull / "skull.ply", (P,), landmarks=lambda ws: _in(ws, name), rel="standin_frontal/posest-sfo/result.json")  # noqa: E501, E731
+    # the mesh alone has no axes file beside it: the folder's own given with --axes (without
+    # them the case would rightly warn normal_axes), so that only the landmark file differs
+    case_lm = lambda name: Run("case", lambda ws: ws.skull / "skull.ply", (P,), landmarks=lambda ws: _in(ws, name), rel="standin_frontal/posest-sfo/result.json", extra=("--axes", lambda ws: ws.skull / "soft_tissue_axes.json"))  # noqa: E501, E731
     case_ref = Run("case", S, (P,), rel="standin_frontal/posest-sfo/result.json")
     for fmt, name in (("csv", "lm.csv"), ("fcsv", "lm.fcsv"), ("fcsv-ras", "lm.fcsv"), ("mrk.json", "lm.mrk.json"), ("pp", "lm.pp")):  # noqa: E501
         p.append(metamorphic(f"standin case cranial landmarks as {fmt} (reversed order) with the mesh", case_ref, _cranial_file(S, fmt), IDENTITY, ST, key="standin case posest", new_run=case_lm(name)))  # noqa: E501
