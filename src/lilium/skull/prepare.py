@@ -4,7 +4,8 @@
 Written in ``out`` (and nowhere else): ``skull.ply`` (the mesh in its own frame and units, welded
 and checked as ``lilium case`` reads it), ``cranial_landmarks.json`` (docs/contract.md:
 ``landmarks``, ``landmark_sources``, ``parts``, ``prepared_by``) and ``soft_tissue_axes.json``
-(the outward surface normals at the landmarks: the axes ``lilium case`` would take by default)
+(:func:`lilium.softtissue.normals.fitted_axes` in the fitted frame: the outward surface
+normals, ``lilium case``'s default, but beside the eye corners and the alae)
 and ``review.html`` (the skull in 3D, each landmark draggable along the bone:
 :mod:`lilium.report.skull_review`).
 """
