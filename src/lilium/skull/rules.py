@@ -297,17 +297,16 @@ def apply_rules(vertices, faces, on_mandible, estimates, anchors, scale=1.0):
             p = _support(vertices, on_mandible, est["gonion" + sfx], GONION_MM, d)
             if p is not None:
                 out["gonion" + sfx] = p
-        if "frontotemporale" + sfx in est:
+        name = "frontotemporale" + sfx
+        if name in est:
             p = None
-            if "glabella" in out:
+            if "glabella" in out:  # the generator's band (template mm), back to the mesh's
                 y = out["glabella"][1] * scale + FRONTOTEMPORALE_ABOVE_GLABELLA_MM
                 p = _frontotemporale(vertices * scale, cranium, sx, y)
-            if p is not None:
-                out["frontotemporale" + sfx] = p / scale
-            else:
+                p = None if p is None else p / scale
+            if p is None:  # no glabella (a cut vault) or nothing in the band
                 d = np.array(FRONTOTEMPORALE["direction"]) * (sx, 1, 1)
-                p = _support(vertices, cranium, est["frontotemporale" + sfx],
-                             FRONTOTEMPORALE_MM, d)  # fmt: skip
-                if p is not None:
-                    out["frontotemporale" + sfx] = p
+                p = _support(vertices, cranium, est[name], FRONTOTEMPORALE_MM, d)
+            if p is not None:
+                out[name] = p
     return {k: np.asarray(v, float) for k, v in out.items() if np.all(np.isfinite(v))}

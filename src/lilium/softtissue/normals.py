@@ -83,8 +83,35 @@ def landmark_normals(vertices_mm, faces, landmarks_mm, radius_mm=NORMAL_NEIGHBOU
     return dict(zip(names, normals, strict=True))
 
 
+def beside_axis(name, left, anterior):
+    """The axis of a landmark of :data:`LATERAL_OFFSET_MM` (module notes): its offset along the
+    head's lateral direction plus the rest of the built-in mean depth towards the front, or None
+    for any other landmark.
+
+    Parameters
+    ----------
+    name : str
+        A cranial landmark, e.g. ``ectoconchion_l``.
+    left, anterior : ndarray of shape (3,)
+        The head's unit left and anterior directions.
+
+    Returns
+    -------
+    ndarray of shape (3,) or None
+        A unit vector.
+    """
+    offset = LATERAL_OFFSET_MM.get(base_name(name))
+    if offset is None or side(name) is None:
+        return None
+    depth = BUILTIN_DEPTHS[base_name(name)].mean_mm
+    lateral = np.asarray(left, float) * (1.0 if side(name) == "l" else -1.0)
+    axis = offset * lateral + np.sqrt(depth**2 - offset**2) * np.asarray(anterior, float)
+    return axis / np.linalg.norm(axis)
+
+
 def fitted_axes(vertices_mm, faces, landmarks_mm, left=None, anterior=None):
-    """Cone axes of named cranial landmarks in an oriented head (module notes).
+    """Cone axes of named cranial landmarks in an oriented head (module notes): the bone normal,
+    but :func:`beside_axis` where it applies.
 
     Parameters
     ----------
@@ -104,11 +131,7 @@ def fitted_axes(vertices_mm, faces, landmarks_mm, left=None, anterior=None):
     if left is None or anterior is None:
         return axes
     for name in axes:
-        offset = LATERAL_OFFSET_MM.get(base_name(name))
-        if offset is None or side(name) is None:
-            continue
-        depth = BUILTIN_DEPTHS[base_name(name)].mean_mm
-        lateral = np.asarray(left, float) * (1.0 if side(name) == "l" else -1.0)
-        axis = offset * lateral + np.sqrt(depth**2 - offset**2) * np.asarray(anterior, float)
-        axes[name] = axis / np.linalg.norm(axis)
+        axis = beside_axis(name, left, anterior)
+        if axis is not None:
+            axes[name] = axis
     return axes
