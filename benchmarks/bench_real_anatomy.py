@@ -67,8 +67,9 @@ def photo_pairs(root, subject, n_photos):
     ]
 
 
-def run_pairs(datasets, out, n_photos, log=print):
-    """Every real photo pair against every real skull (module docstring).
+def run_pairs(datasets, out, n_photos, log=print, calibration=None):
+    """Every real photo pair against every real skull (module docstring), identified with
+    ``calibration`` (a calibration file; None: the shipped one).
 
     Returns
     -------
@@ -85,7 +86,7 @@ def run_pairs(datasets, out, n_photos, log=print):
     from lilium.identification.score import outside_depths
     from lilium.io.calibration import Calibrations
 
-    calibrations = Calibrations()
+    calibrations = Calibrations(calibration)
     skulls = {sid: (head, datasets[head] / "subjects" / sid)
               for head, (_, ids) in HEADS.items() if head in datasets for sid in ids}
     rows = []
@@ -97,6 +98,7 @@ def run_pairs(datasets, out, n_photos, log=print):
                 request = CaseRequest(
                     SkullSource(skull_dir, axes=skull_dir / "axes_C1.json"), case_dir,
                     photos=(PhotoSource(frontal), PhotoSource(lateral)), methods=tuple(METHODS),
+                    calibration=calibration,
                 )
                 entries = run_case(request, log=lambda line: None)
                 for method in METHODS:
@@ -207,6 +209,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="real-anatomy")
     parser.add_argument("--photos", type=int, default=3, help="photo pairs per head")
+    parser.add_argument("--calibration", help="calibration file (default: the shipped one)")
     args = parser.parse_args(argv)
     datasets = real_datasets(Path(args.out) / "datasets", args.photos)
     missing = [h for h in HEADS if h not in datasets]
@@ -214,7 +217,7 @@ def main(argv=None):
         print(f"left out (CT not found): {', '.join(missing)}")
     if not datasets:
         return 0
-    rows = run_pairs(datasets, args.out, args.photos)
+    rows = run_pairs(datasets, args.out, args.photos, calibration=args.calibration)
     print_rows(rows)
     print()
     print_outside(rows)

@@ -101,7 +101,10 @@ def main(argv=None):
         if not datasets:
             print("no real-anatomy CT found: skipped")
             return 0
-        rows = run_pairs(datasets, args.real_out, args.photos, log=lambda line: None)
+        rows = run_pairs(
+            datasets, args.real_out, args.photos, log=lambda line: None,
+            calibration=args.calibration,
+        )
         print_real(rows)
         print()
         print_rows(rows)
