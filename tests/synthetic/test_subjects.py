@@ -15,6 +15,7 @@ from lilium.softtissue.landmarks import (
     MIDLINE_CRANIAL,
     base_name,
 )
+from lilium.synthetic.anatomy.soft_tissue import direction_centre
 from lilium.synthetic.subjects import make_subject, make_subjects, write_subject
 
 
@@ -66,6 +67,16 @@ def test_proportions_are_human(subjects):
         assert lm["porion_l"][1] == pytest.approx(lm["orbitale_l"][1], abs=15)  # Frankfurt
 
 
+def test_face_proportions_are_human(subjects):
+    # The eye corners' and alae's soft tissue lies beside their bone landmark (adult norms:
+    # outer eye corners about 85-95 mm apart, inner 31-33, alae 31-35), not along the normal.
+    for s in subjects:
+        lm = s.facial_landmarks
+        assert 80 <= np.linalg.norm(lm["exocanthion_l"] - lm["exocanthion_r"]) <= 105
+        assert 25 <= np.linalg.norm(lm["endocanthion_l"] - lm["endocanthion_r"]) <= 40
+        assert 26 <= np.linalg.norm(lm["alare_l"] - lm["alare_r"]) <= 42
+
+
 def test_soft_tissue_inside_the_cones(subjects):
     for s in subjects:
         for cranial, facial in CORRESPONDENCES:
@@ -76,7 +87,8 @@ def test_soft_tissue_inside_the_cones(subjects):
             assert depth == pytest.approx(s.soft_tissue_depths_mm[cranial], abs=1e-9)
             axis = s.soft_tissue_axes[cranial]
             np.testing.assert_allclose(st / depth, axis, atol=1e-9)
-            angle = np.degrees(np.arccos(np.clip(axis @ s.bone_normals[cranial], -1, 1)))
+            centre = direction_centre(cranial, s.bone_normals[cranial])
+            angle = np.degrees(np.arccos(np.clip(axis @ centre, -1, 1)))
             assert angle <= min(25.0, CONE_MAX_POLAR_DEG), cranial
 
 

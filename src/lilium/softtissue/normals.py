@@ -16,9 +16,9 @@ real CT heads of the benchmarks (the Cranium and headsq, their true axes from th
 the bone normal lies 13-107 degrees from the true axis at these landmarks (46-107 at
 ectoconchion), this axis 5-34 degrees; at the other landmarks the normal lies 4-53 degrees off
 (subspinale 13-53, prosthion 30-35: left to the normal, no guideline offset here). The generator
-builds its faces along the bone normals
-(:func:`lilium.synthetic.anatomy.soft_tissue.draw_soft_tissue`: its eye corners lie lateral of
-the orbits), so its subjects carry their own axes files.
+draws its faces' soft tissue about these axes at the eye corners and the alae
+(:func:`lilium.synthetic.anatomy.soft_tissue.direction_centre`), about the normal elsewhere; its
+subjects carry their own axes files.
 docs/method/identification.md has the cases measured with each.
 """
 

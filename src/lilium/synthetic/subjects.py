@@ -16,12 +16,13 @@ z forward (docs/contract.md), so a frontal photo camera looks along ``-z`` of th
 
 Soft tissue, per subject: for each cranial landmark of a correspondence, a depth drawn from the
 population table (``N(mean, sd)`` clipped inside ``[min, max]``) and a direction within
-:data:`~.anatomy.soft_tissue.MAX_DIRECTION_DEG` of the outward bone normal (twins nearly
-mirror-symmetric). The target facial point ``F = C + depth * direction`` is then made to lie
-exactly on the skin: the skin is the "soft-tissue support" (bone, eyeballs, muscles, neck) offset
-by a depth field interpolated from the drawn depths, plus nose, lips and ears built around the
-targets, and finally corrected by small Gaussian bumps so that its zero level passes through
-every target.
+:data:`~.anatomy.soft_tissue.MAX_DIRECTION_DEG` of the outward bone normal, or at the eye
+corners and the alae of the axis beside them (:func:`~.anatomy.soft_tissue.direction_centre`;
+twins nearly mirror-symmetric). The target facial point ``F = C + depth * direction`` is then
+made to lie exactly on the skin: the skin is the "soft-tissue support" (bone, eyeballs, muscles,
+neck) offset by a depth field interpolated from the drawn depths, plus nose, lips and ears built
+around the targets, and finally corrected by small Gaussian bumps so that its zero level passes
+through every target.
 
 ``soft_tissue_axes`` holds these true directions (the axes given to the methods; Exp. C perturbs
 them); ``bone_normals`` holds the default axes a method would compute from the skull mesh (the
