@@ -25,7 +25,8 @@ Formats the plain records of :mod:`lilium.report.records` into the templates shi
 A summary table on top lists every SFO of the page: the landmark error in pixels and in
 millimetres at the landmarks' depth for every method side by side (comparable), each method's
 own score in a column of its own (not comparable across methods), "implausible" for any camera
-with skull pixels outside the face mask whatever its method, and the docs/checks.md warnings,
+that puts skull pixels beyond the head mask's edge band whatever its method (the
+identification's ``skull_outside_head``), and the docs/checks.md warnings,
 which each SFO's section lists in full. Nothing is fetched from the network: the
 pictures are base64 ``data:`` URIs, styles and script are inline.
 """

@@ -93,8 +93,9 @@ class Summary:
     Attributes
     ----------
     status : str
-        ``"ok"``, ``"implausible"`` (a camera with skull pixels outside the face mask, whatever
-        the method: docs/method/evaluation.md) or ``"failed: ..."``.
+        ``"ok"``, ``"implausible"`` (a camera that puts skull pixels beyond the head mask's edge
+        band, whatever the method: the identification's ``skull_outside_head``) or
+        ``"failed: ..."``.
     focal_px, scd_mm : float or None
     mean_error_px, mean_error_mm : float or None
         ``landmark_error`` of the result (docs/checks.md): comparable across methods.
@@ -104,7 +105,9 @@ class Summary:
         What that score is (``"mean landmark error, px"``, ``"fitness"``).
     outside_pct : float or None
     implausible : bool or None
-        Whether skull pixels fall outside the face mask (None: failed, or no mask).
+        Whether skull pixels lie beyond the head mask's edge band
+        (:func:`lilium.identification.score.skull_beyond_head`; None: failed, or no mask).
+        ``outside_pct`` counts every skull pixel outside the mask.
     warnings : tuple of (str, str)
         The result's warnings, ``(code, message)``.
     seconds : float

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..evaluation.metrics import outside_face
 from ..geometry.rotations import geodesic_angle_deg, matrix_to_euler_xyz_deg, matrix_to_rotvec
+from ..identification.score import skull_beyond_head
 from ..io.provenance import input_files, software_versions
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
 from ..validation import fmt_range
@@ -250,16 +251,18 @@ def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
     errors = np.array([r.error_px for r in rows])
     mean_err = float(np.mean(errors)) if len(errors) and np.all(np.isfinite(errors)) else None
     camera = camera_facts(result, photo) if result else None
-    outside = None
+    outside = implausible = None
     if result and photo.face_mask is not None:
         outside = outside_face(result.camera, skull.vertices_mm, skull.faces, photo.face_mask)
+        # The identification's rule (consistency failure skull_outside_head): skull pixels beyond
+        # the head mask's edge band, not a pixel or two of raster and mask-edge noise.
+        implausible = skull_beyond_head(skull, photo, result.camera)[0] > 0
     points = [r.photo_uv for r in rows] + [r.estimate_uv for r in rows]
     if result:
         points += list(_skull_uv_in_image(result.camera, skull, photo.image_size_wh))
     box = view_box(photo.image_size_wh, None, photo.face_mask, points)
-    pictures = sfo_pictures(result, skull, photo, box, outside is not None and outside.implausible)
+    pictures = sfo_pictures(result, skull, photo, box, bool(implausible))
     history = result.extra.get("history")
-    implausible = None if outside is None else bool(outside.implausible)
     warnings = tuple((w.code, w.message) for w in result.warnings)
     error = result.landmark_error or {}
     status = "ok" if result else f"failed: {result.error}"
