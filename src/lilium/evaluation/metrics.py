@@ -129,6 +129,12 @@ class ImplausibleSFO:
         """Any skull pixel outside the face mask."""
         return self.outside_px > 0
 
+    @classmethod
+    def of(cls, outside_px, skull_px):
+        """From the two counts (``percent_outside`` 0 for an empty skull raster)."""
+        percent = 100.0 * outside_px / skull_px if skull_px else 0.0
+        return cls(int(outside_px), int(skull_px), percent)
+
 
 def implausible_sfo(skull_mask, face_mask):
     """Count the projected-skull pixels that fall outside the face mask.
@@ -151,10 +157,7 @@ def implausible_sfo(skull_mask, face_mask):
             f"skull_mask {s.shape} and face_mask {f.shape} differ in shape; rasterise the skull "
             "at the photo's resolution"
         )
-    skull_px = int(np.count_nonzero(s))
-    outside_px = int(np.count_nonzero(s & ~f))
-    percent = 100.0 * outside_px / skull_px if skull_px else 0.0
-    return ImplausibleSFO(outside_px, skull_px, percent)
+    return ImplausibleSFO.of(np.count_nonzero(s & ~f), np.count_nonzero(s))
 
 
 def outside_depth_px(skull_mask, face_mask):

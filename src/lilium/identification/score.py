@@ -122,9 +122,16 @@ def skull_beyond_head(skull, photo, camera):
     if found is None:
         return None
     depth, skull_px, eye_px = found
-    band = max(OUTSIDE_BAND_MIN_PX, OUTSIDE_BAND_EYE * eye_px) if np.isfinite(eye_px) else \
-        OUTSIDE_BAND_MIN_PX
-    return int(np.count_nonzero(depth > band)), skull_px, float(band)
+    band = outside_band_px(eye_px)
+    return int(np.count_nonzero(depth > band)), skull_px, band
+
+
+def outside_band_px(eye_px):
+    """The head mask's edge band, pixels: ``max(OUTSIDE_BAND_MIN_PX, OUTSIDE_BAND_EYE *
+    eye_px)``, the floor alone for a non-finite ``eye_px``."""
+    if not np.isfinite(eye_px):
+        return OUTSIDE_BAND_MIN_PX
+    return float(max(OUTSIDE_BAND_MIN_PX, OUTSIDE_BAND_EYE * eye_px))
 
 
 def image_consistency(skull, photo, camera, eye_px):

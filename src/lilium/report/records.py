@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..evaluation.metrics import outside_face
+from ..evaluation.metrics import ImplausibleSFO
 from ..geometry.rotations import geodesic_angle_deg, matrix_to_euler_xyz_deg, matrix_to_rotvec
-from ..identification.score import skull_beyond_head
+from ..identification.score import outside_band_px, outside_depths
 from ..io.provenance import input_files, software_versions
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
 from ..validation import fmt_range
@@ -253,10 +253,12 @@ def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
     camera = camera_facts(result, photo) if result else None
     outside = implausible = None
     if result and photo.face_mask is not None:
-        outside = outside_face(result.camera, skull.vertices_mm, skull.faces, photo.face_mask)
-        # The identification's rule (consistency failure skull_outside_head): skull pixels beyond
-        # the head mask's edge band, not a pixel or two of raster and mask-edge noise.
-        implausible = skull_beyond_head(skull, photo, result.camera)[0] > 0
+        # One raster for both: every skull pixel outside the mask (the figure shown), and the
+        # mark by the identification's rule (skull_outside_head: pixels beyond the mask's edge
+        # band, not a pixel or two of raster and mask-edge noise).
+        depth_px, skull_px, eye_px = outside_depths(skull, photo, result.camera)
+        outside = ImplausibleSFO.of(len(depth_px), skull_px)
+        implausible = bool(np.any(depth_px > outside_band_px(eye_px)))
     points = [r.photo_uv for r in rows] + [r.estimate_uv for r in rows]
     if result:
         points += list(_skull_uv_in_image(result.camera, skull, photo.image_size_wh))
