@@ -54,7 +54,7 @@ def load_skull(source, log=None, out=None):
     """Read the skull from a subject folder or a mesh file.
 
     A mesh without a landmark file (none given, none beside it) gets its cranial landmarks
-    placed automatically (``lilium skull``, :func:`~lilium.skull.prepare.prepared_skull`) into
+    placed automatically (``lilium skull``, :func:`~lilium.skull.prepare.prepare_skull`) into
     ``out/prepared-skull/`` (reused while the mesh is unchanged), with its ``review.html``;
     they are automatic and unreviewed, which leaves every conclusion undetermined until they are
     reviewed (``unreviewed_skull_landmarks``, docs/method/skull.md).
@@ -159,9 +159,9 @@ def skull_files(source, log=None, out=None):
 def _automatic_skull(mesh, axes, folder, log):
     """:func:`skull_files` of a mesh without landmarks: its subject folder placed by ``lilium
     skull`` in ``folder`` (or read back from there)."""
-    from ..skull.prepare import prepared_skull
+    from ..skull.prepare import prepare_skull
 
-    folder, reused = prepared_skull(mesh, folder)
+    reused = prepare_skull(mesh, folder, reuse=True)["reused"]
     if log is not None:
         how = "read back from" if reused else "placed automatically (lilium skull) in"
         log(

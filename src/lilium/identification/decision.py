@@ -296,9 +296,9 @@ def identify(skull, photos, results, calibrations, cohort, facial_landmarks_mm=N
         calibration["provenance"] = model.provenance
         if len(photos) > 1 and not joint:
             note = "calibrated on one frontal and one lateral photo; these photos differ"
+    worst, misfit = worst_landmark_of(skull, photos, [r.camera for r in results])
     inconsistent = _inconsistent(skull, photos, results, facial)
     verdict = conclude(lr, caps, inconsistent)
-    worst, misfit = worst_landmark_of(skull, photos, [r.camera for r in results])
     return Identification(
         calibration,
         nll_score(terms),

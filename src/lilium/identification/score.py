@@ -99,8 +99,8 @@ def outside_depths(skull, photo, camera):
     if photo.face_mask is None:
         return None
     height, width = np.asarray(photo.face_mask).shape
-    skull_mask = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height))
     eye_px = eye_corner_px(camera, np.array(list(skull.landmarks_mm.values()), float))
+    skull_mask = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height))
     return (outside_depth_px(skull_mask, photo.face_mask), int(np.count_nonzero(skull_mask)),
             float(eye_px))
 

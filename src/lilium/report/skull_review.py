@@ -167,4 +167,5 @@ def write_skull_review(path, vertices_mm, faces, landmarks_mm, sources, **kwargs
 
     Keywords go to :func:`skull_review_page`. Returns the path.
     """
-    return write_page(path, skull_review_page(vertices_mm, faces, landmarks_mm, sources, **kwargs))
+    page = skull_review_page(vertices_mm, faces, landmarks_mm, sources, **kwargs)
+    return write_page(path, page)

@@ -258,4 +258,5 @@ def write_workbench(path, skull, photo, result, **kwargs):
 
     Keywords go to :func:`workbench_page`. Returns the path.
     """
-    return write_page(path, workbench_page(skull, photo, result, **kwargs))
+    page = workbench_page(skull, photo, result, **kwargs)
+    return write_page(path, page)

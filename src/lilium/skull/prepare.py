@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .locate import GIVEN, LOCATED, TEMPLATE, locate_skull_landmarks
+from .locate import GIVEN, TEMPLATE, locate_skull_landmarks
 
 #: ``prepared_by`` of the files written here.
 PREPARED_BY = "lilium skull"
@@ -52,48 +52,37 @@ def landmark_sources(result):
     return out
 
 
-def _write_review_page(out, vertices, faces, result, sources, title):
-    """``review.html``: the skull in 3D, every landmark draggable along the bone
+def _review_page(vertices, faces, result, sources, title):
+    """The HTML of ``review.html``: the skull in 3D, every landmark draggable along the bone
     (:mod:`lilium.report.skull_review`), opened in a frontal view of the fitted skull frame."""
-    from ..report.skull_review import write_skull_review
+    from ..report.skull_review import skull_review_page
 
     parts = {"cranium": True, "mandible": result.mandible}
     template = [n for n, q in result.quality.items() if q == TEMPLATE]
     message = "automatic landmarks, unreviewed: check each, drag it where it belongs, Save"
     if template:
         message += f"; template points (off until confirmed): {', '.join(template)}"
-    write_skull_review(
-        out / "review.html", vertices, faces, result.landmarks, sources, title=title,
-        parts=parts, message=message, skull_axes=result.mesh2skull[:3, :3],
+    return skull_review_page(
+        vertices, faces, result.landmarks, sources, title=title, parts=parts, message=message,
+        skull_axes=result.mesh2skull[:3, :3],
     )
 
 
-def prepared_skull(mesh_path, out, rng=0):
-    """The subject folder ``out`` of a mesh without landmarks (``lilium case --skull MESH``):
-    the one ``lilium skull`` wrote there for this mesh (same bytes, ``mesh_sha256``), else
-    written now (:func:`prepare_skull`).
-
-    Returns
-    -------
-    folder : Path
-    reused : bool
-    """
+def _prepared(out, mesh_path):
+    """Whether the subject folder ``out`` is whole and was written for this mesh (its
+    ``cranial_landmarks.json`` names the mesh's sha256, written last, and ``skull.ply`` is
+    there)."""
     from ..io.jsonio import read_json
     from ..io.provenance import sha256_of
 
-    out = Path(out)
-    digest = sha256_of(mesh_path)
     try:
         stored = read_json(out / "cranial_landmarks.json").get("mesh_sha256")
     except (ValueError, AttributeError):
-        stored = None
-    if stored == digest and (out / "skull.ply").is_file():
-        return out, True
-    prepare_skull(mesh_path, out, rng=rng)
-    return out, False
+        return False
+    return stored == sha256_of(mesh_path) and (out / "skull.ply").is_file()
 
 
-def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
+def prepare_skull(mesh_path, out, landmarks_path=None, rng=0, reuse=False):
     """Place the cranial landmarks of a skull mesh and write the subject folder ``out``.
 
     Parameters
@@ -106,11 +95,15 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
         Reviewed landmarks (any cranial landmark file ``lilium case`` reads): kept as they are;
         the rest are placed.
     rng : anything :func:`numpy.random.default_rng` accepts
+    reuse : bool
+        Keep the folder ``out`` as it is when ``lilium skull`` already wrote it for this mesh
+        (the same bytes; ``lilium case --skull MESH``): nothing placed, ``result`` None.
 
     Returns
     -------
     dict
-        ``folder``, ``result`` (:class:`~lilium.skull.locate.SkullLandmarks`), ``faces``.
+        ``folder``, ``reused``, ``result`` (:class:`~lilium.skull.locate.SkullLandmarks`),
+        ``faces``.
 
     Raises
     ------
@@ -121,8 +114,11 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
     from ..io.jsonio import write_json
     from ..io.mesh import parse_mesh, write_mesh
     from ..io.provenance import sha256_of
+    from ..io.results import write_page
 
     mesh_path, out = Path(mesh_path), Path(out)
+    if reuse and _prepared(out, mesh_path):
+        return {"folder": out, "reused": True, "result": None, "faces": None}
     if (out / "skull.ply").resolve() == mesh_path.resolve():
         raise ValueError(
             f"{mesh_path}: --out {out} would write skull.ply over the input mesh; give another "
@@ -132,11 +128,12 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
     keep = _reviewed(landmarks_path) if landmarks_path is not None else None
     result = locate_skull_landmarks(vertices, faces, keep=keep, rng=rng, source=str(mesh_path))
     sources = landmark_sources(result)
+    page = _review_page(vertices, faces, result, sources, mesh_path.name)
     out.mkdir(parents=True, exist_ok=True)
-    _write_review_page(out, vertices, faces, result, sources, mesh_path.name)
+    write_page(out / "review.html", page)
     write_mesh(out / "skull.ply", vertices, faces)
     write_json(out / "soft_tissue_axes.json", {"axes": result.axes, "prepared_by": PREPARED_BY})
-    write_json(  # last: a folder holding it is whole (prepared_skull)
+    write_json(  # last: a folder holding it is whole (_prepared)
         out / "cranial_landmarks.json",
         {
             "landmarks": result.landmarks,
@@ -148,4 +145,4 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0):
             "mesh2skull": np.round(result.mesh2skull, 9),
         },
     )
-    return {"folder": out, "result": result, "faces": len(faces), "located": LOCATED}
+    return {"folder": out, "reused": False, "result": result, "faces": len(faces)}
