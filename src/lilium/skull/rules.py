@@ -29,10 +29,13 @@ Written down (docs/method/skull.md lists them too):
   aperture's centre height, where the aperture is widest: the widest rows' middle finds that
   height whatever the template's centre, where the single most lateral row wanders along a
   near-vertical margin);
-- ``zygion``: the cranium vertex of largest ``|x|`` within ``ZYGION_BOX_MM`` (y, z) of its
-  estimate (the generator's own window, fixed in its frame, put 10 of 20 generated zygia 8-26
-  mm off: its extreme lies on the window's edge, and the fitted frame is not the generator's
-  to a few mm); ``gonion``: the mandible vertex furthest along ``(+-1, -0.22, -0.22)`` within
+- ``zygion``: the cranium vertex of largest ``|x|`` on the arch behind the orbit
+  (:data:`ZYGION_ARCH_MM` about the located orbitale's height and ectoconchion's depth), or,
+  without them, within ``ZYGION_BOX_MM`` (y, z) of its estimate (the generator's own window,
+  fixed in its frame, put 10 of 20 generated zygia 8-26 mm off: its extreme lies on the
+  window's edge, and the fitted frame is not the generator's to a few mm; the box about the
+  estimate missed the real arches' extremes by 9-11 mm); ``gonion``: the mandible vertex
+  furthest along ``(+-1, -0.22, -0.22)`` within
   ``GONION_MM`` of its estimate; ``frontotemporale``: the cranium vertex furthest along
   ``(+-1, 0, 0.8)`` in the generator's band (3 mm up and down, 6 mm along ``(-+0.8, 0, 1)``
   about ``(+-42, y, 60)`` template mm:
@@ -80,6 +83,9 @@ ALARE_SCAN_MM = 25.0
 ALARE_FRACTION = 0.9
 ALARE_ROWS_MM = 8.0
 ZYGION_BOX_MM = (8.0, 12.0)
+#: Zygion's window on the arch (mm): ``(below, above)`` orbitale's height and ``(behind, in
+#: front of)`` relative to ectoconchion's depth, both behind it.
+ZYGION_ARCH_MM = ((20.0, 5.0), (50.0, 5.0))
 GONION_MM = 15.0
 GONION_DIRECTION = (1.0, -0.22, -0.22)
 FRONTOTEMPORALE_MM = 10.0
@@ -247,6 +253,21 @@ def _frontotemporale(points, mask, sx, y):
     return plateau_point(points[band], d / np.linalg.norm(d))
 
 
+def _zygion_box(vertices, estimate, orbitale, ectoconchion):
+    """The vertices ``(V,)`` where zygion is looked for: the arch behind the orbit
+    (:data:`ZYGION_ARCH_MM`: from below to above ``orbitale``'s height, from behind to in front
+    of ``ectoconchion``'s depth) when both are located, else :data:`ZYGION_BOX_MM` about the
+    template's ``estimate``."""
+    y, z = vertices[:, 1], vertices[:, 2]
+    if orbitale is None or ectoconchion is None:
+        return (np.abs(y - estimate[1]) < ZYGION_BOX_MM[0]) & (
+            np.abs(z - estimate[2]) < ZYGION_BOX_MM[1]
+        )
+    (below, above), (behind, front) = ZYGION_ARCH_MM
+    return ((y > orbitale[1] - below) & (y < orbitale[1] + above)
+            & (z > ectoconchion[2] - behind) & (z < ectoconchion[2] - front))
+
+
 def apply_rules(vertices, faces, on_mandible, estimates, anchors, scale=1.0):
     """The landmarks found by their own definitions (module notes).
 
@@ -286,10 +307,8 @@ def apply_rules(vertices, faces, on_mandible, estimates, anchors, scale=1.0):
                 out["alare" + sfx] = p
         name = "zygion" + sfx
         if name in est:
-            e = est[name]
-            box = (np.abs(vertices[:, 1] - e[1]) < ZYGION_BOX_MM[0]) & (
-                np.abs(vertices[:, 2] - e[2]) < ZYGION_BOX_MM[1]
-            )
+            box = _zygion_box(vertices, est[name], out.get("orbitale" + sfx),
+                              out.get("ectoconchion" + sfx))
             if (box & cranium).any():
                 out[name] = plateau_point(vertices[box & cranium], np.array([sx, 0.0, 0.0]))
         if "gonion" + sfx in est:
