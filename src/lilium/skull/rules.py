@@ -35,8 +35,8 @@ Written down (docs/method/skull.md lists them too):
   fixed in its frame, put 10 of 20 generated zygia 8-26 mm off: its extreme lies on the
   window's edge, and the fitted frame is not the generator's to a few mm; the box about the
   estimate missed the real arches' extremes by 9-11 mm); ``gonion``: the mandible vertex
-  furthest along ``(+-1, -0.22, -0.22)`` within
-  ``GONION_MM`` of its estimate; ``frontotemporale``: the cranium vertex furthest along
+  furthest along ``(+-1, -0.22, -0.22)`` within ``GONION_MM`` of its estimate;
+  ``frontotemporale``: the cranium vertex furthest along
   ``(+-1, 0, 0.8)`` in the generator's band (3 mm up and down, 6 mm along ``(-+0.8, 0, 1)``
   about ``(+-42, y, 60)`` template mm:
   :data:`~lilium.synthetic.anatomy.landmarks.FRONTOTEMPORALE`), its height ``y``
@@ -83,8 +83,9 @@ ALARE_SCAN_MM = 25.0
 ALARE_FRACTION = 0.9
 ALARE_ROWS_MM = 8.0
 ZYGION_BOX_MM = (8.0, 12.0)
-#: Zygion's window on the arch (mm): ``(below, above)`` orbitale's height and ``(behind, in
-#: front of)`` relative to ectoconchion's depth, both behind it.
+#: Zygion's window on the arch behind the orbit (mm): from ``below`` to ``above`` the located
+#: orbitale's height, and from ``farthest`` to ``nearest`` behind the located ectoconchion:
+#: ``((below, above), (farthest, nearest))``, as the hand placements of the real heads take it.
 ZYGION_ARCH_MM = ((20.0, 5.0), (50.0, 5.0))
 GONION_MM = 15.0
 GONION_DIRECTION = (1.0, -0.22, -0.22)
@@ -255,17 +256,17 @@ def _frontotemporale(points, mask, sx, y):
 
 def _zygion_box(vertices, estimate, orbitale, ectoconchion):
     """The vertices ``(V,)`` where zygion is looked for: the arch behind the orbit
-    (:data:`ZYGION_ARCH_MM`: from below to above ``orbitale``'s height, from behind to in front
-    of ``ectoconchion``'s depth) when both are located, else :data:`ZYGION_BOX_MM` about the
+    (:data:`ZYGION_ARCH_MM` about ``orbitale``'s height and ``ectoconchion``'s depth) when both
+    are located, else :data:`ZYGION_BOX_MM` about the
     template's ``estimate``."""
     y, z = vertices[:, 1], vertices[:, 2]
     if orbitale is None or ectoconchion is None:
         return (np.abs(y - estimate[1]) < ZYGION_BOX_MM[0]) & (
             np.abs(z - estimate[2]) < ZYGION_BOX_MM[1]
         )
-    (below, above), (behind, front) = ZYGION_ARCH_MM
+    (below, above), (farthest, nearest) = ZYGION_ARCH_MM
     return ((y > orbitale[1] - below) & (y < orbitale[1] + above)
-            & (z > ectoconchion[2] - behind) & (z < ectoconchion[2] - front))
+            & (z > ectoconchion[2] - farthest) & (z < ectoconchion[2] - nearest))
 
 
 def apply_rules(vertices, faces, on_mandible, estimates, anchors, scale=1.0):
