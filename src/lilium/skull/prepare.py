@@ -68,18 +68,16 @@ def _review_page(vertices, faces, result, sources, title):
     )
 
 
-def _prepared(out, mesh_path):
-    """Whether the subject folder ``out`` is whole and was written for this mesh (its
-    ``cranial_landmarks.json`` names the mesh's sha256, written last, and ``skull.ply`` is
-    there)."""
+def _prepared(out, mesh_sha256):
+    """Whether the subject folder ``out`` is whole and was written for the mesh of this sha256
+    (its ``cranial_landmarks.json`` names it, written last, and ``skull.ply`` is there)."""
     from ..io.jsonio import read_json
-    from ..io.provenance import sha256_of
 
     try:
         stored = read_json(out / "cranial_landmarks.json").get("mesh_sha256")
     except (ValueError, AttributeError):
         return False
-    return stored == sha256_of(mesh_path) and (out / "skull.ply").is_file()
+    return stored == mesh_sha256 and (out / "skull.ply").is_file()
 
 
 def prepare_skull(mesh_path, out, landmarks_path=None, rng=0, reuse=False):
@@ -117,7 +115,8 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0, reuse=False):
     from ..io.results import write_page
 
     mesh_path, out = Path(mesh_path), Path(out)
-    if reuse and _prepared(out, mesh_path):
+    digest = sha256_of(mesh_path)
+    if reuse and _prepared(out, digest):
         return {"folder": out, "reused": True, "result": None, "faces": None}
     if (out / "skull.ply").resolve() == mesh_path.resolve():
         raise ValueError(
@@ -141,7 +140,7 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0, reuse=False):
             "parts": {"cranium": True, "mandible": result.mandible},
             "prepared_by": PREPARED_BY,
             "mesh": mesh_path.name,
-            "mesh_sha256": sha256_of(mesh_path),
+            "mesh_sha256": digest,
             "mesh2skull": np.round(result.mesh2skull, 9),
         },
     )
