@@ -249,8 +249,8 @@ def test_a_frontal_and_a_lateral_photo_add_their_log_lrs(case, tmp_path, monkeyp
         seen.append(([p.view for p in photos], facial))
         return terms_of(skull, photos, cameras, facial, **kwargs)
 
-    terms_of = identify_module.identification_terms
-    monkeypatch.setattr(identify_module, "identification_terms", recording)
+    terms_of = identify_module.terms_and_overlaps
+    monkeypatch.setattr(identify_module, "terms_and_overlaps", recording)
     identify(skull, [frontal, lateral], [first, second], calibrations)
     singles = {tuple(views): facial for views, facial in seen if len(views) == 1}
     assert singles[("frontal",)] is own and singles[("lateral_left",)] is moved
@@ -291,8 +291,8 @@ def test_two_photos_reuse_each_photos_own_decision(case, tmp_path, monkeypatch):
         "identification": identify(skull, [p], [result], calibrations)}})
         for p in (frontal, lateral)]
     calls = []
-    real = identify_module.identification_terms
-    monkeypatch.setattr(identify_module, "identification_terms",
+    real = identify_module.terms_and_overlaps
+    monkeypatch.setattr(identify_module, "terms_and_overlaps",
                         lambda *a, **k: calls.append(len(a[1])) or real(*a, **k))
     reused = identify(skull, [frontal, lateral], own, calibrations)
     assert calls == [2]  # the pair's own terms only
@@ -396,13 +396,12 @@ def test_skull_outside_the_head_is_decided_beyond_the_edge_noise(case):
     leaves the head): only the last is ``skull_outside_head``, though the ring already counts
     in ``outside_fraction``."""
     from dataclasses import replace
-    from types import SimpleNamespace
 
     from scipy import ndimage as ndi
 
     from lilium.casework.build import read_photo, read_skull
     from lilium.identification.decision import skull_outside_head
-    from lilium.identification.score import outside_fraction, skull_beyond_head
+    from lilium.identification.score import head_overlap, outside_fraction, skull_beyond_head
     from lilium.imaging.raster import mesh_mask
     from lilium.io.truth import read_ground_truth
 
@@ -416,14 +415,13 @@ def test_skull_outside_the_head_is_decided_beyond_the_edge_noise(case):
     cut[: rows[0] + (rows[-1] - rows[0]) // 4] = False
     masks = {"grown": ndi.binary_dilation(raster, iterations=8),
              "one pixel in": ndi.binary_erosion(raster), "cut at the brow": cut}
-    result = SimpleNamespace(camera=camera)
     found = {}
     for name, mask in masks.items():
         masked = replace(photo, face_mask=mask.astype(np.uint8) * 255)
         beyond, skull_px, band = skull_beyond_head(skull, masked, camera)
         assert skull_px == raster.sum() and band >= 2.0
         found[name] = beyond
-        sentence = skull_outside_head(skull, [masked], [result])
+        sentence = skull_outside_head([masked], [head_overlap(skull, masked, camera)])
         assert (sentence is not None) == (name == "cut at the brow"), (name, sentence)
     assert found["grown"] == found["one pixel in"] == 0 < found["cut at the brow"]
     ring = outside_fraction(skull, replace(photo, face_mask=masks["one pixel in"]), camera)

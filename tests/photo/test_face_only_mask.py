@@ -45,18 +45,16 @@ def test_a_face_only_mask_does_not_read_the_vault_as_outside(case, tmp_path, is_
     """Marked a head mask, the cut mask puts the vault outside the head; marked face-only
     (``face_mask_is_head: false``), the skull above the eye-corner line counts as inside, so
     skull_beyond_head, outside_fraction and P_skof's count see none of it; the photo says why."""
-    from types import SimpleNamespace
-
     from lilium.casework.build import read_photo
     from lilium.evaluation.metrics import outside_face
     from lilium.identification.decision import skull_outside_head
-    from lilium.identification.score import outside_fraction, skull_beyond_head
+    from lilium.identification.score import head_overlap, outside_fraction, skull_beyond_head
 
     skull, camera, folder = _face_only_folder(case, tmp_path, is_head)
     photo = read_photo(folder)
     beyond, skull_px, _ = skull_beyond_head(skull, photo, camera)
     codes = [w.code for w in photo.warnings]
-    sentence = skull_outside_head(skull, [photo], [SimpleNamespace(camera=camera)])
+    sentence = skull_outside_head([photo], [head_overlap(skull, photo, camera)])
     counts = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
     if is_head:
         assert beyond > 0.1 * skull_px and sentence is not None

@@ -25,7 +25,7 @@ from ..inputs import correspondences
 from ..methods.prior_checks import perspective_conflict, prior_conflicts
 from .calibration import VIEWS_LOG10_LR
 from .conclusion import EXAMINER_CAMERA, UNREVIEWED_SKULL, conclude, material_caps
-from .score import identification_terms, nll_score, skull_beyond_head, worst_landmark_of
+from .score import nll_score, terms_and_overlaps, worst_landmark_of
 
 #: Cranial landmarks on the mandible: a skull with none of them has no mandible.
 MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")
@@ -138,13 +138,14 @@ def outside_calibration(model, terms, key):
     )}
 
 
-def skull_outside_head(skull, photos, results):
+def skull_outside_head(photos, overlaps):
     """The sentence of ``skull_outside_head``, or None: the photos where skull pixels lie
-    beyond the head mask's edge band (:func:`~lilium.identification.score.skull_beyond_head`),
-    how many and how far."""
+    beyond the head mask's edge band (``overlaps``: per photo its
+    :class:`~lilium.identification.score.HeadOverlap` or None,
+    :meth:`~lilium.identification.score.HeadOverlap.beyond`), how many and how far."""
     found = []
-    for photo, result in zip(photos, results, strict=True):
-        counts = skull_beyond_head(skull, photo, result.camera)
+    for photo, overlap in zip(photos, overlaps, strict=True):
+        counts = None if overlap is None else overlap.beyond()
         if counts is None or counts[0] == 0:
             continue
         beyond, skull_px, band = counts
@@ -155,9 +156,9 @@ def skull_outside_head(skull, photos, results):
     return "; ".join(found) or None
 
 
-def _inconsistent(skull, photos, results, facial_landmarks_mm):
+def _inconsistent(photos, results, overlaps, facial_landmarks_mm):
     out = {}
-    outside = skull_outside_head(skull, photos, results)
+    outside = skull_outside_head(photos, overlaps)
     if outside:
         out["skull_outside_head"] = outside
     conflicts, far = [], {}
@@ -260,7 +261,7 @@ def identify(skull, photos, results, calibrations, cohort, facial_landmarks_mm=N
     facial = facial_landmarks_mm or frontal.facial_landmarks_mm
     # The built-in depth table, whatever the SFO used: the calibration was fitted on terms
     # computed with it, and a user's table would move the terms off that calibration.
-    terms = identification_terms(
+    terms, overlaps = terms_and_overlaps(
         skull, photos, [r.camera for r in results], facial, cohort=cohort
     )
     model = calibrations.get(key)
@@ -297,7 +298,7 @@ def identify(skull, photos, results, calibrations, cohort, facial_landmarks_mm=N
         if len(photos) > 1 and not joint:
             note = "calibrated on one frontal and one lateral photo; these photos differ"
     worst, misfit = worst_landmark_of(skull, photos, [r.camera for r in results])
-    inconsistent = _inconsistent(skull, photos, results, facial)
+    inconsistent = _inconsistent(photos, results, overlaps, facial)
     verdict = conclude(lr, caps, inconsistent)
     return Identification(
         calibration,

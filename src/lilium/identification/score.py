@@ -7,9 +7,12 @@ unweighted (the score before calibration); the calibrated log10 LR is
 :meth:`lilium.identification.calibration.Calibration.log10_lr`.
 """
 
+from dataclasses import dataclass
+from functools import cached_property
+
 import numpy as np
 
-from ..evaluation.metrics import outside_depth_px, outside_face
+from ..evaluation.metrics import implausible_sfo, outside_depth_px
 from ..geometry.camera import Camera
 from ..imaging.raster import mesh_mask
 from ..inputs import correspondences
@@ -62,11 +65,9 @@ def pll_face(skull, photo, camera, eye_px):
 
 def outside_fraction(skull, photo, camera):
     """The share of the skull's pixels outside the photo's head mask under one camera (None
-    when the photo has no mask)."""
-    if photo.face_mask is None:
-        return None
-    counts = outside_face(camera, skull.vertices_mm, skull.faces, photo.face_mask)
-    return counts.outside_px / counts.skull_px if counts.skull_px else 1.0
+    when the photo has no mask; :attr:`HeadOverlap.outside_fraction`)."""
+    overlap = head_overlap(skull, photo, camera)
+    return None if overlap is None else overlap.outside_fraction
 
 
 #: "Skull outside the head" counts the skull's pixels more than this share of the eye-corner
@@ -83,6 +84,63 @@ OUTSIDE_BAND_EYE = 0.01
 OUTSIDE_BAND_MIN_PX = 2.0
 
 
+@dataclass(frozen=True)
+class HeadOverlap:
+    """The skull's raster under one camera against the photo's head mask: one raster for the
+    term ``outside_fraction`` and the rule "skull outside the head" (:meth:`beyond`).
+
+    Attributes
+    ----------
+    skull_mask : ndarray of shape (H, W), bool
+        The projected skull (:func:`lilium.imaging.raster.mesh_mask`).
+    face_mask : ndarray of shape (H, W), bool
+        The photo's head mask.
+    eye_px : float
+        The eye-corner distance in pixels at the skull's landmarks (the face-size unit; NaN for
+        a degenerate camera).
+    """
+
+    skull_mask: np.ndarray
+    face_mask: np.ndarray
+    eye_px: float
+
+    @property
+    def skull_px(self):
+        """The skull's pixels."""
+        return int(np.count_nonzero(self.skull_mask))
+
+    @property
+    def outside_fraction(self):
+        """The share of the skull's pixels outside the mask (1 for a skull of no pixel;
+        :func:`lilium.evaluation.metrics.implausible_sfo`'s counts)."""
+        counts = implausible_sfo(self.skull_mask, self.face_mask)
+        return counts.outside_px / counts.skull_px if counts.skull_px else 1.0
+
+    @cached_property
+    def depths_px(self):
+        """Per skull pixel outside the mask, its distance (pixels) to the nearest mask pixel
+        (:func:`lilium.evaluation.metrics.outside_depth_px`), shape (M,); computed once."""
+        return outside_depth_px(self.skull_mask, self.face_mask)
+
+    def beyond(self):
+        """``(beyond_px, skull_px, band_px)``: the skull's pixels more than ``band_px``
+        (:func:`outside_band_px`) outside the mask, of its ``skull_px``."""
+        band = outside_band_px(self.eye_px)
+        return int(np.count_nonzero(self.depths_px > band)), self.skull_px, band
+
+
+def head_overlap(skull, photo, camera):
+    """The :class:`HeadOverlap` of the skull under one camera (None when the photo has no
+    mask)."""
+    if photo.face_mask is None:
+        return None
+    face_mask = np.asarray(photo.face_mask) != 0
+    height, width = face_mask.shape
+    eye_px = eye_corner_px(camera, np.array(list(skull.landmarks_mm.values()), float))
+    skull_mask = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height)) != 0
+    return HeadOverlap(skull_mask, face_mask, float(eye_px))
+
+
 def outside_depths(skull, photo, camera):
     """How far outside the head mask each of the skull's pixels outside it lies, under one
     camera (None when the photo has no mask).
@@ -96,13 +154,10 @@ def outside_depths(skull, photo, camera):
     eye_px : float
         The eye-corner distance in pixels (the face-size unit; NaN for a degenerate camera).
     """
-    if photo.face_mask is None:
+    overlap = head_overlap(skull, photo, camera)
+    if overlap is None:
         return None
-    height, width = np.asarray(photo.face_mask).shape
-    eye_px = eye_corner_px(camera, np.array(list(skull.landmarks_mm.values()), float))
-    skull_mask = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height))
-    return (outside_depth_px(skull_mask, photo.face_mask), int(np.count_nonzero(skull_mask)),
-            float(eye_px))
+    return overlap.depths_px, overlap.skull_px, overlap.eye_px
 
 
 def skull_beyond_head(skull, photo, camera):
@@ -118,12 +173,8 @@ def skull_beyond_head(skull, photo, camera):
 
     None when the photo has no mask.
     """
-    found = outside_depths(skull, photo, camera)
-    if found is None:
-        return None
-    depth, skull_px, eye_px = found
-    band = outside_band_px(eye_px)
-    return int(np.count_nonzero(depth > band)), skull_px, band
+    overlap = head_overlap(skull, photo, camera)
+    return None if overlap is None else overlap.beyond()
 
 
 def outside_band_px(eye_px):
@@ -132,12 +183,6 @@ def outside_band_px(eye_px):
     if not np.isfinite(eye_px):
         return OUTSIDE_BAND_MIN_PX
     return float(max(OUTSIDE_BAND_MIN_PX, OUTSIDE_BAND_EYE * eye_px))
-
-
-def image_consistency(skull, photo, camera, eye_px):
-    """``outside_fraction`` and ``pll_face`` of one photo under one camera (None when the
-    photo has no mask / P_pll cannot apply)."""
-    return outside_fraction(skull, photo, camera), pll_face(skull, photo, camera, eye_px)
 
 
 def refit_terms(skull, photos, views):
@@ -151,11 +196,12 @@ def refit_terms(skull, photos, views):
     return float(landmark_chi2(refitted)[0]), (float(np.mean(outside)) if outside else None)
 
 
-def identification_terms(
+def terms_and_overlaps(
     skull, photos, cameras, facial_landmarks_mm, depth_table=None, image=None, cohort=None,
     cohort_cache=None,
 ):
-    """The identification terms of one SFO result.
+    """The identification terms of one SFO result, and the skull's overlap with each photo's
+    head mask they read (:func:`identification_terms` without the overlaps).
 
     Parameters
     ----------
@@ -184,17 +230,26 @@ def identification_terms(
 
     Returns
     -------
-    dict
+    terms : dict
         ``{name: float or None}`` for every name of :data:`TERM_NAMES`, plus ``"nll"`` (the
         landmarks' negative log-likelihood in nats) and ``"landmarks"`` (pairs used).
+    overlaps : list of HeadOverlap or None
+        Per photo, the skull's raster under its camera against the head mask (None where the
+        photo has no mask or its ``image`` terms were given): ``outside_fraction`` is read from
+        it, and the rule "skull outside the head" (:meth:`HeadOverlap.beyond`) can read the
+        same raster.
     """
     views = views_of(skull, photos, cameras, depth_table)
-    outside, pll, excess = [], [], []
+    outside, pll, excess, overlaps = [], [], [], []
     for k, (photo, camera, view) in enumerate(zip(photos, cameras, views, strict=True)):
+        overlap = None
         if image is not None and image[k] is not None:
             o, p = image[k]
         else:
-            o, p = image_consistency(skull, photo, camera, eye_corner_px(camera, view.cranial_mm))
+            overlap = head_overlap(skull, photo, camera)
+            o = None if overlap is None else overlap.outside_fraction
+            p = pll_face(skull, photo, camera, eye_corner_px(camera, view.cranial_mm))
+        overlaps.append(overlap)
         outside.append(o)
         pll.append(p)
         point = scd_point_mm(facial_landmarks_mm) if facial_landmarks_mm else view.cranial_mm[0]
@@ -243,7 +298,18 @@ def identification_terms(
     assert tuple(out) == TERM_NAMES
     out["nll"] = nll
     out["landmarks"] = int(sum(len(v.names) for v in views))
-    return out
+    return out, overlaps
+
+
+def identification_terms(
+    skull, photos, cameras, facial_landmarks_mm, depth_table=None, image=None, cohort=None,
+    cohort_cache=None,
+):
+    """The identification terms of one SFO result: :func:`terms_and_overlaps`' ``terms``
+    (same parameters)."""
+    return terms_and_overlaps(
+        skull, photos, cameras, facial_landmarks_mm, depth_table, image, cohort, cohort_cache
+    )[0]
 
 
 #: The terms added last, in the order they came: stored terms lacking only these are

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..evaluation.metrics import ImplausibleSFO
 from ..geometry.rotations import geodesic_angle_deg, matrix_to_euler_xyz_deg, matrix_to_rotvec
-from ..identification.score import outside_band_px, outside_depths
+from ..identification.score import head_overlap
 from ..io.provenance import input_files, software_versions
 from ..softtissue.landmarks import FACIAL_TO_CRANIAL
 from ..validation import fmt_range
@@ -256,9 +256,9 @@ def sfo_record(entry, index=1, hash_cache=None, view_cache=None):
         # One raster for both: every skull pixel outside the mask (the figure shown), and the
         # mark by the identification's rule (skull_outside_head: pixels beyond the mask's edge
         # band, not a pixel or two of raster and mask-edge noise).
-        depth_px, skull_px, eye_px = outside_depths(skull, photo, result.camera)
-        outside = ImplausibleSFO.of(len(depth_px), skull_px)
-        implausible = bool(np.any(depth_px > outside_band_px(eye_px)))
+        overlap = head_overlap(skull, photo, result.camera)
+        outside = ImplausibleSFO.of(len(overlap.depths_px), overlap.skull_px)
+        implausible = overlap.beyond()[0] > 0
     points = [r.photo_uv for r in rows] + [r.estimate_uv for r in rows]
     if result:
         points += list(_skull_uv_in_image(result.camera, skull, photo.image_size_wh))
