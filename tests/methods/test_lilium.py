@@ -112,3 +112,63 @@ def test_refused_focal_lengths_read_well_in_the_message():
     assert "3.16e+129 px" in message and len(message) < 500
     assert "ran off towards an infinite focal length" in message and "swapped" not in message
     assert "4 landmark pairs lie nearly in one plane (0.0 mm RMS out of it" in message
+
+
+def test_missed_head_prior_is_the_identifications_bound(case):
+    """A best camera more than three tolerances off the head-orientation prior missed it (the
+    bound of the identification's ``head_outside_prior``); without a prior or a camera, not."""
+    from dataclasses import replace
+
+    from scipy.spatial.transform import Rotation
+
+    from lilium.methods.lilium_outcome import missed_head_prior
+    from lilium.methods.prior_checks import FAR_TOLERANCES
+
+    photo = read_photo(case[1])
+    priors = photo.priors
+    assert priors.uses_head
+    bound = FAR_TOLERANCES * priors.head_tolerance_deg
+    prior_R = np.asarray(priors.head_rotation_skull2cam)
+
+    def turned(deg):
+        return Rotation.from_euler("y", deg, degrees=True).as_matrix() @ prior_R
+
+    assert not missed_head_prior(photo, {"R": prior_R, "success": True})
+    assert not missed_head_prior(photo, {"R": turned(bound - 1.0), "success": True})
+    assert missed_head_prior(photo, {"R": turned(bound + 1.0), "success": True})
+    assert not missed_head_prior(photo, {"R": turned(bound + 1.0), "success": False})
+    bare = replace(photo, priors=CameraPriors(focal_px=priors.focal_px, scd_mm=priors.scd_mm))
+    assert not missed_head_prior(bare, {"R": turned(90.0), "success": True})
+
+
+@pytest.mark.parametrize("misses", [1, 5])
+def test_a_search_that_missed_the_head_prior_runs_again(case, monkeypatch, misses):
+    """A search whose best camera missed the head prior runs again with the seed ``[seed, k]``,
+    at most MAX_RESTARTS times; the result is the search of lowest fitness, and says how many
+    ran. A camera given to score is never searched again."""
+    import lilium.methods.lilium as lilium_module
+    from lilium.methods.lilium_outcome import MAX_RESTARTS
+
+    skull, photo = read_skull(case[0]), read_photo(case[1])
+    opts = _opts(generations=8, population=10)
+    plain = lilium_sfo(skull, photo, opts, seed=3)
+    assert plain.extra["restarts"] == 0
+    calls = []
+
+    def missed(photo, best):
+        calls.append(best)
+        return len(calls) <= misses
+
+    monkeypatch.setattr(lilium_module, "missed_head_prior", missed)
+    result = lilium_sfo(skull, photo, opts, seed=3)
+    restarts = min(misses, MAX_RESTARTS)
+    assert result.extra["restarts"] == restarts
+    searched = [
+        float(lilium_module._search(skull, photo, opts, s, None, None)[1].fun)
+        for s in [3, *([3, k] for k in range(1, restarts + 1))]
+    ]
+    assert searched[0] == plain.extra["history"][-1]
+    assert result.extra["history"][-1] == min(searched)
+    calls.clear()
+    scored = lilium_sfo(skull, photo, opts, seed=3, camera=plain.camera)
+    assert scored.extra["restarts"] == 0 and not calls

@@ -68,8 +68,8 @@ from ..pose.prior_refine import refine_with_priors
 from ..pose.residuals import reprojection_sq_errors
 from ..softtissue.cones import decode
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL
-from .lilium import IMAGE_TERMS, LiliumProblem, build_cones, de_extra
-from .lilium_outcome import outcome_fitness, photo_outcome
+from .lilium import IMAGE_TERMS, LiliumProblem, build_cones
+from .lilium_outcome import de_extra, outcome_fitness, photo_outcome
 from .options import SfoOptions
 from .result import SfoResult, finite_or_none
 

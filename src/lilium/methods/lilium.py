@@ -43,7 +43,13 @@ from ..softtissue.cones import decode, encode_depth_only, make_cones, midsagitta
 from ..softtissue.depths import depth_stats
 from .checks import facing_check
 from .lilium_cameras import camera_terms_compiled, checks_compiled
-from .lilium_outcome import outcome_fitness, photo_outcome
+from .lilium_outcome import (
+    MAX_RESTARTS,
+    de_extra,
+    missed_head_prior,
+    outcome_fitness,
+    photo_outcome,
+)
 from .lilium_terms import image_terms, prior_terms_off
 from .options import SfoOptions, with_focal_cap
 from .posest_sfo import RUN_OFF_FACTOR, mean_depth_landmarks
@@ -503,16 +509,20 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None, camera
         ``stop``, ``genes``, ``fallbacks``, ``no_camera_evaluations`` (population evaluations
         where no member had a camera and each took its own POSEST), ``rescued`` (the initial
         population got POSEST-SFO's soft tissue and camera, :func:`rescue_population`) and the
-        working level's (:meth:`LiliumProblem.level_extra`).
+        working level's (:meth:`LiliumProblem.level_extra`), and ``restarts``: the searches
+        run again with the seeds ``[seed, 1]``, ``[seed, 2]`` because the best camera missed
+        the head-orientation prior (:func:`~lilium.methods.lilium_outcome.missed_head_prior`),
+        at most :data:`~lilium.methods.lilium_outcome.MAX_RESTARTS`; the result is the search
+        of lowest fitness.
     """
     start = time.perf_counter()
-    rng = np.random.default_rng(seed)
-    problem = LiliumProblem(skull, photo, options, rng=rng, camera=camera)
-    solver = DifferentialEvolution(
-        problem, problem.cones.n_genes, problem.periodic, options.de, rng=rng, callback=callback
-    )
-    rescued = camera is None and rescue_population(problem, solver)
-    de = solver.solve()
+    problem, de, rescued = _search(skull, photo, options, seed, callback, camera)
+    restarts = 0
+    while camera is None and restarts < MAX_RESTARTS and missed_head_prior(photo, de.payload):
+        restarts += 1
+        again = _search(skull, photo, options, [seed, restarts], callback, camera)
+        if again[1].fun < de.fun:
+            problem, de, rescued = again
     best = de.payload
     camera, terms, error, warnings = photo_outcome(problem, best, seed)
     fitness = outcome_fitness(problem, de.fun, camera, terms)
@@ -535,9 +545,22 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None, camera
             **de_extra(de, problem.n_fallbacks),
             "no_camera_evaluations": problem.n_no_camera,
             "rescued": rescued,
+            "restarts": restarts,
             **problem.level_extra(),
         },
     )
+
+
+def _search(skull, photo, options, seed, callback, camera):
+    """One DE search of :func:`lilium_sfo` seeded by ``seed`` (an int, or ``[seed, k]`` for its
+    k-th restart): ``(problem, DE result, rescued)``."""
+    rng = np.random.default_rng(seed)
+    problem = LiliumProblem(skull, photo, options, rng=rng, camera=camera)
+    solver = DifferentialEvolution(
+        problem, problem.cones.n_genes, problem.periodic, options.de, rng=rng, callback=callback
+    )
+    rescued = camera is None and rescue_population(problem, solver)
+    return problem, solver.solve(), rescued
 
 
 def rescue_population(problem, solver):
@@ -571,16 +594,3 @@ def rescue_population(problem, solver):
         values[k] = terms[key][0]
     solver.history[0] = float(solver.fitness.min())
     return True
-
-
-def de_extra(de, fallbacks):
-    """The ``extra`` of an SFO result from its finished :class:`DifferentialEvolution` run:
-    ``history``, ``generations``, ``evaluations``, ``stop``, ``genes``, ``fallbacks``."""
-    return {
-        "history": de.history.tolist(),
-        "generations": de.nit,
-        "evaluations": de.nfev,
-        "stop": de.message,
-        "genes": de.x.tolist(),
-        "fallbacks": fallbacks,
-    }
