@@ -172,3 +172,5 @@ def test_a_search_that_missed_the_head_prior_runs_again(case, monkeypatch, misse
     calls.clear()
     scored = lilium_sfo(skull, photo, opts, seed=3, camera=plain.camera)
     assert scored.extra["restarts"] == 0 and not calls
+    halted = lilium_sfo(skull, photo, opts, seed=3, callback=lambda solver: True)
+    assert halted.extra["restarts"] == 0 and halted.extra["stop"] == "stopped by the callback"

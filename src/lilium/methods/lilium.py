@@ -35,7 +35,7 @@ from ..fitness._camera_kernels import camera_terms_kernel
 from ..fitness.camera_penalty import camera_penalty_from_priors, prior_arrays
 from ..geometry.camera import Cameras, principal_point_of
 from ..inputs import correspondences
-from ..optimisation.de import DifferentialEvolution
+from ..optimisation.de import STOPPED_BY_CALLBACK, DifferentialEvolution
 from ..pose.posest import posest
 from ..pose.refine import refine_batch
 from ..pose.residuals import reprojection_sq_errors
@@ -512,15 +512,18 @@ def lilium_sfo(skull, photo, options=SfoOptions(), seed=0, callback=None, camera
         working level's (:meth:`LiliumProblem.level_extra`), and ``restarts``: the searches
         run again with the seeds ``[seed, 1]``, ``[seed, 2]`` because the best camera missed
         the head-orientation prior (:func:`~lilium.methods.lilium_outcome.missed_head_prior`),
-        at most :data:`~lilium.methods.lilium_outcome.MAX_RESTARTS`; the result is the search
-        of lowest fitness.
+        at most :data:`~lilium.methods.lilium_outcome.MAX_RESTARTS` (none after the callback
+        stopped a search; each search has the DE's whole budget); the result is the search of
+        lowest fitness.
     """
     start = time.perf_counter()
     problem, de, rescued = _search(skull, photo, options, seed, callback, camera)
-    restarts = 0
-    while camera is None and restarts < MAX_RESTARTS and missed_head_prior(photo, de.payload):
+    restarts, stopped = 0, de.message == STOPPED_BY_CALLBACK
+    while (camera is None and not stopped and restarts < MAX_RESTARTS
+           and missed_head_prior(photo, de.payload)):
         restarts += 1
         again = _search(skull, photo, options, [seed, restarts], callback, camera)
+        stopped = again[1].message == STOPPED_BY_CALLBACK
         if again[1].fun < de.fun:
             problem, de, rescued = again
     best = de.payload

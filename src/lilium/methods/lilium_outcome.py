@@ -7,8 +7,8 @@ members fitted the landmarks better than the result but exceeded the cap, or whe
 tissue fits a focal length above the cap.
 
 A search whose best camera looks at the head from far outside the photo's head-orientation prior
-(:func:`missed_head_prior`) is run again with other seeds (:func:`~lilium.methods.lilium.
-lilium_sfo`). :func:`de_extra` is a finished run's record.
+(:func:`missed_head_prior`) is run again with other seeds
+(:func:`~lilium.methods.lilium.lilium_sfo`). :func:`de_extra` is a finished run's record.
 """
 
 import numpy as np

@@ -183,6 +183,10 @@ def fold_into_cube(x, periodic, rng):
     return x
 
 
+#: :attr:`DifferentialEvolution.message` of a run its callback stopped.
+STOPPED_BY_CALLBACK = "stopped by the callback"
+
+
 class DifferentialEvolution:
     """DE/rand/1/exp solver; iterate it to run one generation per step.
 
@@ -253,7 +257,7 @@ class DifferentialEvolution:
             raise StopIteration
         self.step()
         if self.callback is not None and self.callback(self):
-            self.message = "stopped by the callback"
+            self.message = STOPPED_BY_CALLBACK
             raise StopIteration
         return self.population[self.best_index], float(self.fitness.min())
 
