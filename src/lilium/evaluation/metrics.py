@@ -209,12 +209,19 @@ def outside_face(camera, vertices_mm, faces, face_mask, topology=None):
     -------
     ImplausibleSFO
     """
+    face_mask = face_mask_2d(face_mask)
+    height, width = face_mask.shape
+    skull_mask = mesh_mask(vertices_mm, faces, camera, (width, height), topology=topology)
+    return implausible_sfo(skull_mask, face_mask)
+
+
+def face_mask_2d(face_mask):
+    """``face_mask`` as an array of shape (H, W); a ``ValueError`` that says so otherwise (a
+    colour mask)."""
     face_mask = np.asarray(face_mask)
     if face_mask.ndim != 2:
         raise ValueError(
             f"face_mask must be a 2D (rows, columns) array, got shape {face_mask.shape}; "
             "convert a colour mask to one channel first"
         )
-    height, width = face_mask.shape
-    skull_mask = mesh_mask(vertices_mm, faces, camera, (width, height), topology=topology)
-    return implausible_sfo(skull_mask, face_mask)
+    return face_mask

@@ -12,7 +12,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..evaluation.metrics import implausible_sfo, outside_depth_px
+from ..evaluation.metrics import face_mask_2d, implausible_sfo, outside_depth_px
 from ..geometry.camera import Camera
 from ..imaging.raster import mesh_mask
 from ..inputs import correspondences
@@ -84,7 +84,7 @@ OUTSIDE_BAND_EYE = 0.01
 OUTSIDE_BAND_MIN_PX = 2.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class HeadOverlap:
     """The skull's raster under one camera against the photo's head mask: one raster for the
     term ``outside_fraction`` and the rule "skull outside the head" (:meth:`beyond`).
@@ -134,7 +134,7 @@ def head_overlap(skull, photo, camera):
     mask)."""
     if photo.face_mask is None:
         return None
-    face_mask = np.asarray(photo.face_mask) != 0
+    face_mask = face_mask_2d(photo.face_mask) != 0
     height, width = face_mask.shape
     eye_px = eye_corner_px(camera, np.array(list(skull.landmarks_mm.values()), float))
     skull_mask = mesh_mask(skull.vertices_mm, skull.faces, camera, (width, height)) != 0

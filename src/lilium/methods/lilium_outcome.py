@@ -79,7 +79,7 @@ def missed_head_prior(photo, best):
     head-orientation prior: the same bound as the identification's ``head_outside_prior``.
 
     On a lateral photo the DE's whole population can start in the wrong branch of the pose
-    solutions (measured: 2 of 240 same-person lateral SFOs, fitness 7e5-2e6 against tens, the
+    solutions (measured: 2 of 240 same-person SFOs, both lateral, fitness 7e5-2e6 against tens, the
     camera 47-57 degrees off the prior); another seed finds the right one.
 
     Parameters
