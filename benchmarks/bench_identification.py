@@ -62,7 +62,7 @@ from lilium.experiments.runner import run_experiment
 from lilium.experiments.store import COLUMNS, ResultStore
 from lilium.geometry.camera import Camera
 from lilium.identification.terms import COHORT_CALIBRATED_TERMS
-from lilium.inputs import correspondences
+from lilium.methods.pairs import correspondences
 from lilium.methods.posest_sfo import mean_depth_landmarks
 from lilium.optimisation.de import DEOptions
 

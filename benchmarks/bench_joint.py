@@ -52,11 +52,11 @@ import numpy as np
 
 from lilium.casework.build import read_photo, read_skull
 from lilium.evaluation import outside_face, score
-from lilium.inputs import correspondences
 from lilium.io.jsonio import read_json
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions, run_sfo
 from lilium.methods.joint import ANGLE_PRIOR_WEIGHT, DEFAULT_CAMERA, joint_lilium_sfo
+from lilium.methods.pairs import correspondences
 from lilium.optimisation import DEOptions
 
 #: The data tools (benchmarks/datasets) this script imports, e.g. ``headsq_case``.

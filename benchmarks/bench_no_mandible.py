@@ -40,10 +40,10 @@ import numpy as np
 
 from lilium.casework.build import read_photo, read_skull
 from lilium.evaluation import score
-from lilium.inputs import correspondences
 from lilium.io.jsonio import read_json
 from lilium.io.truth import read_ground_truth
 from lilium.methods import SfoOptions, run_sfo
+from lilium.methods.pairs import correspondences
 from lilium.optimisation import DEOptions
 
 #: Dataset kinds: folder name -> share of skulls without the mandible.

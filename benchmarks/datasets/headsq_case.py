@@ -216,8 +216,8 @@ def sfo_problems_from_dataset(root, experiment="C", axes_set=1, subjects=None):
     """
     from lilium.casework.build import read_photo, read_skull
     from lilium.geometry.camera import Camera
-    from lilium.inputs import correspondences
     from lilium.io.jsonio import read_json
+    from lilium.methods.pairs import correspondences
     from lilium.methods.posest_sfo import mean_depth_landmarks
     from sfo_problems import SfoProblem
 

@@ -19,7 +19,8 @@ import numpy as np
 
 from lilium.evaluation.metrics import back_projection_error
 from lilium.geometry import Camera
-from lilium.inputs import Photo, Skull, correspondences
+from lilium.inputs import Photo, Skull
+from lilium.methods.pairs import correspondences
 from lilium.methods.posest_sfo import mean_depth_landmarks
 from lilium.synthetic import noise as _noise
 from lilium.synthetic import photos as _photos

@@ -38,9 +38,9 @@ from lilium.identification.cohort import (
     skull_cohort_terms,
 )
 from lilium.identification.terms import landmark_blocks, landmark_chi2, make_view
-from lilium.inputs import correspondences
 from lilium.io.calibration import shipped_cohort
 from lilium.io.jsonio import read_json
+from lilium.methods.pairs import correspondences
 
 #: The data tools (benchmarks/datasets) this study imports: ``headsq_case``, ``cranium_case``.
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "datasets"))

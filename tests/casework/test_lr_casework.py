@@ -67,7 +67,7 @@ def test_the_record_names_a_misplaced_landmark(case, tmp_path):
     from types import SimpleNamespace
 
     from lilium.casework.build import read_photo, read_skull
-    from lilium.inputs import correspondences
+    from lilium.methods.pairs import correspondences
     from lilium.report.conclusion_html import conclusion_section
 
     subject_dir, photo_dir = case

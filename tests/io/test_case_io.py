@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from lilium.casework.build import read_photo, read_skull
-from lilium.inputs import correspondences
 from lilium.io.case import read_depth_table
 from lilium.io.mesh import write_mesh
+from lilium.methods.pairs import correspondences
 
 
 def _edit_json(path, change):

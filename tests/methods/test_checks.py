@@ -9,7 +9,7 @@ import pytest
 from lilium.casework.build import read_photo, read_skull
 from lilium.geometry.camera import Camera, principal_point_of
 from lilium.geometry.rotations import rotvec_to_matrix
-from lilium.inputs import Photo, Priors, correspondences
+from lilium.inputs import Photo, Priors
 from lilium.methods import SfoOptions, run_sfo
 from lilium.methods.checks import (
     check_inputs,
@@ -22,6 +22,7 @@ from lilium.methods.checks import (
     skull_directions,
 )
 from lilium.methods.lilium import lilium_sfo
+from lilium.methods.pairs import correspondences
 from lilium.methods.posest_sfo import mean_depth_landmarks, posest_sfo
 from lilium.methods.prior_checks import priors_record
 from lilium.softtissue.landmarks import side, twin

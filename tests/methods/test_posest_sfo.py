@@ -5,8 +5,9 @@ import numpy as np
 from lilium.casework.build import read_photo, read_skull
 from lilium.cli.main import main
 from lilium.geometry import Camera, geodesic_angle_deg
-from lilium.inputs import Photo, correspondences
+from lilium.inputs import Photo
 from lilium.io.truth import read_ground_truth
+from lilium.methods.pairs import correspondences
 from lilium.methods.posest_sfo import mean_depth_landmarks, posest_sfo
 
 

@@ -8,10 +8,10 @@ import pytest
 
 from lilium.casework.build import read_photo, read_skull
 from lilium.geometry.camera import Camera
-from lilium.inputs import correspondences
 from lilium.methods import SfoOptions
 from lilium.methods.lilium import lilium_sfo
 from lilium.methods.lilium_terms import SkofTerm, full_image_terms
+from lilium.methods.pairs import correspondences
 from lilium.methods.working_level import (
     WorkingLevel,
     cluster_vertices,

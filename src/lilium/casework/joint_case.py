@@ -8,9 +8,9 @@ Methods without a joint form (POSEST-SFO) run per photo as without ``--joint``.
 
 from pathlib import Path
 
-from ..inputs import correspondences
 from ..io.jsonio import write_json
 from ..io.results import read_joint_result
+from ..methods.pairs import correspondences
 from ..methods.registry import METHODS, method_tag, run_joint_sfo
 from .console import log_warnings, status_text
 from .folders import (

@@ -50,8 +50,8 @@ from ..identification.calibration import (
 from ..identification.cohort import Cohort
 from ..identification.score import LATE_TERMS, identification_terms, pll_face, with_late_terms
 from ..identification.terms import TERM_NAMES, eye_corner_px
-from ..inputs import correspondences
 from ..io.calibration import shipped_cohort
+from ..methods.pairs import correspondences
 from ..synthetic.subjects import axes_on_skull, make_subjects
 from .config import view_group
 from .store import COLUMNS, ResultStore, task_key

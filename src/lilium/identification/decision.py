@@ -21,7 +21,7 @@ them, :mod:`lilium.casework.identify`).
 
 from dataclasses import dataclass, field
 
-from ..inputs import correspondences
+from ..methods.pairs import correspondences
 from ..methods.prior_checks import perspective_conflict, prior_conflicts
 from .calibration import VIEWS_LOG10_LR
 from .conclusion import EXAMINER_CAMERA, UNREVIEWED_SKULL, conclude, material_caps

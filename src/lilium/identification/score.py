@@ -15,8 +15,8 @@ import numpy as np
 from ..evaluation.metrics import face_mask_2d, implausible_sfo, outside_depth_px
 from ..geometry.camera import Camera
 from ..imaging.raster import mesh_mask
-from ..inputs import correspondences
 from ..methods.lilium_terms import PllTerm, TermOff
+from ..methods.pairs import correspondences
 from ..methods.prior_checks import scd_point_mm
 from ..softtissue.depths import depth_stats
 from ..softtissue.landmarks import CRANIAL_TO_FACIAL

@@ -224,7 +224,7 @@ class View:
 
 
 def make_view(camera, corr, sources=None, depth_table=None):
-    """A :class:`View` from an SFO's camera and its :class:`lilium.inputs.Correspondences`.
+    """A :class:`View` from an SFO's camera and its :class:`lilium.methods.pairs.Correspondences`.
 
     Parameters
     ----------

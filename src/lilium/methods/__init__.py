@@ -2,6 +2,8 @@
 
 - :mod:`~lilium.methods.registry`: :data:`METHODS`, :func:`run_sfo`, :func:`method_tag`;
 - :mod:`~lilium.methods.options`: :class:`SfoOptions`, the one options type;
+- :mod:`~lilium.methods.pairs`: :func:`~lilium.methods.pairs.correspondences`, the skull's and
+  the photo's landmarks paired (the first step of every method and of the checks before one);
 - :mod:`~lilium.methods.result`: :class:`SfoResult` and its ``result.json`` dictionary;
 - :mod:`~lilium.methods.posest_sfo`: the POSEST-SFO baseline;
 - :mod:`~lilium.methods.lilium` and :mod:`~lilium.methods.lilium_terms`: Lilium (DE over

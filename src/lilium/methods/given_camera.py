@@ -7,11 +7,11 @@ import time
 
 import numpy as np
 
-from ..inputs import correspondences
 from ..pose.residuals import reprojection_sq_errors
 from .lilium import LiliumProblem, lilium_sfo
 from .lilium_outcome import outcome_fitness, photo_outcome
 from .options import SfoOptions
+from .pairs import correspondences
 from .posest_sfo import mean_depth_landmarks
 from .result import SfoResult
 

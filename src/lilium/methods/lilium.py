@@ -34,7 +34,6 @@ from ..constants import C_INF, FOCAL_MIN_PX, focal_cap_px
 from ..fitness._camera_kernels import camera_terms_kernel
 from ..fitness.camera_penalty import camera_penalty_from_priors, prior_arrays
 from ..geometry.camera import Cameras, principal_point_of
-from ..inputs import correspondences
 from ..optimisation.de import STOPPED_BY_CALLBACK, DifferentialEvolution
 from ..pose.posest import posest
 from ..pose.refine import refine_batch
@@ -52,6 +51,7 @@ from .lilium_outcome import (
 )
 from .lilium_terms import image_terms, prior_terms_off
 from .options import SfoOptions, with_focal_cap
+from .pairs import correspondences
 from .posest_sfo import RUN_OFF_FACTOR, mean_depth_landmarks
 from .result import SfoResult
 from .working_level import working_level
@@ -73,7 +73,7 @@ IMAGE_TERMS = ("p_pll", "p_skof")
 
 def build_cones(skull, corr, depth_table=None):
     """Cones of the usable landmarks (``corr``: anything with ``cranial_names`` and ``axes``, a
-    :class:`~lilium.inputs.Correspondences`), twins with mirror-consistent bases."""
+    :class:`~lilium.methods.pairs.Correspondences`), twins with mirror-consistent bases."""
     stats = [depth_stats(c, depth_table) for c in corr.cranial_names]
     _, normal = midsagittal_plane(skull.landmarks_mm)
     return make_cones(

@@ -17,12 +17,13 @@ import numpy as np
 
 from ..constants import FOCAL_MAX_PX, focal_cap_px
 from ..geometry.camera import principal_point_of
-from ..inputs import CaseWarning, correspondences
+from ..inputs import CaseWarning
 from ..pose.posest import posest
 from ..softtissue.depths import depth_stats
 from ..validation import fmt_number, fmt_range
 from .checks import facing_check, facing_failure
 from .options import SfoOptions, with_cap_px, with_focal_cap
+from .pairs import correspondences
 from .result import SfoResult
 
 

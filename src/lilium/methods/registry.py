@@ -7,13 +7,13 @@ runs a method through :func:`run_sfo` with one :class:`~lilium.methods.options.S
 
 from dataclasses import dataclass, replace
 
-from ..inputs import correspondences
 from .checks import check_given_camera, check_inputs, finish_result
 from .given_camera import lilium_at, posest_sfo_at
 from .joint import joint_lilium_sfo
 from .lilium import VARIANTS, lilium_sfo
 from .lilium_terms import planned_terms_off
 from .options import SfoOptions
+from .pairs import correspondences
 from .posest_sfo import posest_sfo
 
 
@@ -219,7 +219,7 @@ def run_joint_sfo(method, skull, photos, options=SfoOptions(), seed=0):
 def check_runnable(skull, photo, methods, variant, photo_file):
     """Check that an SFO of ``photo`` can run, before any SFO runs; say what it will switch off.
 
-    The landmarks must pair (:func:`lilium.inputs.correspondences`: at least four pairs, the
+    The landmarks must pair (:func:`lilium.methods.pairs.correspondences`: at least four pairs, the
     one case no term set can run); otherwise the ``ValueError`` starts with the file to fix.
     For Lilium, a term the variant asks for whose inputs are missing (P_skof without a face
     mask; P_pll without the cranial landmarks that cut its region, e.g. a skull without its
