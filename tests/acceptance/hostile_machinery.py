@@ -189,8 +189,8 @@ def check_probe(probe, ws, limit_s=LIMIT_S):
 def probe_params(*groups, known_limits=None):
     """A ``pytest.param`` of each probe of ``groups`` (lists of :class:`Probe`), its name as
     its id (``-k`` selects by it); ``known_limits``: ``{probe name: reason}`` of the probes
-    that fail on a limit docs/method.md documents and that is not mended (expected to fail,
-    not strictly: a run may land within the tolerance)."""
+    that fail on a limit the method's docs (docs/method/) document and that is not mended
+    (expected to fail, not strictly: a run may land within the tolerance)."""
     import pytest
 
     known_limits = known_limits or {}

@@ -10,11 +10,12 @@ Two kinds of probes:
   an uninterrupted run of the same command would (its outputs are compared with a fresh run's
   in another folder), or refuse in one line; silently keeping a stale result is ``silently
   wrong``.
-- the subprocess scenarios of ``hostile_scenarios.py``, run by this file (``python
-  benchmarks/hostile_resume.py --work /tmp/probesB [--only TEXT]``): subprocesses killed
-  with SIGKILL mid-run and rerun, interrupted with SIGINT (Ctrl-C: one line, no traceback, also
-  from worker processes), two runs on one ``--out`` or ``--db`` at once, and a file-size limit
-  (``ulimit -f``) while writing. One line per scenario: ``pass`` or ``defect`` and why.
+- the subprocess scenarios of ``hostile_scenarios.py``, run by ``test_hostile_resume.py``
+  (``python -m pytest -m slow tests/acceptance/test_hostile_resume.py [-k TEXT]``):
+  subprocesses killed with SIGKILL mid-run and rerun, interrupted with SIGINT (Ctrl-C: one
+  line, no traceback, also from worker processes), two runs on one ``--out`` or ``--db`` at
+  once, and a file-size limit (``ulimit -f``) while writing. One line per scenario: ``pass``
+  or ``defect`` and why.
 
 Budgets: POSEST-SFO, or Lilium with DE 5 x 2 (in-process) and 8 x 40 (to be killed mid-run).
 """

@@ -11,8 +11,8 @@ pytestmark = pytest.mark.slow
 LIMIT_S = 120
 
 _RESOLUTION = (
-    "known limit: the photo's resolution moves Lilium's answer (docs/method.md, 'The photo's "
-    "resolution moves Lilium's lateral LR'); not mended"
+    "known limit: the photo's resolution moves Lilium's answer (docs/method/lilium.md, 'The "
+    "photo's resolution moves the lateral LR'); not mended"
 )
 _ON_MAIN = "fails on main (05067e4) under the former runner too, just over the tolerance: "
 
