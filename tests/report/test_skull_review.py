@@ -21,6 +21,8 @@ from browser import WEBGL_FLAGS, needs_chromium, run_chromium
 from lilium.casework.build import read_skull
 from lilium.geometry.mesh import decimate
 from lilium.report.skull_review import skull_review_page, write_skull_review
+from lilium.skull.locate import orientation_dependent
+from lilium.skull.prepare import FLAG
 from lilium.synthetic.subjects import distance_to_mesh, make_subject, write_subject
 
 #: Faces the test page draws (the subject has 50,000): a decimated page, quick to pick on.
@@ -46,7 +48,15 @@ def subject():
 
 def _sources(names):
     quality = {n: "template" if n.startswith(TEMPLATE) else "located" for n in names}
-    return {n: {"source": "automatic", "quality": q} for n, q in quality.items()}
+    out = {n: {"source": "automatic", "quality": q} for n, q in quality.items()}
+    for n in names:  # as lilium skull flags them (lilium.skull.prepare.landmark_sources)
+        if orientation_dependent(n):
+            out[n]["flag"] = FLAG
+    return out
+
+
+def _mark_class(dom, name):
+    return re.search(rf'<g class="([^"]*)" id="lm-{name}"', dom)[1].split()
 
 
 @pytest.fixture(scope="module")
@@ -113,6 +123,12 @@ def test_frontal_drag_moves_a_point_along_the_bone(subject, page, opened):
     assert name == on[0]  # the first switched-on landmark, in sight from the front
     # Template points start switched off: saving without looking confirms none of them.
     assert list(saved["landmarks"]) == on
+    # The orientation-dependent extremes are ringed and marked "check" until reviewed.
+    assert "flagged" in _mark_class(dom, "zygion_l") and "flagged" in _mark_class(dom, "orbitale_r")
+    assert "flagged" not in _mark_class(dom, "nasion")
+    rows = re.findall(r"<tr[^>]*>(.*?)</tr>", dom, re.S)
+    checked = {re.search(r'id="on-(\w+)"', r)[1] for r in rows if 'class="flag"' in r}
+    assert checked == {n for n in lm if orientation_dependent(n)}
     for n in on[1:]:  # the others exactly as given
         assert saved["landmarks"][n] == [float(x) for x in lm[n]], n
     sources = _sources(lm)
@@ -140,6 +156,8 @@ def test_left_view_hides_the_right_side_and_ticks_a_template_point(subject, page
         "source": "reviewed", "quality": "template", "confirmed": True,
     }  # fmt: skip
     assert saved["landmarks"]["gonion_l"] == [float(x) for x in lm["gonion_l"]]
+    assert "flagged" not in _mark_class(dom, "gonion_l")  # ticked: reviewed
+    assert "flagged" in _mark_class(dom, "zygion_l")
     assert {n for n in saved["landmarks"] if n.startswith(TEMPLATE)} == {"gonion_l"}
 
 

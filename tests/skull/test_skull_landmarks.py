@@ -124,11 +124,19 @@ def test_command_writes_a_folder_lilium_sfo_reads(skull, tmp_path, capsys):
     write_mesh(tmp_path / "bare.ply", v, f)
     out = tmp_path / "subject"
     assert main(["skull", str(tmp_path / "bare.ply"), "--out", str(out)]) == 0
-    assert "parts found: cranium and mandible" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "parts found: cranium and mandible" in printed
     data = read_json(out / "cranial_landmarks.json")
     assert data["parts"] == {"cranium": True, "mandible": True}
     sources = data["landmark_sources"]
     assert set(sources) == set(data["landmarks"])
+    # The extremes that depend on the head's orientation are flagged for review, and said.
+    hard = {n for n in sources if n.startswith(("porion", "orbitale", "gonion", "zygion"))}
+    assert {n for n, s in sources.items() if s.get("flag") == "orientation_dependent"} == hard
+    assert {"zygion_l", "zygion_r", "orbitale_l", "gonion_r"} <= hard
+    said = "flagged for review (extremes whose place depends on the head's orientation): "
+    assert said + ", ".join(n for n in sources if n in hard) in printed
+    assert "check first" in (out / "review.html").read_text()
     located = {n for n, s in sources.items() if s["quality"] == "located"}
     # The case reads the folder as it is; template points wait for confirmation.
     skull_read = read_skull(out)

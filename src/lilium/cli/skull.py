@@ -32,7 +32,7 @@ def register(subparsers):
 
 def run(args):
     from ..io.paths import check_no_links
-    from ..skull.prepare import prepare_skull
+    from ..skull.prepare import flagged, landmark_sources, prepare_skull
 
     check_no_links(args.out)
     start = time.perf_counter()
@@ -48,6 +48,12 @@ def run(args):
     template = [n for n, q in result.quality.items() if q == "template"]
     if template:
         print(f"template landmarks (not used until confirmed): {', '.join(template)}")
+    check = flagged(landmark_sources(result))
+    if check:
+        print(
+            "flagged for review (extremes whose place depends on the head's orientation): "
+            + ", ".join(check)
+        )
     print(
         f"wrote {done['folder']} (skull {done['faces']} faces) in "
         f"{time.perf_counter() - start:.1f} s"

@@ -102,9 +102,11 @@ def skull_review_page(
         Cranial landmarks, skull frame, mm; listed in this order (the test hook drags the
         first one switched on and in sight).
     sources : dict of str -> dict
-        ``landmark_sources`` of ``cranial_landmarks.json``: ``{"source", "quality"}`` per name;
-        ``quality`` ``"located"`` or ``"template"`` colours the marker, and template points
-        start switched off. A name without one is ``"manual"`` (switched on).
+        ``landmark_sources`` of ``cranial_landmarks.json``: ``{"source", "quality"[, "flag"]}``
+        per name; ``quality`` ``"located"`` or ``"template"`` colours the marker, and template
+        points start switched off; ``"flag": "orientation_dependent"`` rings the marker and
+        marks its row "check" until it is reviewed. A name without one is ``"manual"``
+        (switched on).
     title : str
         Shown on top (escaped).
     parts : dict of str -> bool, optional

@@ -45,6 +45,18 @@ SYMMETRY_POINTS = 6000
 #: Qualities of a placed landmark (docs/method/skull.md).
 LOCATED, TEMPLATE, GIVEN = "located", "template", "given"
 
+#: Landmarks flagged for review wherever they were placed automatically: extreme points (the
+#: top of the ear canal, the lowest point of the orbit's margin, the angle of the jaw, the most
+#: lateral point of the arch) whose place along a flat stretch of bone depends on the head's
+#: orientation, where observers disagree most (docs/method/skull.md).
+ORIENTATION_DEPENDENT = ("porion", "orbitale", "gonion", "zygion")
+
+
+def orientation_dependent(name):
+    """Whether the landmark ``name`` (``zygion_l``, ...) is one of
+    :data:`ORIENTATION_DEPENDENT`."""
+    return name.removesuffix("_l").removesuffix("_r") in ORIENTATION_DEPENDENT
+
 
 @dataclass(frozen=True)
 class SkullLandmarks:

@@ -14,10 +14,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .locate import GIVEN, TEMPLATE, locate_skull_landmarks
+from .locate import GIVEN, TEMPLATE, locate_skull_landmarks, orientation_dependent
 
 #: ``prepared_by`` of the files written here.
 PREPARED_BY = "lilium skull"
+
+#: The ``flag`` of an automatic point of :data:`~lilium.skull.locate.ORIENTATION_DEPENDENT`:
+#: check it first in review.html.
+FLAG = "orientation_dependent"
 
 
 def _reviewed(landmarks_path):
@@ -41,15 +45,24 @@ def _reviewed(landmarks_path):
 
 
 def landmark_sources(result):
-    """``{name: {"source", "quality"[, "confirmed"]}}`` of the contract for a
-    :class:`~lilium.skull.locate.SkullLandmarks`."""
+    """``{name: {"source", "quality"[, "confirmed"][, "flag"]}}`` of the contract for a
+    :class:`~lilium.skull.locate.SkullLandmarks`: an automatic point of
+    :data:`~lilium.skull.locate.ORIENTATION_DEPENDENT` is flagged for review, ``"flag":
+    "orientation_dependent"``."""
     out = {}
     for name, quality in result.quality.items():
         if quality == GIVEN:
             out[name] = {"source": "reviewed", "quality": "manual", "confirmed": True}
         else:
             out[name] = {"source": "automatic", "quality": quality}
+            if orientation_dependent(name):
+                out[name]["flag"] = FLAG
     return out
+
+
+def flagged(sources):
+    """The names ``sources`` (``landmark_sources``) flags for review, in its order."""
+    return [name for name, entry in sources.items() if entry.get("flag") == FLAG]
 
 
 def _review_page(vertices, faces, result, sources, title):
@@ -62,6 +75,11 @@ def _review_page(vertices, faces, result, sources, title):
     message = "automatic landmarks, unreviewed: check each, drag it where it belongs, Save"
     if template:
         message += f"; template points (off until confirmed): {', '.join(template)}"
+    if flagged(sources):
+        message += (
+            "; check first (extremes whose place depends on the head's orientation): "
+            + ", ".join(flagged(sources))
+        )
     return skull_review_page(
         vertices, faces, result.landmarks, sources, title=title, parts=parts, message=message,
         skull_axes=result.mesh2skull[:3, :3],

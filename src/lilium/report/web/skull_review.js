@@ -18,6 +18,10 @@
    VISIBLE_TOLERANCE_MM; hidden ones are not drawn. Dragging a landmark moves it along the
    surface: the first surface point under the pointer (pickSurface), the grab offset kept.
 
+   A point flagged "orientation_dependent" (lilium skull: porion, orbitale, gonion, zygion, whose
+   place depends on the head's orientation) is ringed red and its row marked "check" until the
+   examiner moves or ticks it.
+
    Save offers cranial_landmarks.json: {"landmarks": {name: [x, y, z]}, "landmark_sources":
    {name: {"source": "reviewed", "quality": <the original quality>, "confirmed": true}}} with
    the points switched on only; a point never moved keeps its coordinates exactly.
@@ -42,6 +46,8 @@
   /** Depth (mm) a landmark may lie behind the drawn surface and still be in sight: the drawn
       mesh may be decimated, and a pixel spans a slope. */
   const VISIBLE_TOLERANCE_MM = 2.0;
+  /** The ``flag`` of a point to check first (lilium.skull.prepare.FLAG). */
+  const FLAG = "orientation_dependent";
   /** Marker radius and label size, CSS pixels; the test drag, CSS pixels. */
   const MARK_R = 6, LABEL_PX = 12, TEST_DRAG = [15, 8];
   /** Camera looking direction and image-down direction of each view, from the skull's
@@ -113,9 +119,11 @@
   const xyz = (p) => p.map((x) => x.toFixed(1)).join(", ");
   for (const name of names) {
     const quality = (DATA.sources[name] || {}).quality || "manual";
+    const flagged = (DATA.sources[name] || {}).flag === FLAG;
     const g = Page.svg("g", {class: "lm", id: "lm-" + name}, $("g-marks"));
     const dot = Page.svg("circle", {r: MARK_R}, g);
-    Page.svg("title", {}, dot).textContent = name + " (" + quality + ")";
+    Page.svg("title", {}, dot).textContent = name + " (" + quality + (flagged ? ", check" : "")
+      + ")";
     const label = Page.svg("text", {}, g);
     label.textContent = name;
     const row = document.createElement("tr");
@@ -126,11 +134,18 @@
       td.append(content);
       return td;
     });
+    if (flagged) {
+      const mark = document.createElement("span");
+      mark.className = "flag";
+      mark.title = "depends on the head's orientation: check it";
+      mark.textContent = "check";
+      cells[1].append(" ", mark);
+    }
     const swatch = document.createElement("span");
     cells[0].firstChild.append(box, " ", swatch, " ", name);
     $("rows").append(row);
-    const s = state[name] = {point: DATA.landmarks_mm[name].slice(), quality, moved: false,
-      touched: false, on: quality !== "template", uv: [NaN, NaN], visible: false, g, dot, label,
+    const s = state[name] = {point: DATA.landmarks_mm[name].slice(), quality, flagged,
+      moved: false, touched: false, on: quality !== "template", uv: [NaN, NaN], visible: false, g, dot, label,
       box, row, swatch, coords: cells[2]};
     box.checked = s.on;
     box.onchange = () => { s.on = box.checked; s.touched = true; schedule(); };
@@ -138,9 +153,12 @@
     dot.addEventListener("pointermove", moveDrag);
     dot.addEventListener("pointerup", endDrag);
   }
-  /** A mark's class: quality colour (or "reviewed" once the examiner moved or ticked it). */
+  /** A mark's class: quality colour (or "reviewed" once the examiner moved or ticked it),
+      ringed while flagged and not yet reviewed. */
   function markClass(s) {
-    return "lm " + (s.moved || s.touched && s.on ? "reviewed" : s.quality) + (s.on ? "" : " off");
+    const reviewed = s.moved || s.touched && s.on;
+    return "lm " + (reviewed ? "reviewed" : s.quality) + (s.flagged && !reviewed ? " flagged" : "")
+      + (s.on ? "" : " off");
   }
 
   // ---- drawing -------------------------------------------------------------------------
