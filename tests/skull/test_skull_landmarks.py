@@ -233,3 +233,18 @@ def test_mandible_absent_on_a_partial_skull():
     assert not result.mandible, result.mandible_coverage
     assert result.mandible_coverage < 0.1
     assert not set(result.landmarks) & set(MANDIBLE_LANDMARKS)
+
+
+def test_subspinale_on_a_flat_wall_is_its_lowest_point():
+    from lilium.skull.rules import WALL_MM, lowest_deepest
+
+    ys = np.arange(-40.0, -30.0, 0.5)
+    # A vertical wall below the spine whose depth wanders by hundredths of a millimetre: its
+    # lowest point, not the deepest by a hair near its top.
+    wall = np.column_stack([np.zeros_like(ys), ys, 91.1 - 0.004 * (ys + 40.0)])
+    assert lowest_deepest(wall)[1] == -40.0
+    # A curved concavity: its deepest point, to within the wall's tolerance.
+    bowl = np.column_stack([np.zeros_like(ys), ys, 90.0 + 0.05 * (ys + 35.0) ** 2])
+    p = lowest_deepest(bowl)
+    assert p[2] - bowl[:, 2].min() <= WALL_MM and abs(p[1] + 35.0) <= 1.5
+
