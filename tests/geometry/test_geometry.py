@@ -191,3 +191,20 @@ def test_rotation_vectors_and_euler_angles_are_scipys():
             warnings.simplefilter("ignore")  # scipy warns at gimbal lock
             want = Rotation.from_matrix(m).as_euler("xyz", degrees=True)
         np.testing.assert_allclose(matrix_to_euler_xyz_deg(m), want, atol=1e-9)
+
+
+def test_open_edge_points_are_a_cut_not_a_pinhole():
+    import trimesh
+
+    from lilium.geometry.mesh import open_edge_points
+
+    sphere = trimesh.creation.icosphere(4, radius=50.0)
+    v, f = np.asarray(sphere.vertices), np.asarray(sphere.faces)
+    assert open_edge_points(v, f, 20.0).shape == (0, 3)  # closed
+    pinhole = np.delete(f, 0, axis=0)  # one triangle's rim, a few mm
+    assert open_edge_points(v, pinhole, 20.0).shape == (0, 3)
+    assert len(open_edge_points(v, pinhole, 1.0)) == 3
+    cut = f[~(v[f][:, :, 1] > 40.0).any(axis=1)]  # the cap above y = 40 cut off
+    rim = open_edge_points(v, cut, 20.0)
+    assert len(rim) > 10
+    assert np.all(np.abs(rim[:, 1] - 40.0) < 5.0)  # on the cut's rim, nowhere else

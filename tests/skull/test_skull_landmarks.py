@@ -248,3 +248,27 @@ def test_subspinale_on_a_flat_wall_is_its_lowest_point():
     p = lowest_deepest(bowl)
     assert p[2] - bowl[:, 2].min() <= WALL_MM and abs(p[1] + 35.0) <= 1.5
 
+
+
+def test_a_cut_vault_leaves_no_landmark_located_on_the_cut(skull):
+    from scipy.spatial import cKDTree
+
+    from lilium.geometry.mesh import compact, open_edge_points
+    from lilium.skull.locate import CUT_EDGE_MM, NEAR_CUT_MM
+
+    v, f, truth, whole = skull
+    # The vault cut off 3 mm above the glabella (a craniotomy, or a scan cut short): the rules
+    # found the glabella's bulge on the cut, the vault's top on the skull base (150 mm off) and
+    # a frontotemporale 143 mm off.
+    v, below = compact(v, f[~(v[f][:, :, 1] > truth["glabella"][1] + 3.0).any(axis=1)])
+    result = locate_skull_landmarks(v, below)
+    assert result.quality.get("glabella") == "template"
+    assert result.doubtful["glabella"].startswith("on an open edge")
+    assert result.doubtful["bregma"] == "far from the fitted template"
+    assert "bregma" not in result.landmarks and "metopion" not in result.landmarks
+    rim = cKDTree(open_edge_points(v, below, CUT_EDGE_MM))
+    located = [n for n, q in result.quality.items() if q == "located"]
+    assert len(located) >= 12
+    for name in located:  # off the cut, and where the whole skull's are
+        assert rim.query(result.landmarks[name])[0] > NEAR_CUT_MM, name
+        assert np.linalg.norm(result.landmarks[name] - whole.landmarks[name]) < 4.0, name

@@ -48,6 +48,9 @@ def run(args):
     template = [n for n, q in result.quality.items() if q == "template"]
     if template:
         print(f"template landmarks (not used until confirmed): {', '.join(template)}")
+    for name, why in result.doubtful.items():
+        where = "template" if name in result.landmarks else "left out"
+        print(f"{name}: not located, {why} ({where})")
     check = flagged(landmark_sources(result))
     if check:
         print(

@@ -170,6 +170,38 @@ def compact(vertices, faces):
     return vertices[used], index[faces]
 
 
+def open_edge_points(vertices, faces, min_length_mm):
+    """The vertices on the mesh's open edges (edges of one face) that run at least
+    ``min_length_mm`` in one piece: a cut or a missing region, not a pinhole's rim.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+    faces : ndarray of shape (F, 3), int
+    min_length_mm : float
+        Total length of a connected run of open edges, below which it is left out.
+
+    Returns
+    -------
+    ndarray of shape (K, 3)
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    edges = np.sort(np.asarray(faces)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    unique, count = np.unique(edges, axis=0, return_counts=True)
+    open_ = unique[count == 1]
+    if not len(open_):
+        return np.empty((0, 3))
+    n = len(vertices)
+    graph = coo_matrix((np.ones(len(open_)), (open_[:, 0], open_[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    run = label[open_[:, 0]]
+    length = np.linalg.norm(vertices[open_[:, 0]] - vertices[open_[:, 1]], axis=1)
+    long_run = np.bincount(run, weights=length, minlength=n)[run] >= min_length_mm
+    return vertices[np.unique(open_[long_run].reshape(-1))]
+
+
 def gaps_beyond(points, vertices, faces, tolerance_mm):
     """The points farther than ``tolerance_mm`` from a triangle surface, with their distance.
 

@@ -11,7 +11,9 @@ Stages (:func:`locate_skull_landmarks`, each timed in :attr:`SkullLandmarks.prof
 4. ``transfer``: the template's landmarks fitted patch by patch (:mod:`lilium.skull.transfer`);
    the fit checked (not a skull: an error);
 5. ``rules``: each landmark's own definition on the normalised mesh (:mod:`lilium.skull.rules`):
-   quality ``"located"``; where a rule finds nothing, the transfer stays, ``"template"``;
+   quality ``"located"``; where a rule finds nothing, or its point lies at an open edge of the
+   mesh or far from the fitted template (:data:`NEAR_CUT_MM`, :data:`FAR_FROM_TEMPLATE_MM`), the
+   transfer stays, ``"template"``;
 6. ``axes``: the cone axes at the landmarks in the fitted frame
    (:func:`lilium.softtissue.normals.fitted_axes`: the outward surface normals, ``lilium
    case``'s default, but the eye corners' and the alae's, which lie beside them).
@@ -24,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..geometry.mesh import compact, open_edge_points
 from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL
 from ..synthetic.subjects import MANDIBLE_LANDMARKS
 from .align import align_to_template, symmetrise
@@ -44,6 +47,20 @@ from .transfer import (
 SYMMETRY_POINTS = 6000
 #: Qualities of a placed landmark (docs/method/skull.md).
 LOCATED, TEMPLATE, GIVEN = "located", "template", "given"
+
+#: A rule's point within ``NEAR_CUT_MM`` (mm) of an open edge of the mesh that runs at least
+#: ``CUT_EDGE_MM`` in one piece (a cut vault, a broken or missing part; not a pinhole) is not
+#: located: the bone its definition looks for may lie beyond the edge (a vault cut below the
+#: glabella had its glabella "located" on the cut, and a frontotemporale 143 mm off). It keeps
+#: the template's estimate, quality template.
+NEAR_CUT_MM, CUT_EDGE_MM = 3.0, 20.0
+
+#: A point (a rule's or the template patch's) farther than this (mm) from the fitted template's
+#: own landmark found another structure: a rule's is not located (the estimate stays, as
+#: template, where it is within this), an estimate is left out. Every located landmark of 12
+#: generated skulls and the real heads lies within 23 mm of it; on vaults cut above the orbits
+#: "the highest point of the vault" was the skull base's, 122-152 mm off.
+FAR_FROM_TEMPLATE_MM = 30.0
 
 #: Landmarks flagged for review wherever they were placed automatically: extreme points (the
 #: top of the ear canal, the lowest point of the orbit's margin, the angle of the jaw, the most
@@ -87,6 +104,10 @@ class SkullLandmarks:
     fit_rms_mm : float
     profile_s : dict of str -> float
         Seconds per stage.
+    doubtful : dict of str -> str
+        The landmarks whose rule's point was not kept, and why: at an open edge of the mesh
+        (:data:`NEAR_CUT_MM`) or far from the fitted template (:data:`FAR_FROM_TEMPLATE_MM`);
+        each is template (its estimate) or absent.
     """
 
     landmarks: dict
@@ -99,6 +120,7 @@ class SkullLandmarks:
     fit_rms_mm: float
     profile_s: dict = field(default_factory=dict)
     mandible_coverage: float = float("nan")
+    doubtful: dict = field(default_factory=dict)
 
 
 def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
@@ -107,7 +129,7 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     Parameters
     ----------
     vertices : ndarray of shape (V, 3)
-        mm, any frame.
+        mm, any frame; a vertex no face uses is left out.
     faces : ndarray of shape (F, 3), int
     keep : dict of str -> ndarray of shape (3,), optional
         Landmarks to keep as they are (mesh frame).
@@ -130,8 +152,8 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     from ..softtissue.normals import fitted_axes
     from .rules import apply_rules
 
-    vertices = np.asarray(vertices, float)
-    faces = np.asarray(faces, np.int64)
+    # A vertex that no face uses is no bone (a rule or a patch would find it).
+    vertices, faces = compact(np.asarray(vertices, float), np.asarray(faces, np.int64))
     rng = np.random.default_rng(rng)
     keep = {n: np.asarray(p, float) for n, p in (keep or {}).items()}
     profile, clock = {}, [time.perf_counter()]
@@ -167,15 +189,15 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     tree = cKDTree(moved)
     wanted = [n for n in CRANIAL_NAMES if has_mandible or n not in MANDIBLE_LANDMARKS]
     part_of = {n: template.mandible == (n in MANDIBLE_LANDMARKS) for n in wanted}
-    found = transfer_landmarks(
-        tree, moved, tpl, {n: template.landmarks[n] / fit.scale for n in wanted}, part_of
-    )
+    expected = {n: template.landmarks[n] / fit.scale for n in wanted}
+    found = transfer_landmarks(tree, moved, tpl, expected, part_of)
     check_skull_fit(fit.rms_mm, found, source)
     lap("transfer")
     anchors = {k: v / fit.scale for k, v in template.anchors.items()}
     _, nearest = cKDTree(tpl).query(moved)
     on_mandible = template.mandible[nearest] if has_mandible else np.zeros(len(moved), bool)
     located = apply_rules(moved, faces, on_mandible, found, anchors, fit.scale)
+    located, found, doubtful = _plausible(located, found, expected, moved, faces)
     lap("rules")
     placed, quality = {}, {}
     for name in CRANIAL_NAMES:
@@ -191,5 +213,27 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     lap("axes")
     return SkullLandmarks(
         placed, quality, axes, bool(has_mandible), mismatch, fit.mesh2skull, fit.scale,
-        fit.rms_mm, profile, coverage,
+        fit.rms_mm, profile, coverage, doubtful,
     )  # fmt: skip
+
+
+def _plausible(located, found, expected, vertices, faces):
+    """The rules' points (``located``) and the template's estimates (``found``) that can be
+    trusted, and why each rule's point left out was (normalised frame, mm): not at an open edge
+    of the mesh (:data:`NEAR_CUT_MM`), not far from the fitted template's landmark
+    (``expected``, :data:`FAR_FROM_TEMPLATE_MM`)."""
+    from scipy.spatial import cKDTree
+
+    def far(name, point):
+        return np.linalg.norm(point - expected[name]) > FAR_FROM_TEMPLATE_MM
+
+    doubtful = {n: "far from the fitted template" for n, p in located.items() if far(n, p)}
+    cut = open_edge_points(vertices, faces, CUT_EDGE_MM)
+    if len(cut):
+        near = cKDTree(cut)
+        doubtful |= {n: "on an open edge of the mesh (a cut or missing bone)"
+                     for n, p in located.items()
+                     if n not in doubtful and near.query(p)[0] <= NEAR_CUT_MM}  # fmt: skip
+    located = {n: p for n, p in located.items() if n not in doubtful}
+    found = {n: p for n, p in found.items() if not far(n, p)}
+    return located, found, doubtful

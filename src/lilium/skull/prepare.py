@@ -75,6 +75,8 @@ def _review_page(vertices, faces, result, sources, title):
     message = "automatic landmarks, unreviewed: check each, drag it where it belongs, Save"
     if template:
         message += f"; template points (off until confirmed): {', '.join(template)}"
+    for name, why in result.doubtful.items():
+        message += f"; {name} not located: {why}"
     if flagged(sources):
         message += (
             "; check first (extremes whose place depends on the head's orientation): "

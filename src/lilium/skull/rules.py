@@ -42,8 +42,8 @@ Written down (docs/method/skull.md lists them too):
   about ``(+-42, y, 60)`` template mm:
   :data:`~lilium.synthetic.anatomy.landmarks.FRONTOTEMPORALE`), its height ``y``
   :data:`FRONTOTEMPORALE_ABOVE_GLABELLA_MM` above the located glabella (the generator's is 18
-  mm above its brow design height, which no mesh shows; without a glabella: within
-  ``FRONTOTEMPORALE_MM`` of the estimate);
+  mm above its brow design height, which no mesh shows; with no bone in that band, a vault
+  cut below it, none; without a glabella: within ``FRONTOTEMPORALE_MM`` of the estimate);
 
 Left as the template places them: ``prosthion`` and ``infradentale`` (the alveolar crest
 between the incisors: the teeth and the bone are one surface on a mesh), ``porion`` (the ear
@@ -336,12 +336,11 @@ def apply_rules(vertices, faces, on_mandible, estimates, anchors, scale=1.0):
                 out["gonion" + sfx] = p
         name = "frontotemporale" + sfx
         if name in est:
-            p = None
             if "glabella" in out:  # the generator's band (template mm), back to the mesh's
                 y = out["glabella"][1] * scale + FRONTOTEMPORALE_ABOVE_GLABELLA_MM
                 p = _frontotemporale(vertices * scale, cranium, sx, y)
-                p = None if p is None else p / scale
-            if p is None:  # no glabella (a cut vault) or nothing in the band
+                p = None if p is None else p / scale  # no bone in the band: a cut vault
+            else:  # no glabella: near the estimate
                 d = np.array(FRONTOTEMPORALE["direction"]) * (sx, 1, 1)
                 p = _support(vertices, cranium, est[name], FRONTOTEMPORALE_MM, d)
             if p is not None:
