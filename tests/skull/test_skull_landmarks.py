@@ -272,3 +272,46 @@ def test_a_cut_vault_leaves_no_landmark_located_on_the_cut(skull):
     for name in located:  # off the cut, and where the whole skull's are
         assert rim.query(result.landmarks[name])[0] > NEAR_CUT_MM, name
         assert np.linalg.norm(result.landmarks[name] - whole.landmarks[name]) < 4.0, name
+
+
+def _bad_mesh(kind, folder):
+    """A file that is not a skull mesh, named for ``kind``."""
+    import trimesh
+
+    from lilium.io.mesh import write_mesh
+
+    sphere = trimesh.creation.icosphere(3, 90.0)
+    v, f = np.asarray(sphere.vertices), np.asarray(sphere.faces)
+    path = folder / {"garbage": "bad.stl", "folder": "bad.ply"}.get(kind, "bad.ply")
+    if kind == "empty":
+        path.write_bytes(b"")
+    elif kind == "text":
+        path.write_text("hello\n")
+    elif kind == "garbage":
+        path.write_bytes(np.random.default_rng(0).bytes(5000))
+    elif kind == "nan":
+        v[3] = np.nan
+        write_mesh(path, v, f)
+    elif kind == "flat":
+        write_mesh(path, np.array([[0, 0, 0], [99, 0, 0], [0, 99, 0.0]]), np.array([[0, 1, 2]]))
+    elif kind == "points":
+        path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                        "property float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n")
+    elif kind == "folder":
+        path.mkdir()
+    return path
+
+
+@pytest.mark.parametrize("kind", ["empty", "text", "garbage", "nan", "flat", "points", "folder",
+                                  "missing"])  # fmt: skip
+def test_command_on_a_file_that_is_no_mesh_is_one_line(kind, tmp_path, capsys):
+    from lilium.cli.main import main
+
+    path = tmp_path / "missing.ply" if kind == "missing" else _bad_mesh(kind, tmp_path)
+    out = tmp_path / "out"
+    assert main(["skull", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("lilium skull: error: ") and str(path) in err, err
+    assert "\n" not in err
+    assert "Traceback" not in err
+    assert not out.exists()

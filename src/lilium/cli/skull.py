@@ -2,8 +2,8 @@
 (docs/method/skull.md)."""
 
 import time
-from pathlib import Path
 
+from .argtypes import existing_file
 from .options import add_options
 
 
@@ -20,11 +20,11 @@ def register(subparsers):
             "normals). lilium sfo, case and lineup take the folder as it is."
         ),
     )
-    p.add_argument("mesh", type=Path, help="the skull mesh (millimetres)")
+    p.add_argument("mesh", type=existing_file("skull mesh"), help="the skull mesh (millimetres)")
     add_options(p, "out", required=("out",))
     p.add_argument(
         "--landmarks",
-        type=Path,
+        type=existing_file("landmark file"),
         help="reviewed cranial landmarks (any format lilium case reads): kept, the rest placed",
     )
     p.set_defaults(func=run)
