@@ -50,16 +50,17 @@ LOCATED, TEMPLATE, GIVEN = "located", "template", "given"
 
 #: A rule's point within ``NEAR_CUT_MM`` (mm) of an open edge of the mesh that runs at least
 #: ``CUT_EDGE_MM`` in one piece (a cut vault, a broken or missing part; not a pinhole) is not
-#: located: the bone its definition looks for may lie beyond the edge (a vault cut below the
-#: glabella had its glabella "located" on the cut, and a frontotemporale 143 mm off). It keeps
-#: the template's estimate, quality template.
+#: located: the bone its definition looks for may lie beyond the edge (a vault cut just above
+#: the glabella had its glabella "located" on the cut). It keeps the template's estimate,
+#: quality template.
 NEAR_CUT_MM, CUT_EDGE_MM = 3.0, 20.0
 
 #: A point (a rule's or the template patch's) farther than this (mm) from the fitted template's
 #: own landmark found another structure: a rule's is not located (the estimate stays, as
 #: template, where it is within this), an estimate is left out. Every located landmark of 12
-#: generated skulls and the real heads lies within 23 mm of it; on vaults cut above the orbits
-#: "the highest point of the vault" was the skull base's, 122-152 mm off.
+#: generated skulls and of the real heads lies within 23 mm of it, but headsq's bregma: on
+#: vaults cut off "the highest point of the vault" was on the cut or the skull base, 122-152 mm
+#: off, and a frontotemporale was found 143 mm off, on the other side.
 FAR_FROM_TEMPLATE_MM = 30.0
 
 #: Landmarks flagged for review wherever they were placed automatically: extreme points (the
@@ -219,9 +220,9 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
 
 def _plausible(located, found, expected, vertices, faces):
     """The rules' points (``located``) and the template's estimates (``found``) that can be
-    trusted, and why each rule's point left out was (normalised frame, mm): not at an open edge
-    of the mesh (:data:`NEAR_CUT_MM`), not far from the fitted template's landmark
-    (``expected``, :data:`FAR_FROM_TEMPLATE_MM`)."""
+    trusted (normalised frame, mm): not far from the fitted template's landmark (``expected``,
+    :data:`FAR_FROM_TEMPLATE_MM`) and, for a rule's point, not at an open edge of the mesh
+    (:data:`NEAR_CUT_MM`); and ``{name: why}`` of the rules' points not trusted."""
     from scipy.spatial import cKDTree
 
     def far(name, point):

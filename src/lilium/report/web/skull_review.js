@@ -145,8 +145,8 @@
     cells[0].firstChild.append(box, " ", swatch, " ", name);
     $("rows").append(row);
     const s = state[name] = {point: DATA.landmarks_mm[name].slice(), quality, flagged,
-      moved: false, touched: false, on: quality !== "template", uv: [NaN, NaN], visible: false, g, dot, label,
-      box, row, swatch, coords: cells[2]};
+      moved: false, touched: false, on: quality !== "template", uv: [NaN, NaN], visible: false,
+      g, dot, label, box, row, swatch, coords: cells[2]};
     box.checked = s.on;
     box.onchange = () => { s.on = box.checked; s.touched = true; schedule(); };
     dot.addEventListener("pointerdown", (e) => startDrag(e, name));
