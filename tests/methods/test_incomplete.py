@@ -180,6 +180,22 @@ def test_pll_off_without_the_mandible_on_frontal_photos_only(pair):
     subject_dir, photo_dir = _case(root, "no_mandible", "lateral")
     lateral = read_photo(photo_dir)
     assert pll_off_reason(skull, lateral) == ""
+    # A skull with its jaw whose infradentale and foramina lilium skull left as template points
+    # (not used until confirmed): the message says so, not "no mandible".
+    from dataclasses import replace
+
+    subject_dir, photo_dir = _case(root, "complete", "frontal")
+    whole = read_skull(subject_dir)
+    gone = ("infradentale", "mental_foramen_l", "mental_foramen_r")
+    automatic = replace(
+        whole,
+        landmarks_mm={n: p for n, p in whole.landmarks_mm.items() if n not in gone},
+        landmark_sources=dict.fromkeys(whole.landmarks_mm, "located"),
+    )
+    why = pll_off_reason(automatic, read_photo(photo_dir))
+    assert "lilium skull's template points" in why and "no mandible" not in why
+    plain = replace(automatic, landmark_sources={})
+    assert "no mandible" not in pll_off_reason(plain, read_photo(photo_dir))
     assert image_terms(skull, lateral, centre, True, True)[2] == {}
     # Without glabella on the skull, the forehead cannot be cut either.
     no_glabella = replace(

@@ -23,12 +23,10 @@ from dataclasses import dataclass, field
 
 from ..methods.pairs import correspondences
 from ..methods.prior_checks import perspective_conflict, prior_conflicts
+from ..softtissue.landmarks import MANDIBLE_LANDMARKS
 from .calibration import VIEWS_LOG10_LR
 from .conclusion import EXAMINER_CAMERA, UNREVIEWED_SKULL, conclude, material_caps
 from .score import nll_score, terms_and_overlaps, worst_landmark_of
-
-#: Cranial landmarks on the mandible: a skull with none of them has no mandible.
-MANDIBLE_LANDMARKS = ("pogonion", "gnathion", "gonion_l", "gonion_r", "infradentale")
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from ..fitness.pll_context import PllContext
 from ..fitness.regions import anatomical_frame, chin_jaw_region, forehead_region
 from ..fitness.skof import prepare_skof, skof_penalty, skull_outside_pixels_cameras
 from ..geometry.mesh import decimate
+from ..softtissue.landmarks import MANDIBLE_LANDMARKS
 from .working_level import WorkingPll, WorkingSkof
 
 
@@ -94,7 +95,15 @@ def pll_off_reason(skull, photo):
     view, region = photo.view, _region_name(photo.view)
     missing = [n for n in pll_skull_landmarks(view) if n not in skull.landmarks_mm]
     if missing:
-        absent = " (no mandible?)" if view == "frontal" and "infradentale" in missing else ""
+        absent = ""
+        if view == "frontal" and "infradentale" in missing:
+            jaw = any(n in skull.landmarks_mm for n in MANDIBLE_LANDMARKS)
+            automatic = "located" in skull.landmark_sources.values()  # lilium skull's
+            absent = (
+                " (lilium skull's template points: used once confirmed in its review.html)"
+                if jaw and automatic
+                else "" if jaw else " (no mandible?)"
+            )
         return (
             f"skull {skull.id!r} has no {', '.join(missing)}{absent} in its cranial landmarks, "
             f"which cut the {region} region"

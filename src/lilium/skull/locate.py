@@ -27,8 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..geometry.mesh import compact, open_edge_points
-from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL
-from ..synthetic.subjects import MANDIBLE_LANDMARKS
+from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL, MANDIBLE_LANDMARKS
 from .align import align_to_template, symmetrise
 from .checks import check_skull_extent, check_skull_fit
 from .template import mean_template

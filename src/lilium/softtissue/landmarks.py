@@ -50,6 +50,18 @@ FACIAL_TO_CRANIAL = {facial: cranial for cranial, facial in CORRESPONDENCES}
 CRANIAL_NAMES = tuple(c for c, _ in CORRESPONDENCES) + EXTRA_CRANIAL
 FACIAL_NAMES = tuple(f for _, f in CORRESPONDENCES) + EXTRA_FACIAL
 
+#: Cranial landmarks on the mandible: absent from a skull without it (a skull with none of them
+#: has no mandible).
+MANDIBLE_LANDMARKS = (
+    "infradentale",
+    "mental_foramen_l",
+    "mental_foramen_r",
+    "pogonion",
+    "gnathion",
+    "gonion_l",
+    "gonion_r",
+)
+
 #: Midline cranial landmarks (lie on the midsagittal plane).
 MIDLINE_CRANIAL = (
     "glabella",

@@ -44,7 +44,7 @@ import numpy as np
 
 from ..ct.mesh import volume_to_mesh
 from ..ct.volume import Volume
-from ..softtissue.landmarks import CORRESPONDENCES, FACIAL_NAMES
+from ..softtissue.landmarks import CORRESPONDENCES, FACIAL_NAMES, MANDIBLE_LANDMARKS
 from ..softtissue.normals import landmark_normals
 from .anatomy.bone import build_bone
 from .anatomy.landmarks import locate_cranial_landmarks, place_cheilia
@@ -127,16 +127,6 @@ SOFT_TISSUE_TRIES = 4
 #: (measured: 1 subject in 12 at seed 0 with the published craniometric spread) is redrawn.
 SHAPE_TRIES = 3
 
-#: Cranial landmarks on the mandible: absent from a skull without it.
-MANDIBLE_LANDMARKS = (
-    "infradentale",
-    "mental_foramen_l",
-    "mental_foramen_r",
-    "pogonion",
-    "gnathion",
-    "gonion_l",
-    "gonion_r",
-)
 
 
 def _mesh(field, target_faces):

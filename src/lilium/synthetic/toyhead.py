@@ -77,7 +77,8 @@ def make_toy_subject(subject_id="toy", rng=None, subdivisions=4, mandible=True):
         Icosphere subdivisions of the skin and skull meshes (4 -> 5,120 faces each).
     mandible : bool
         False: the skull loses its "mandible" (the triangles below the infradentale in front
-        of the ear canals) and the :data:`~.subjects.MANDIBLE_LANDMARKS`; the head is the same.
+        of the ear canals) and the :data:`~lilium.softtissue.landmarks.MANDIBLE_LANDMARKS`; the
+        head is the same.
 
     Returns
     -------
