@@ -188,12 +188,12 @@ def open_edge_points(vertices, faces, min_length_mm):
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    edges = np.sort(np.asarray(faces)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    unique, count = np.unique(edges, axis=0, return_counts=True)
-    open_ = unique[count == 1]
+    n = len(vertices)
+    edges = np.sort(np.asarray(faces, np.int64)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    key, count = np.unique(edges[:, 0] * n + edges[:, 1], return_counts=True)  # one int per edge
+    open_ = np.column_stack(np.divmod(key[count == 1], n))
     if not len(open_):
         return np.empty((0, 3))
-    n = len(vertices)
     graph = coo_matrix((np.ones(len(open_)), (open_[:, 0], open_[:, 1])), shape=(n, n))
     _, label = connected_components(graph, directed=False)
     run = label[open_[:, 0]]
