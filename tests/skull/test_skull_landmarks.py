@@ -315,3 +315,20 @@ def test_command_on_a_file_that_is_no_mesh_is_one_line(kind, tmp_path, capsys):
     assert "\n" not in err
     assert "Traceback" not in err
     assert not out.exists()
+
+
+def test_reviewed_landmarks_off_the_mesh_are_an_error(skull, tmp_path, capsys):
+    from lilium.cli.main import main
+    from lilium.io.mesh import write_mesh
+
+    v, f, truth, _ = skull
+    write_mesh(tmp_path / "bare.ply", v, f)
+    metres = truth["nasion"] / 1000.0  # the point's file in metres, the mesh in millimetres
+    (tmp_path / "lm.csv").write_text(f"name,x,y,z\nnasion,{metres[0]},{metres[1]},{metres[2]}\n")
+    out = tmp_path / "out"
+    argv = ["skull", str(tmp_path / "bare.ply"), "--out", str(out), "--landmarks",
+            str(tmp_path / "lm.csv")]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "lm.csv: landmarks.nasion lies" in err and "mesh's frame and units" in err
+    assert "\n" not in err and not out.exists()

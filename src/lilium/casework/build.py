@@ -21,7 +21,7 @@ from ..constants import (
     PART_APART_MM,
     VIEWS,
 )
-from ..geometry.mesh import clean_mesh, compact, gaps_beyond, parts_apart
+from ..geometry.mesh import check_landmarks_on_mesh, clean_mesh, compact, parts_apart
 from ..inputs import CaseWarning, Photo, Priors, Skull
 from ..io.case import (
     check_axes_file,
@@ -146,14 +146,8 @@ def build_skull(parsed):
             "docs/method/identification.md); give --axes: `lilium skull MESH --landmarks "
             "FILE --out DIR` keeps your landmarks and writes them to DIR/soft_tissue_axes.json"
         )))  # fmt: skip
+    check_landmarks_on_mesh(landmarks, vertices, faces, lm_path)
     extent = np.ptp(vertices, axis=0).max()
-    off_mesh = gaps_beyond(landmarks, vertices, faces, 0.1 * extent)
-    if off_mesh:  # the first, in the file's order
-        name, gap = next(iter(off_mesh.items()))
-        raise ValueError(
-            f"{lm_path}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
-            "must be in the mesh's frame and units"
-        )
     check_landmark_layout(lm_path, landmarks, extent * MIN_CRANIAL_EXTENT_FRACTION, "mm")
     return Skull(
         parsed.skull_id, vertices, faces, landmarks, axes, warnings=tuple(warnings),

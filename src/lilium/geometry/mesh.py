@@ -236,6 +236,24 @@ def gaps_beyond(points, vertices, faces, tolerance_mm):
     return far
 
 
+#: A landmark farther than this share of the mesh's largest extent from its surface is not on
+#: it: another frame or unit (:func:`check_landmarks_on_mesh`).
+OFF_MESH_FRACTION = 0.1
+
+
+def check_landmarks_on_mesh(landmarks, vertices, faces, source):
+    """Raise a ``ValueError`` naming ``source`` (the landmarks' file) and the first landmark
+    farther than :data:`OFF_MESH_FRACTION` of the mesh's extent from its surface."""
+    extent = np.ptp(vertices, axis=0).max()
+    off_mesh = gaps_beyond(landmarks, vertices, faces, OFF_MESH_FRACTION * extent)
+    if off_mesh:  # the first, in the file's order
+        name, gap = next(iter(off_mesh.items()))
+        raise ValueError(
+            f"{source}: landmarks.{name} lies {gap:.0f} mm from the skull mesh; landmarks "
+            "must be in the mesh's frame and units"
+        )
+
+
 def point_surface_distance(points, vertices, faces):
     """Distance of each point to the nearest point of a triangle surface (not only its vertices).
 

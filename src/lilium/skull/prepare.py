@@ -128,7 +128,7 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0, reuse=False):
     ValueError
         An unreadable mesh, a mesh that is not a skull in millimetres, a bad landmark file.
     """
-    from ..geometry.mesh import clean_mesh, compact
+    from ..geometry.mesh import check_landmarks_on_mesh, clean_mesh, compact
     from ..io.jsonio import write_json
     from ..io.mesh import parse_mesh, write_mesh
     from ..io.provenance import sha256_of
@@ -145,6 +145,8 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0, reuse=False):
         )
     vertices, faces = compact(*clean_mesh(*parse_mesh(mesh_path), source=str(mesh_path)))
     keep = _reviewed(landmarks_path) if landmarks_path is not None else None
+    if keep:
+        check_landmarks_on_mesh(keep, vertices, faces, landmarks_path)
     result = locate_skull_landmarks(vertices, faces, keep=keep, rng=rng, source=str(mesh_path))
     sources = landmark_sources(result)
     page = _review_page(vertices, faces, result, sources, mesh_path.name)
