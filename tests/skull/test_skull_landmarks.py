@@ -332,3 +332,24 @@ def test_reviewed_landmarks_off_the_mesh_are_an_error(skull, tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "lm.csv: landmarks.nasion lies" in err and "mesh's frame and units" in err
     assert "\n" not in err and not out.exists()
+
+
+def test_reviewed_landmarks_with_mirrored_labels_are_an_error(skull, tmp_path, capsys):
+    import json
+
+    from lilium.cli.main import main
+    from lilium.io.mesh import write_mesh
+
+    v, f, truth, _ = skull
+    write_mesh(tmp_path / "bare.ply", v, f)
+    swap = {"_l": "_r", "_r": "_l"}
+    mirrored = {n[:-2] + swap[n[-2:]] if n[-2:] in swap else n: [float(c) for c in p]
+                for n, p in truth.items()}  # fmt: skip
+    (tmp_path / "lm.json").write_text(json.dumps({"landmarks": mirrored}))
+    out = tmp_path / "out"
+    argv = ["skull", str(tmp_path / "bare.ply"), "--out", str(out), "--landmarks",
+            str(tmp_path / "lm.json")]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "lm.json: left and right are mirrored" in err and "\n" not in err
+    assert not out.exists()

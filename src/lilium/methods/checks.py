@@ -296,10 +296,16 @@ def check_skull_labels(skull):
         Naming ``skull.landmarks_file`` and what to swap.
     """
     where = skull.landmarks_file or f"skull {skull.id!r}: cranial landmarks"
-    together = coincident_pairs(skull.landmarks_mm)
+    check_cranial_labels(skull.landmarks_mm, skull.vertices_mm, where)
+
+
+def check_cranial_labels(landmarks_mm, vertices_mm, where):
+    """:func:`check_skull_labels` of landmarks on a mesh (``where`` names them in the
+    message)."""
+    together = coincident_pairs(landmarks_mm)
     if together:
         raise ValueError(coincident_message(where, together, "mm"))
-    handedness = label_handedness(skull.landmarks_mm, skull.vertices_mm)
+    handedness = label_handedness(landmarks_mm, vertices_mm)
     if handedness is None or handedness >= 0:
         return
     raise ValueError(

@@ -133,6 +133,7 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0, reuse=False):
     from ..io.mesh import parse_mesh, write_mesh
     from ..io.provenance import sha256_of
     from ..io.results import write_page
+    from ..methods.checks import check_cranial_labels
 
     mesh_path, out = Path(mesh_path), Path(out)
     digest = sha256_of(mesh_path)
@@ -147,6 +148,7 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0, reuse=False):
     keep = _reviewed(landmarks_path) if landmarks_path is not None else None
     if keep:
         check_landmarks_on_mesh(keep, vertices, faces, landmarks_path)
+        check_cranial_labels(keep, vertices, landmarks_path)
     result = locate_skull_landmarks(vertices, faces, keep=keep, rng=rng, source=str(mesh_path))
     sources = landmark_sources(result)
     page = _review_page(vertices, faces, result, sources, mesh_path.name)
