@@ -13,12 +13,11 @@ A search whose best camera looks at the head from far outside the photo's head-o
 
 import numpy as np
 
-from ..fitness.camera_penalty import head_deviation_deg
 from ..geometry.camera import Camera
 from .checks import facing_failure
 from .lilium_terms import full_image_terms
 from .posest_sfo import RUN_OFF_FACTOR, focal_cap_message, focal_cap_warning, long_lens_focal_px
-from .prior_checks import FAR_TOLERANCES
+from .prior_checks import far_from_head_prior, head_deviation_of
 from .working_level import WorkingPll
 
 
@@ -76,7 +75,8 @@ MAX_RESTARTS = 2
 def missed_head_prior(photo, best):
     """Whether the best member's camera looks at the head from more than
     :data:`~lilium.methods.prior_checks.FAR_TOLERANCES` tolerances off the photo's
-    head-orientation prior: the same bound as the identification's ``head_outside_prior``.
+    head-orientation prior: the identification's rule ``head_outside_prior``
+    (:func:`~lilium.methods.prior_checks.far_from_head_prior`).
 
     On a lateral photo the DE's whole population can start in the wrong branch of the pose
     solutions (measured: 2 of 240 same-person SFOs, both lateral, fitness 7e5-2e6 against tens, the
@@ -93,11 +93,9 @@ def missed_head_prior(photo, best):
     bool
         False without a head prior or a camera.
     """
-    priors = photo.priors
-    if not priors.uses_head or not bool(best["success"]):
+    if not bool(best["success"]):
         return False
-    deviation = head_deviation_deg(np.asarray(best["R"])[None], priors.head_rotation_skull2cam)
-    return bool(deviation[0] > FAR_TOLERANCES * priors.head_tolerance_deg)
+    return far_from_head_prior(photo, head_deviation_of(photo, best["R"]))
 
 
 def outcome_fitness(problem, de_fitness, camera, terms):

@@ -97,13 +97,10 @@ def pll_off_reason(skull, photo):
     if missing:
         absent = ""
         if view == "frontal" and "infradentale" in missing:
-            jaw = any(n in skull.landmarks_mm for n in MANDIBLE_LANDMARKS)
-            automatic = "located" in skull.landmark_sources.values()  # lilium skull's
-            absent = (
-                " (lilium skull's template points: used once confirmed in its review.html)"
-                if jaw and automatic
-                else "" if jaw else " (no mandible?)"
-            )
+            if not any(n in skull.landmarks_mm for n in MANDIBLE_LANDMARKS):
+                absent = " (no mandible?)"
+            elif "located" in skull.landmark_sources.values():  # lilium skull's, unreviewed
+                absent = " (lilium skull's template points: used once confirmed in its review.html)"
         return (
             f"skull {skull.id!r} has no {', '.join(missing)}{absent} in its cranial landmarks, "
             f"which cut the {region} region"

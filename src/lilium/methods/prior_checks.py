@@ -139,10 +139,25 @@ def _measured(photo, camera, facial_landmarks_mm):
 def _head_deviation_deg(photo, camera):
     """The camera's head orientation's deviation (deg) from the photo's prior; None without
     one."""
+    return head_deviation_of(photo, camera.R)
+
+
+def head_deviation_of(photo, R):
+    """The deviation (deg) of the head orientation ``R`` (skull2cam rotation, (3, 3)) from the
+    photo's prior; None without one."""
     p = photo.priors
     if not p.uses_head:
         return None
-    return float(head_deviation_deg(camera.R[None], p.head_rotation_skull2cam)[0])
+    return float(head_deviation_deg(np.asarray(R)[None], p.head_rotation_skull2cam)[0])
+
+
+def far_from_head_prior(photo, deviation_deg):
+    """Whether a head orientation ``deviation_deg`` off the photo's prior (None: no prior) lies
+    beyond :data:`FAR_TOLERANCES` tolerances: the rule ``head_outside_prior``, and Lilium's
+    restart (:func:`lilium.methods.lilium_outcome.missed_head_prior`)."""
+    if deviation_deg is None:
+        return False
+    return deviation_deg > FAR_TOLERANCES * photo.priors.head_tolerance_deg
 
 
 def prior_conflicts(photo, camera, facial_landmarks_mm):
@@ -183,7 +198,7 @@ def prior_conflicts(photo, camera, facial_landmarks_mm):
     if far:
         out["camera_outside_priors"] = "; ".join(far)
     dev = _head_deviation_deg(photo, camera)
-    if dev is not None and dev > FAR_TOLERANCES * p.head_tolerance_deg:
+    if far_from_head_prior(photo, dev):
         out["head_outside_prior"] = (
             f"the head orientation found deviates {dev:.1f} deg from its prior, more than "
             f"{FAR_TOLERANCES:g} x its tolerance of {p.head_tolerance_deg:g} deg "

@@ -77,10 +77,11 @@ def _review_page(vertices, faces, result, sources, title):
         message += f"; template points (off until confirmed): {', '.join(template)}"
     for name, why in result.doubtful.items():
         message += f"; {name} not located: {why}"
-    if flagged(sources):
+    check = flagged(sources)
+    if check:
         message += (
             "; check first (extremes whose place depends on the head's orientation): "
-            + ", ".join(flagged(sources))
+            + ", ".join(check)
         )
     return skull_review_page(
         vertices, faces, result.landmarks, sources, title=title, parts=parts, message=message,
