@@ -274,6 +274,49 @@ def test_a_cut_vault_leaves_no_landmark_located_on_the_cut(skull):
         assert np.linalg.norm(result.landmarks[name] - whole.landmarks[name]) < 4.0, name
 
 
+def test_a_vault_cut_behind_bregma_leaves_it_unlocated(skull):
+    from lilium.geometry.mesh import compact
+
+    v, f, truth, whole = skull
+    # The vault's back cut off 4 mm in front of the true bregma (a broken or sawn calvaria):
+    # the template patch slid along the vault and the rule put bregma 14 mm forward, located.
+    behind = (v[f][:, :, 2] < truth["bregma"][2] + 4.0) & (v[f][:, :, 1] > truth["nasion"][1])
+    v, f = compact(v, f[~behind.any(axis=1)])
+    result = locate_skull_landmarks(v, f)
+    assert result.quality.get("bregma") != "located"
+    assert result.doubtful["bregma"].startswith("the vault cut within 10 mm")
+    located = [n for n, q in result.quality.items() if q == "located"]
+    assert len(located) >= 20
+    for name in located:  # the face is untouched (the fit moves with the vault: 2.1 mm)
+        assert np.linalg.norm(result.landmarks[name] - whole.landmarks[name]) < 4.0, name
+
+
+def test_a_stand_under_the_chin_is_left_out(skull, tmp_path, capsys):
+    import trimesh
+
+    from lilium.cli.main import main
+    from lilium.io.mesh import write_mesh
+
+    v, f, truth, whole = skull
+    # A block the skull rests on, touching the chin (a separate part): its top was taken for
+    # the chin, pogonion and gnathion 29-32 mm off, located.
+    stand = trimesh.creation.box(extents=[40.0, 30.0, 40.0]).subdivide()
+    stand.apply_translation([0.0, v[:, 1].min() - 14.0, truth["gnathion"][2] - 10.0])
+    vs = np.vstack([v, stand.vertices])
+    fs = np.vstack([f, np.asarray(stand.faces) + len(v)])
+    result = locate_skull_landmarks(vs, fs)
+    assert result.parts_left_out == (len(stand.faces),)
+    for name in ("pogonion", "gnathion"):
+        assert result.quality[name] == "located"
+        assert np.linalg.norm(result.landmarks[name] - whole.landmarks[name]) < 1.0, name
+    assert locate_skull_landmarks(v, f).parts_left_out == ()
+    write_mesh(tmp_path / "on_stand.ply", vs, fs)
+    assert main(["skull", str(tmp_path / "on_stand.ply"), "--out", str(tmp_path / "s")]) == 0
+    printed = capsys.readouterr().out
+    assert f"1 part(s) of the mesh apart from the skull ({len(stand.faces)} faces)" in printed
+    assert "remove them from the mesh" in (tmp_path / "s" / "review.html").read_text()
+
+
 def _bad_mesh(kind, folder):
     """A file that is not a skull mesh, named for ``kind``."""
     import trimesh

@@ -32,7 +32,12 @@ def register(subparsers):
 
 def run(args):
     from ..io.paths import check_no_links
-    from ..skull.prepare import flagged, landmark_sources, prepare_skull
+    from ..skull.prepare import (
+        flagged,
+        landmark_sources,
+        parts_left_out_sentence,
+        prepare_skull,
+    )
 
     check_no_links(args.out)
     start = time.perf_counter()
@@ -51,6 +56,8 @@ def run(args):
     for name, why in result.doubtful.items():
         where = "template" if name in result.landmarks else "left out"
         print(f"{name}: not located, {why} ({where})")
+    if result.parts_left_out:
+        print(parts_left_out_sentence(result.parts_left_out))
     check = flagged(landmark_sources(result))
     if check:
         print(

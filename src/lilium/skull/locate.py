@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.mesh import compact, open_edge_points
+from ..geometry.mesh import compact, face_components, open_edge_points
 from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL, MANDIBLE_LANDMARKS
 from .align import align_to_template, symmetrise
 from .checks import check_skull_extent, check_skull_fit
@@ -53,6 +53,19 @@ LOCATED, TEMPLATE, GIVEN = "located", "template", "given"
 #: the glabella had its glabella "located" on the cut). It keeps the template's estimate,
 #: quality template.
 NEAR_CUT_MM, CUT_EDGE_MM = 3.0, 20.0
+
+#: Bregma's rule takes the vault's top at the depth where the template patch put it, and the
+#: patch slides along a vault cut behind it: with the vault's back cut off at 0 to 14 mm behind
+#: the true bregma (generated skulls), the patch moved it 10-22 mm forward and the rule's point
+#: lay 6-8 mm from the cut. A bregma within ``VAULT_CUT_MM`` (mm) of a cut is not located.
+VAULT_CUT_MM = 10.0
+
+#: A part of the mesh apart from the largest one whose vertices lie farther than this (mm, the
+#: median) from the fitted template is not bone (a stand under the chin, a label, a mounting
+#: pin): the rules do not search it. Measured: the largest part of generated skulls 1.7-3.2
+#: mm, of the real heads 4.5-4.8 mm (their inner surfaces included); a box under a generated
+#: chin 15.9 mm, which put pogonion and gnathion 29-32 mm off, "located".
+FOREIGN_PART_MM = 10.0
 
 #: A point (a rule's or the template patch's) farther than this (mm) from the fitted template's
 #: own landmark found another structure: a rule's is not located (the estimate stays, as
@@ -108,6 +121,9 @@ class SkullLandmarks:
         The landmarks whose rule's point was not kept, and why: at an open edge of the mesh
         (:data:`NEAR_CUT_MM`) or far from the fitted template (:data:`FAR_FROM_TEMPLATE_MM`);
         each is template (its estimate) or absent.
+    parts_left_out : tuple of int
+        The face counts of the mesh's parts left out of the search as not bone
+        (:data:`FOREIGN_PART_MM`).
     """
 
     landmarks: dict
@@ -121,6 +137,7 @@ class SkullLandmarks:
     profile_s: dict = field(default_factory=dict)
     mandible_coverage: float = float("nan")
     doubtful: dict = field(default_factory=dict)
+    parts_left_out: tuple = ()
 
 
 def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
@@ -183,8 +200,11 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     has_mandible = coverage >= MANDIBLE_COVERED
     lap("align")
     fit = symmetrise(fit, mesh_samples[:: max(1, SURFACE_SAMPLES // SYMMETRY_POINTS)])
-    moved = fit.to_skull(vertices)
     tpl = template.vertices / fit.scale
+    foreign, left_out = foreign_parts(fit.to_skull(vertices), faces, tpl)
+    if left_out:
+        vertices, faces = compact(vertices, faces[~foreign])
+    moved = fit.to_skull(vertices)
     lap("symmetry")
     tree = cKDTree(moved)
     wanted = [n for n in CRANIAL_NAMES if has_mandible or n not in MANDIBLE_LANDMARKS]
@@ -213,15 +233,51 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     lap("axes")
     return SkullLandmarks(
         placed, quality, axes, bool(has_mandible), mismatch, fit.mesh2skull, fit.scale,
-        fit.rms_mm, profile, coverage, doubtful,
+        fit.rms_mm, profile, coverage, doubtful, left_out,
     )  # fmt: skip
+
+
+def foreign_parts(vertices, faces, template_points):
+    """The parts of a mesh that are not bone: apart from its largest part, with their vertices
+    farther than :data:`FOREIGN_PART_MM` (median) from the fitted template.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+        Normalised frame (the fitted template's), mm.
+    faces : ndarray of shape (F, 3), int
+    template_points : ndarray of shape (M, 3)
+        The fitted template's vertices, same frame.
+
+    Returns
+    -------
+    foreign : ndarray of shape (F,), bool
+        The faces of those parts.
+    face_counts : tuple of int
+        Each such part's face count, largest first.
+    """
+    from scipy.spatial import cKDTree
+
+    labels = face_components(faces, len(vertices))
+    counts = np.bincount(labels)
+    foreign = np.zeros(len(faces), bool)
+    if len(counts) < 2:
+        return foreign, ()
+    tree, left_out = cKDTree(template_points), []
+    for part in np.argsort(-counts)[1:]:
+        own = np.unique(faces[labels == part])
+        if np.median(tree.query(vertices[own])[0]) > FOREIGN_PART_MM:
+            foreign |= labels == part
+            left_out.append(int(counts[part]))
+    return foreign, tuple(left_out)
 
 
 def _plausible(located, found, expected, vertices, faces):
     """The rules' points (``located``) and the template's estimates (``found``) that can be
     trusted (normalised frame, mm): not far from the fitted template's landmark (``expected``,
     :data:`FAR_FROM_TEMPLATE_MM`) and, for a rule's point, not at an open edge of the mesh
-    (:data:`NEAR_CUT_MM`); and ``{name: why}`` of the rules' points not trusted."""
+    (:data:`NEAR_CUT_MM`; bregma :data:`VAULT_CUT_MM`); and ``{name: why}`` of the rules'
+    points not trusted."""
     from scipy.spatial import cKDTree
 
     def far(name, point):
@@ -231,9 +287,17 @@ def _plausible(located, found, expected, vertices, faces):
     cut = open_edge_points(vertices, faces, CUT_EDGE_MM)
     if len(cut):
         near = cKDTree(cut)
-        doubtful |= {n: "on an open edge of the mesh (a cut or missing bone)"
-                     for n, p in located.items()
-                     if n not in doubtful and near.query(p)[0] <= NEAR_CUT_MM}  # fmt: skip
+        for name, point in located.items():
+            gap = near.query(point)[0]
+            if name in doubtful:
+                continue
+            if gap <= NEAR_CUT_MM:
+                doubtful[name] = "on an open edge of the mesh (a cut or missing bone)"
+            elif name == "bregma" and gap <= VAULT_CUT_MM:
+                doubtful[name] = (
+                    f"the vault cut within {VAULT_CUT_MM:g} mm of it (its place along the vault "
+                    "is the template's, which slides on a cut vault)"
+                )
     located = {n: p for n, p in located.items() if n not in doubtful}
     found = {n: p for n, p in found.items() if not far(n, p)}
     return located, found, doubtful

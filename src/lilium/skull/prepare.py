@@ -14,7 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .locate import GIVEN, TEMPLATE, locate_skull_landmarks, orientation_dependent
+from .locate import (
+    FOREIGN_PART_MM,
+    GIVEN,
+    TEMPLATE,
+    locate_skull_landmarks,
+    orientation_dependent,
+)
 
 #: ``prepared_by`` of the files written here.
 PREPARED_BY = "lilium skull"
@@ -60,6 +66,17 @@ def landmark_sources(result):
     return out
 
 
+def parts_left_out_sentence(face_counts):
+    """What ``lilium skull`` says of the mesh's parts it took for no bone
+    (:func:`~lilium.skull.locate.foreign_parts`; ``face_counts`` per part)."""
+    faces = ", ".join(str(n) for n in face_counts)
+    return (
+        f"{len(face_counts)} part(s) of the mesh apart from the skull ({faces} faces) lie "
+        f"farther than {FOREIGN_PART_MM:g} mm from the fitted skull: not searched for "
+        "landmarks (a stand, a label?); an SFO still draws them: remove them from the mesh"
+    )
+
+
 def flagged(sources):
     """The names ``sources`` (``landmark_sources``) flags for review, in its order."""
     return [name for name, entry in sources.items() if entry.get("flag") == FLAG]
@@ -77,6 +94,8 @@ def _review_page(vertices, faces, result, sources, title):
         message += f"; template points (off until confirmed): {', '.join(template)}"
     for name, why in result.doubtful.items():
         message += f"; {name} not located: {why}"
+    if result.parts_left_out:
+        message += f"; {parts_left_out_sentence(result.parts_left_out)}"
     check = flagged(sources)
     if check:
         message += (
