@@ -295,7 +295,7 @@ def test_a_stand_under_the_chin_is_left_out(skull, tmp_path, capsys):
     import trimesh
 
     from lilium.cli.main import main
-    from lilium.io.mesh import write_mesh
+    from lilium.io.mesh import read_mesh, write_mesh
 
     v, f, truth, whole = skull
     # A block the skull rests on, touching the chin (a separate part): its top was taken for
@@ -310,11 +310,25 @@ def test_a_stand_under_the_chin_is_left_out(skull, tmp_path, capsys):
         assert result.quality[name] == "located"
         assert np.linalg.norm(result.landmarks[name] - whole.landmarks[name]) < 1.0, name
     assert locate_skull_landmarks(v, f).parts_left_out == ()
+    # A block beside the skull, 10 mm off (one part with it, as the case's skull reader takes
+    # parts 20 mm or less apart), or 100 mm off (the mesh was too large for a skull).
+    for gap in (10.0, 100.0):
+        block = trimesh.creation.box(extents=[40.0, 40.0, 40.0]).subdivide().subdivide()
+        block.apply_translation([v[:, 0].max() + 20.0 + gap, 0.0, 0.0])
+        beside = locate_skull_landmarks(
+            np.vstack([v, block.vertices]), np.vstack([f, np.asarray(block.faces) + len(v)])
+        )
+        assert beside.parts_left_out == (len(block.faces),)
+        assert np.count_nonzero(~beside.faces_kept) == len(block.faces)
+        for name, p in whole.landmarks.items():
+            assert np.linalg.norm(beside.landmarks[name] - p) < 1e-9, name
     write_mesh(tmp_path / "on_stand.ply", vs, fs)
     assert main(["skull", str(tmp_path / "on_stand.ply"), "--out", str(tmp_path / "s")]) == 0
     printed = capsys.readouterr().out
-    assert f"1 part(s) of the mesh apart from the skull ({len(stand.faces)} faces)" in printed
-    assert "remove them from the mesh" in (tmp_path / "s" / "review.html").read_text()
+    assert f"1 part(s) of the mesh left out of skull.ply ({len(stand.faces)} faces)" in printed
+    assert "left out of skull.ply" in (tmp_path / "s" / "review.html").read_text()
+    written, _ = read_mesh(tmp_path / "s" / "skull.ply")
+    assert np.allclose(written, v)  # the skull as given, without the stand
 
 
 def _bad_mesh(kind, folder):

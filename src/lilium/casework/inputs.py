@@ -159,15 +159,17 @@ def skull_files(source, log=None, out=None):
 def _automatic_skull(mesh, axes, folder, log):
     """:func:`skull_files` of a mesh without landmarks: its subject folder placed by ``lilium
     skull`` in ``folder`` (or read back from there)."""
-    from ..skull.prepare import prepare_skull
+    from ..skull.prepare import parts_left_out_sentence, prepare_skull
 
-    reused = prepare_skull(mesh, folder, reuse=True)["reused"]
+    done = prepare_skull(mesh, folder, reuse=True)
     if log is not None:
-        how = "read back from" if reused else "placed automatically (lilium skull) in"
+        how = "read back from" if done["reused"] else "placed automatically (lilium skull) in"
         log(
             f"{mesh.name}: no cranial landmark file beside the mesh: landmarks {how} {folder} "
             f"(automatic, unreviewed: check them in {folder / 'review.html'})"
         )
+        if done["result"] is not None and done["result"].parts_left_out:
+            log(f"{mesh.name}: {parts_left_out_sentence(done['result'].parts_left_out)}")
     axes = Path(axes) if axes is not None else folder / "soft_tissue_axes.json"
     landmarks = folder / "cranial_landmarks.json"
     inputs = {"skull mesh": mesh, "cranial landmarks": landmarks}

@@ -2,11 +2,13 @@
 
 Stages (:func:`locate_skull_landmarks`, each timed in :attr:`SkullLandmarks.profile_s`):
 
-1. ``check``: the mesh's size is a skull's in millimetres (:mod:`lilium.skull.checks`);
+1. ``check``: the parts apart from the mesh's largest left out, the rest's size a skull's in
+   millimetres (:mod:`lilium.skull.checks`);
 2. ``align``: the rigid motion (and scale) onto the template skull (:mod:`lilium.skull.align`),
    with and without the template's mandible; the fit that lays the template's cranium best is
    kept, and bone where it puts the template's mandible body says whether the lower jaw is
-   there (:func:`~lilium.skull.transfer.mandible_coverage`);
+   there (:func:`~lilium.skull.transfer.mandible_coverage`); parts far from the fitted template
+   left out (:data:`FOREIGN_PART_MM`) and the skull fitted again without them;
 3. ``symmetry``: the mirror plane to ``x = 0``;
 4. ``transfer``: the template's landmarks fitted patch by patch (:mod:`lilium.skull.transfer`);
    the fit checked (not a skull: an error);
@@ -26,10 +28,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.mesh import compact, face_components, open_edge_points
+from ..constants import PART_APART_MM
+from ..geometry.mesh import compact, face_components, open_edge_points, parts_apart
 from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL, MANDIBLE_LANDMARKS
 from .align import align_to_template, symmetrise
-from .checks import check_skull_extent, check_skull_fit
+from .checks import FIT_RMS_MM, check_skull_extent, check_skull_fit
 from .template import mean_template
 from .transfer import (
     MANDIBLE_COVERED,
@@ -60,11 +63,14 @@ NEAR_CUT_MM, CUT_EDGE_MM = 3.0, 20.0
 #: lay 6-8 mm from the cut. A bregma within ``VAULT_CUT_MM`` (mm) of a cut is not located.
 VAULT_CUT_MM = 10.0
 
-#: A part of the mesh apart from the largest one whose vertices lie farther than this (mm, the
-#: median) from the fitted template is not bone (a stand under the chin, a label, a mounting
-#: pin): the rules do not search it. Measured: the largest part of generated skulls 1.7-3.2
-#: mm, of the real heads 4.5-4.8 mm (their inner surfaces included); a box under a generated
-#: chin 15.9 mm, which put pogonion and gnathion 29-32 mm off, "located".
+#: Parts of the mesh that are not the skull are left out before anything is placed: those
+#: apart from the largest part (``PART_APART_MM`` between bounding boxes, as ``lilium case``'s
+#: skull reader leaves them out), then, after the template fit, a part whose vertices lie
+#: farther than this (mm, the median) from the fitted template (a stand under the chin, a
+#: label, a mounting pin); the skull is fitted again without them. Measured: the largest part
+#: of generated skulls 1.7-3.2 mm, of the real heads 4.5-4.8 mm (their inner surfaces
+#: included); a box under a generated chin 15.9 mm, which put pogonion and gnathion 29-32 mm
+#: off, "located".
 FOREIGN_PART_MM = 10.0
 
 #: A point (a rule's or the template patch's) farther than this (mm) from the fitted template's
@@ -122,8 +128,10 @@ class SkullLandmarks:
         (:data:`NEAR_CUT_MM`) or far from the fitted template (:data:`FAR_FROM_TEMPLATE_MM`);
         each is template (its estimate) or absent.
     parts_left_out : tuple of int
-        The face counts of the mesh's parts left out of the search as not bone
-        (:data:`FOREIGN_PART_MM`).
+        The face counts of the mesh's parts left out as not the skull's (apart from it, or far
+        from the fitted template: :data:`FOREIGN_PART_MM`), largest first.
+    faces_kept : ndarray of shape (F,), bool
+        Which of the mesh's faces are the skull's (all but those parts).
     """
 
     landmarks: dict
@@ -138,6 +146,7 @@ class SkullLandmarks:
     mandible_coverage: float = float("nan")
     doubtful: dict = field(default_factory=dict)
     parts_left_out: tuple = ()
+    faces_kept: np.ndarray | None = None
 
 
 def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
@@ -180,30 +189,33 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
         profile[stage] = now - clock[0]
         clock[0] = now
 
-    check_skull_extent(vertices, source)
+    kept, left_out = _skull_part(vertices, faces)  # of the mesh's faces
+    check_skull_extent(vertices[np.unique(faces[kept])], source)
     template = mean_template()
     lap("check")
-    mesh_samples = surface_samples(vertices, faces, SURFACE_SAMPLES, rng)
-    templates = {True: template.vertices, False: template.vertices[~template.mandible]}
-
-    def score(fit, has_mandible):
-        return mismatch_mm(fit.to_skull(mesh_samples), templates[has_mandible] / fit.scale)
-
-    _, _, mismatch, fits = align_to_template(mesh_samples, templates, score, rng)
-    # The fit that lays the template's cranium best, and bone where it puts the mandible.
-    cranium = template.vertices[~template.mandible]
-    on_cranium = {k: cranium_mismatch_mm(f.to_skull(mesh_samples), cranium / f.scale)
-                  for k, f in fits.items()}  # fmt: skip
-    fit = fits[min(on_cranium, key=on_cranium.get)]
-    body = template.vertices[mandible_body(template.vertices, template.mandible)] / fit.scale
-    coverage = mandible_coverage(fit.to_skull(mesh_samples), body)
+    start = rng.bit_generator.state
+    skull_v, skull_f = compact(vertices, faces[kept])
+    fit, mismatch, coverage, samples = _align(skull_v, skull_f, template, rng)
+    largest = _largest_part(skull_f, len(skull_v)) if fit.rms_mm > FIT_RMS_MM else None
+    retried = largest is not None and not largest.all()
+    if retried:  # an object by the skull may have pulled the fit: the largest part's alone,
+        # and the other parts judged by it
+        rng.bit_generator.state = start
+        fit = _align(*compact(skull_v, skull_f[largest]), template, rng)[0]
+    foreign, counts = foreign_parts(fit.to_skull(skull_v), skull_f, template.vertices / fit.scale)
+    if counts or retried:  # fitted again without them (a part far from the skull pulls the
+        # fit), with the same draws: the skull alone gets the fit and the landmarks it gets as
+        # a mesh alone
+        kept[np.flatnonzero(kept)[foreign]] = False
+        left_out = tuple(sorted(left_out + counts, reverse=True))
+        skull_v, skull_f = compact(vertices, faces[kept])
+        rng.bit_generator.state = start
+        fit, mismatch, coverage, samples = _align(skull_v, skull_f, template, rng)
+    faces_kept, vertices, faces = kept, skull_v, skull_f
     has_mandible = coverage >= MANDIBLE_COVERED
     lap("align")
-    fit = symmetrise(fit, mesh_samples[:: max(1, SURFACE_SAMPLES // SYMMETRY_POINTS)])
+    fit = symmetrise(fit, samples[:: max(1, SURFACE_SAMPLES // SYMMETRY_POINTS)])
     tpl = template.vertices / fit.scale
-    foreign, left_out = foreign_parts(fit.to_skull(vertices), faces, tpl)
-    if left_out:
-        vertices, faces = compact(vertices, faces[~foreign])
     moved = fit.to_skull(vertices)
     lap("symmetry")
     tree = cKDTree(moved)
@@ -233,8 +245,42 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     lap("axes")
     return SkullLandmarks(
         placed, quality, axes, bool(has_mandible), mismatch, fit.mesh2skull, fit.scale,
-        fit.rms_mm, profile, coverage, doubtful, left_out,
+        fit.rms_mm, profile, coverage, doubtful, left_out, faces_kept,
     )  # fmt: skip
+
+
+def _skull_part(vertices, faces):
+    """The faces of the mesh's parts that are not apart from its largest (``(F,)`` bool), and
+    the face counts of those apart (:func:`~lilium.geometry.mesh.parts_apart`,
+    ``PART_APART_MM``)."""
+    apart, parts = parts_apart(vertices, faces, None, PART_APART_MM)
+    return ~apart, tuple(sorted((n for n, _ in parts), reverse=True))
+
+
+def _largest_part(faces, n_vertices):
+    """The faces of a mesh's connected part with the most faces: ``(F,)`` bool."""
+    labels = face_components(faces, n_vertices)
+    return labels == np.argmax(np.bincount(labels))
+
+
+def _align(vertices, faces, template, rng):
+    """The mesh fitted onto the template (:func:`~lilium.skull.align.align_to_template`, with
+    and without its mandible): the fit that lays the template's cranium best, the two
+    hypotheses' mismatches, the share of the template's mandible body with bone there
+    (:func:`~lilium.skull.transfer.mandible_coverage`) and the mesh's surface samples."""
+    samples = surface_samples(vertices, faces, SURFACE_SAMPLES, rng)
+    templates = {True: template.vertices, False: template.vertices[~template.mandible]}
+
+    def score(fit, has_mandible):
+        return mismatch_mm(fit.to_skull(samples), templates[has_mandible] / fit.scale)
+
+    _, _, mismatch, fits = align_to_template(samples, templates, score, rng)
+    cranium = template.vertices[~template.mandible]
+    on_cranium = {k: cranium_mismatch_mm(f.to_skull(samples), cranium / f.scale)
+                  for k, f in fits.items()}  # fmt: skip
+    fit = fits[min(on_cranium, key=on_cranium.get)]
+    body = template.vertices[mandible_body(template.vertices, template.mandible)] / fit.scale
+    return fit, mismatch, mandible_coverage(fit.to_skull(samples), body), samples
 
 
 def foreign_parts(vertices, faces, template_points):
@@ -288,9 +334,9 @@ def _plausible(located, found, expected, vertices, faces):
     if len(cut):
         near = cKDTree(cut)
         for name, point in located.items():
-            gap = near.query(point)[0]
             if name in doubtful:
                 continue
+            gap = near.query(point)[0]
             if gap <= NEAR_CUT_MM:
                 doubtful[name] = "on an open edge of the mesh (a cut or missing bone)"
             elif name == "bregma" and gap <= VAULT_CUT_MM:

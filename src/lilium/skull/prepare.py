@@ -67,13 +67,15 @@ def landmark_sources(result):
 
 
 def parts_left_out_sentence(face_counts):
-    """What ``lilium skull`` says of the mesh's parts it took for no bone
-    (:func:`~lilium.skull.locate.foreign_parts`; ``face_counts`` per part)."""
-    faces = ", ".join(str(n) for n in face_counts)
+    """What ``lilium skull`` says of the mesh's parts it took for no part of the skull
+    (:func:`~lilium.skull.locate.locate_skull_landmarks`; ``face_counts`` per part, largest
+    first)."""
+    n, faces = len(face_counts), sum(face_counts)
+    largest = f"; the largest {face_counts[0]}" if n > 1 else ""
     return (
-        f"{len(face_counts)} part(s) of the mesh apart from the skull ({faces} faces) lie "
-        f"farther than {FOREIGN_PART_MM:g} mm from the fitted skull: not searched for "
-        "landmarks (a stand, a label?); an SFO still draws them: remove them from the mesh"
+        f"{n} part(s) of the mesh left out of skull.ply ({faces} faces{largest}): apart from "
+        f"the skull, or farther than {FOREIGN_PART_MM:g} mm from the fitted skull (a stand, a "
+        "label, a mandible not in place?); if one is this skull's bone, put it in place"
     )
 
 
@@ -170,6 +172,9 @@ def prepare_skull(mesh_path, out, landmarks_path=None, rng=0, reuse=False):
         check_landmarks_on_mesh(keep, vertices, faces, landmarks_path)
         check_cranial_labels(keep, vertices, landmarks_path)
     result = locate_skull_landmarks(vertices, faces, keep=keep, rng=rng, source=str(mesh_path))
+    # The skull without the parts that are not its bone (a stand, a far fragment): what the
+    # landmarks were placed on, and what an SFO is to draw.
+    vertices, faces = compact(vertices, faces[result.faces_kept])
     sources = landmark_sources(result)
     page = _review_page(vertices, faces, result, sources, mesh_path.name)
     out.mkdir(parents=True, exist_ok=True)
