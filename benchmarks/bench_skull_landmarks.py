@@ -12,13 +12,17 @@ Skulls:
 Each skull three times: as it is (the canonical skull frame), after a random rigid motion, and
 after that motion plus quadric decimation to ``min(100k, F / 2)`` faces (the generated skulls
 and headsq have fewer than 100k faces). Per landmark and overall: median, 90th percentile and
-worst distance (mm) to the truth, and the share placed as ``located``. The timing: a
+worst distance (mm) to the truth, and the share placed as ``located``. With ``--draws N``,
+each real head is also placed with ``N`` seeds of the fit's random draws (``rng`` of
+:func:`lilium.skull.locate_skull_landmarks`): the range of its median and worst error over the
+draws, which one seed's table does not show. The timing: a
 600k-face skull (``benchmarks/datasets/real_size.py``: a generated skull decimated and
 subdivided) with the per-stage profile, on one core (``OMP_NUM_THREADS=1`` etc. are set here).
 
 Run::
 
     PYTHONPATH=src python benchmarks/bench_skull_landmarks.py [--subjects 6] [--real DIR]
+        [--draws 20]
 """
 
 import os
@@ -136,6 +140,27 @@ def run(skulls, rng, log=print):
     return rows
 
 
+def draws(skulls, n, log=print):
+    """Each skull placed with ``n`` seeds of the fit: the range of its median and worst error
+    (mm) over the seeds, and how many refused it as no skull."""
+    from lilium.skull import locate_skull_landmarks
+
+    log(f"\nreal heads, {n} draws of the fit: median error min-max, worst landmark min-max (mm)")
+    for sid, (v, f, truth) in skulls.items():
+        medians, worst, refused = [], [], 0
+        for seed in range(n):
+            try:
+                errors, _ = score(locate_skull_landmarks(v, f, rng=seed), truth)
+            except ValueError:  # "does not look like a skull"
+                refused += 1
+                continue
+            e = np.array([x for x, _ in errors.values()])
+            medians.append(np.nanmedian(e))
+            worst.append(np.nanmax(e))
+        log(f"{sid:10s} median {min(medians):5.2f}-{max(medians):5.2f}  worst {min(worst):5.1f}-"
+            f"{max(worst):5.1f}  refused as no skull {refused} of {n}")  # fmt: skip
+
+
 def table(rows, title, file=sys.stdout):
     """Per-landmark and overall median / p90 / worst (mm) and located share."""
     names = sorted({n for r in rows for n in r["errors"]})
@@ -189,6 +214,7 @@ def main(argv=None):
     parser.add_argument("--no-real", action="store_true")
     parser.add_argument("--no-speed", action="store_true")
     parser.add_argument("--seed", type=int, default=0, help="random motions")
+    parser.add_argument("--draws", type=int, default=0, help="seeds of the fit per real head")
     args = parser.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     if not args.no_generated:
@@ -205,6 +231,8 @@ def main(argv=None):
         rows = run(real_skulls(args.real), rng)
         for variant in ("canonical", "moved", "decimated"):
             table([r for r in rows if r["variant"] == variant], f"real heads, {variant}")
+        if args.draws:
+            draws(real_skulls(args.real), args.draws)
     if not args.no_speed:
         speed(rng)
     return 0

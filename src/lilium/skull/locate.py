@@ -47,6 +47,7 @@ from .transfer import (
 
 #: Mesh surface samples the mirror plane is fitted on.
 SYMMETRY_POINTS = 6000
+
 #: Qualities of a placed landmark (docs/method/skull.md).
 LOCATED, TEMPLATE, GIVEN = "located", "template", "given"
 
@@ -193,24 +194,22 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     check_skull_extent(vertices[np.unique(faces[kept])], source)
     template = mean_template()
     lap("check")
-    start = rng.bit_generator.state
+    seed = rng.integers(2**63)  # every fit below draws the same samples
     skull_v, skull_f = compact(vertices, faces[kept])
-    fit, mismatch, coverage, samples = _align(skull_v, skull_f, template, rng)
+    fit, mismatch, coverage, samples = _align(skull_v, skull_f, template, seed)
     largest = _largest_part(skull_f, len(skull_v)) if fit.rms_mm > FIT_RMS_MM else None
     retried = largest is not None and not largest.all()
     if retried:  # an object by the skull may have pulled the fit: the largest part's alone,
         # and the other parts judged by it
-        rng.bit_generator.state = start
-        fit = _align(*compact(skull_v, skull_f[largest]), template, rng)[0]
+        fit = _align(*compact(skull_v, skull_f[largest]), template, seed)[0]
     foreign, counts = foreign_parts(fit.to_skull(skull_v), skull_f, template.vertices / fit.scale)
     if counts or retried:  # fitted again without them (a part far from the skull pulls the
-        # fit), with the same draws: the skull alone gets the fit and the landmarks it gets as
+        # fit), with the same seed: the skull alone gets the fit and the landmarks it gets as
         # a mesh alone
         kept[np.flatnonzero(kept)[foreign]] = False
         left_out = tuple(sorted(left_out + counts, reverse=True))
         skull_v, skull_f = compact(vertices, faces[kept])
-        rng.bit_generator.state = start
-        fit, mismatch, coverage, samples = _align(skull_v, skull_f, template, rng)
+        fit, mismatch, coverage, samples = _align(skull_v, skull_f, template, seed)
     faces_kept, vertices, faces = kept, skull_v, skull_f
     has_mandible = coverage >= MANDIBLE_COVERED
     lap("align")
@@ -263,11 +262,12 @@ def _largest_part(faces, n_vertices):
     return labels == np.argmax(np.bincount(labels))
 
 
-def _align(vertices, faces, template, rng):
+def _align(vertices, faces, template, seed):
     """The mesh fitted onto the template (:func:`~lilium.skull.align.align_to_template`, with
     and without its mandible): the fit that lays the template's cranium best, the two
     hypotheses' mismatches, the share of the template's mandible body with bone there
     (:func:`~lilium.skull.transfer.mandible_coverage`) and the mesh's surface samples."""
+    rng = np.random.default_rng(seed)
     samples = surface_samples(vertices, faces, SURFACE_SAMPLES, rng)
     templates = {True: template.vertices, False: template.vertices[~template.mandible]}
 
