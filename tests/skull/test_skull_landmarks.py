@@ -322,10 +322,11 @@ def test_a_stand_under_the_chin_is_left_out(skull, tmp_path, capsys):
         assert np.linalg.norm(result.landmarks[name] - whole.landmarks[name]) < 1.0, name
     assert locate_skull_landmarks(v, f).parts_left_out == ()
     # A block beside the skull, 10 mm off (one part with it, as the case's skull reader takes
-    # parts 20 mm or less apart), or 100 mm off (the mesh was too large for a skull).
-    for gap in (10.0, 100.0):
-        block = trimesh.creation.box(extents=[40.0, 40.0, 40.0]).subdivide().subdivide()
-        block.apply_translation([v[:, 0].max() + 20.0 + gap, 0.0, 0.0])
+    # parts 20 mm or less apart; 60 mm wide, it pulled the fit and the skull was refused as no
+    # skull), or 100 mm off (the mesh was too large for a skull).
+    for size, gap in ((40.0, 10.0), (60.0, 10.0), (40.0, 100.0)):
+        block = trimesh.creation.box(extents=[size] * 3).subdivide().subdivide()
+        block.apply_translation([v[:, 0].max() + size / 2 + gap, 0.0, 0.0])
         beside = locate_skull_landmarks(
             np.vstack([v, block.vertices]), np.vstack([f, np.asarray(block.faces) + len(v)])
         )

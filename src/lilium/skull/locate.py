@@ -8,7 +8,8 @@ Stages (:func:`locate_skull_landmarks`, each timed in :attr:`SkullLandmarks.prof
    with and without the template's mandible; the fit that lays the template's cranium best is
    kept, and bone where it puts the template's mandible body says whether the lower jaw is
    there (:func:`~lilium.skull.transfer.mandible_coverage`); parts far from the fitted template
-   left out (:data:`FOREIGN_PART_MM`) and the skull fitted again without them;
+   left out (:data:`FOREIGN_PART_MM`; judged by the largest part's own fit when the fit is
+   poor, :data:`PULLED_FIT_RMS_MM`) and the skull fitted again without them;
 3. ``symmetry``: the mirror plane to ``x = 0``;
 4. ``transfer``: the template's landmarks fitted patch by patch (:mod:`lilium.skull.transfer`);
    the fit checked (not a skull: an error);
@@ -32,7 +33,7 @@ from ..constants import PART_APART_MM
 from ..geometry.mesh import compact, face_components, open_edge_points, parts_apart
 from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL, MANDIBLE_LANDMARKS
 from .align import align_to_template, symmetrise
-from .checks import FIT_RMS_MM, check_skull_extent, check_skull_fit
+from .checks import check_skull_extent, check_skull_fit
 from .template import mean_template
 from .transfer import (
     MANDIBLE_COVERED,
@@ -73,6 +74,11 @@ VAULT_CUT_MM = 10.0
 #: included); a box under a generated chin 15.9 mm, which put pogonion and gnathion 29-32 mm
 #: off, "located".
 FOREIGN_PART_MM = 10.0
+#: A fit worse than this (trimmed RMS, mm) on a mesh of several parts may have been pulled by
+#: an object beside the skull: its largest part is fitted alone, and the other parts judged by
+#: that fit. The real heads fit to 4.3-4.7 mm, generated skulls 1.3-3.8; a 60 mm block 10 mm
+#: beside a generated skull pulled the fit to 7.5 mm and the skull was refused as no skull.
+PULLED_FIT_RMS_MM = 5.5
 
 #: A point (a rule's or the template patch's) farther than this (mm) from the fitted template's
 #: own landmark found another structure: a rule's is not located (the estimate stays, as
@@ -197,7 +203,7 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     seed = rng.integers(2**63)  # every fit below draws the same samples
     skull_v, skull_f = compact(vertices, faces[kept])
     fit, mismatch, coverage, samples = _align(skull_v, skull_f, template, seed)
-    largest = _largest_part(skull_f, len(skull_v)) if fit.rms_mm > FIT_RMS_MM else None
+    largest = _largest_part(skull_f, len(skull_v)) if fit.rms_mm > PULLED_FIT_RMS_MM else None
     retried = largest is not None and not largest.all()
     if retried:  # an object by the skull may have pulled the fit: the largest part's alone,
         # and the other parts judged by it
