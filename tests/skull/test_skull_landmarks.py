@@ -334,6 +334,18 @@ def test_a_stand_under_the_chin_is_left_out(skull, tmp_path, capsys):
         assert np.count_nonzero(~beside.faces_kept) == len(block.faces)
         for name, p in whole.landmarks.items():
             assert np.linalg.norm(beside.landmarks[name] - p) < 1e-9, name
+    # Specks of a noisy scan all about it: chained up they spanned more than a skull.
+    rng = np.random.default_rng(0)
+    specks = trimesh.util.concatenate([
+        trimesh.creation.icosphere(1, 1.0).apply_translation(rng.uniform(-200.0, 200.0, 3))
+        for _ in range(300)
+    ])  # fmt: skip
+    noisy = locate_skull_landmarks(
+        np.vstack([v, specks.vertices]), np.vstack([f, np.asarray(specks.faces) + len(v)])
+    )
+    assert len(noisy.parts_left_out) == 300
+    for name, p in whole.landmarks.items():
+        assert np.linalg.norm(noisy.landmarks[name] - p) < 1e-9, name
     write_mesh(tmp_path / "on_stand.ply", vs, fs)
     assert main(["skull", str(tmp_path / "on_stand.ply"), "--out", str(tmp_path / "s")]) == 0
     printed = capsys.readouterr().out

@@ -33,7 +33,7 @@ from ..constants import PART_APART_MM
 from ..geometry.mesh import compact, face_components, open_edge_points, parts_apart
 from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL, MANDIBLE_LANDMARKS
 from .align import align_to_template, symmetrise
-from .checks import check_skull_extent, check_skull_fit
+from .checks import SKULL_EXTENT_MM, check_skull_extent, check_skull_fit
 from .template import mean_template
 from .transfer import (
     MANDIBLE_COVERED,
@@ -257,9 +257,16 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
 def _skull_part(vertices, faces):
     """The faces of the mesh's parts that are not apart from its largest (``(F,)`` bool), and
     the face counts of those apart (:func:`~lilium.geometry.mesh.parts_apart`,
-    ``PART_APART_MM``)."""
+    ``PART_APART_MM``). Where the parts near one another span more than a skull (hundreds of
+    specks of a noisy scan chain up), the largest part alone."""
     apart, parts = parts_apart(vertices, faces, None, PART_APART_MM)
-    return ~apart, tuple(sorted((n for n, _ in parts), reverse=True))
+    kept = ~apart
+    if np.ptp(vertices[np.unique(faces[kept])], axis=0).max() > SKULL_EXTENT_MM[1]:
+        kept = _largest_part(faces, len(vertices))
+        labels = face_components(faces, len(vertices))
+        counts = np.bincount(labels[~kept])
+        return kept, tuple(sorted((int(n) for n in counts if n), reverse=True))
+    return kept, tuple(sorted((n for n, _ in parts), reverse=True))
 
 
 def _largest_part(faces, n_vertices):
@@ -312,16 +319,20 @@ def foreign_parts(vertices, faces, template_points):
 
     labels = face_components(faces, len(vertices))
     counts = np.bincount(labels)
-    foreign = np.zeros(len(faces), bool)
     if len(counts) < 2:
-        return foreign, ()
-    tree, left_out = cKDTree(template_points), []
-    for part in np.argsort(-counts)[1:]:
-        own = np.unique(faces[labels == part])
-        if np.median(tree.query(vertices[own])[0]) > FOREIGN_PART_MM:
-            foreign |= labels == part
-            left_out.append(int(counts[part]))
-    return foreign, tuple(left_out)
+        return np.zeros(len(faces), bool), ()
+    part_of = np.full(len(vertices), -1)
+    part_of[faces.reshape(-1)] = np.repeat(labels, 3)
+    other = np.flatnonzero((part_of >= 0) & (part_of != np.argmax(counts)))
+    distance = cKDTree(template_points).query(vertices[other])[0]
+    part = part_of[other]
+    order = np.lexsort((distance, part))  # by part, then by distance: each part's median
+    starts = np.flatnonzero(np.r_[True, np.diff(part[order]) != 0])
+    ends = np.r_[starts[1:], len(order)]
+    middle = distance[order][(starts + ends - 1) // 2] + distance[order][(starts + ends) // 2]
+    far = part[order][starts][middle / 2 > FOREIGN_PART_MM]
+    foreign = np.isin(labels, far)
+    return foreign, tuple(sorted((int(counts[p]) for p in far), reverse=True))
 
 
 def _plausible(located, found, expected, vertices, faces):
