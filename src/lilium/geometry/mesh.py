@@ -55,6 +55,28 @@ def face_components(faces, n_vertices):
     return np.unique(roots, return_inverse=True)[1].reshape(-1).astype(np.int64)
 
 
+def largest_component(faces, n_vertices):
+    """The faces of the connected component with the most faces, and the face counts of the
+    others.
+
+    Parameters
+    ----------
+    faces : ndarray of shape (F, 3), int (F >= 1)
+    n_vertices : int
+
+    Returns
+    -------
+    largest : ndarray of shape (F,), bool
+    others : tuple of int
+        Largest first.
+    """
+    labels = face_components(faces, n_vertices)
+    counts = np.bincount(labels)
+    keep_label = int(np.argmax(counts))
+    others = sorted((int(n) for k, n in enumerate(counts) if k != keep_label), reverse=True)
+    return labels == keep_label, tuple(others)
+
+
 def keep_largest_component(vertices, faces):
     """Keep the connected component with the most faces (vertices re-indexed).
 
@@ -70,9 +92,7 @@ def keep_largest_component(vertices, faces):
     """
     if len(faces) == 0:
         return vertices, faces
-    labels = face_components(faces, len(vertices))
-    keep_label = np.argmax(np.bincount(labels))
-    return compact(vertices, faces[labels == keep_label])
+    return compact(vertices, faces[largest_component(faces, len(vertices))[0]])
 
 
 def parts_apart(vertices, faces, anchors, gap_mm):

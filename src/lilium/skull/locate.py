@@ -30,7 +30,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..constants import PART_APART_MM
-from ..geometry.mesh import compact, face_components, open_edge_points, parts_apart
+from ..geometry.mesh import (
+    compact,
+    face_components,
+    largest_component,
+    open_edge_points,
+    parts_apart,
+)
 from ..softtissue.landmarks import CRANIAL_NAMES, CRANIAL_TO_FACIAL, MANDIBLE_LANDMARKS
 from .align import align_to_template, symmetrise
 from .checks import SKULL_EXTENT_MM, check_skull_extent, check_skull_fit
@@ -203,11 +209,13 @@ def locate_skull_landmarks(vertices, faces, keep=None, rng=0, source="mesh"):
     seed = rng.integers(2**63)  # every fit below draws the same samples
     skull_v, skull_f = compact(vertices, faces[kept])
     fit, mismatch, coverage, samples = _align(skull_v, skull_f, template, seed)
-    largest = _largest_part(skull_f, len(skull_v)) if fit.rms_mm > PULLED_FIT_RMS_MM else None
-    retried = largest is not None and not largest.all()
-    if retried:  # an object by the skull may have pulled the fit: the largest part's alone,
-        # and the other parts judged by it
-        fit = _align(*compact(skull_v, skull_f[largest]), template, seed)[0]
+    retried = False
+    if fit.rms_mm > PULLED_FIT_RMS_MM:  # an object by the skull may have pulled the fit: the
+        # largest part's alone, and the other parts judged by it
+        largest, others = largest_component(skull_f, len(skull_v))
+        retried = bool(others)
+        if retried:
+            fit = _align(*compact(skull_v, skull_f[largest]), template, seed)[0]
     foreign, counts = foreign_parts(fit.to_skull(skull_v), skull_f, template.vertices / fit.scale)
     if counts or retried:  # fitted again without them (a part far from the skull pulls the
         # fit), with the same seed: the skull alone gets the fit and the landmarks it gets as
@@ -262,17 +270,8 @@ def _skull_part(vertices, faces):
     apart, parts = parts_apart(vertices, faces, None, PART_APART_MM)
     kept = ~apart
     if np.ptp(vertices[np.unique(faces[kept])], axis=0).max() > SKULL_EXTENT_MM[1]:
-        kept = _largest_part(faces, len(vertices))
-        labels = face_components(faces, len(vertices))
-        counts = np.bincount(labels[~kept])
-        return kept, tuple(sorted((int(n) for n in counts if n), reverse=True))
+        return largest_component(faces, len(vertices))
     return kept, tuple(sorted((n for n, _ in parts), reverse=True))
-
-
-def _largest_part(faces, n_vertices):
-    """The faces of a mesh's connected part with the most faces: ``(F,)`` bool."""
-    labels = face_components(faces, n_vertices)
-    return labels == np.argmax(np.bincount(labels))
 
 
 def _align(vertices, faces, template, seed):
