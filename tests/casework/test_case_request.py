@@ -106,3 +106,17 @@ def test_a_script_runs_a_case_from_a_request(files, tmp_path):
     (entry,) = run_case(request, log=lines.append)
     assert entry.result and (tmp_path / "script" / "front" / "posest-sfo" / "result.json").is_file()
     assert any("found beside the photo" in line for line in lines)
+
+
+def test_a_request_refuses_what_it_can_check_before_reading_a_file(tmp_path):
+    # Nothing named here exists: the request's own faults come first, before any file is read.
+    skull, out = SkullSource(tmp_path / "none.ply"), tmp_path / "out"
+    one = (PhotoSource(tmp_path / "a.png"),)
+    with pytest.raises(ValueError, match="unknown method 'bogus'"):
+        CaseRequest(skull, out, photos=one, methods=("bogus",))
+    with pytest.raises(ValueError, match="--joint needs two or more --photo"):
+        CaseRequest(skull, out, photos=one, joint=True)
+    two = (*one, PhotoSource(tmp_path / "b.png"))
+    with pytest.raises(ValueError, match="--joint: none of the methods"):
+        CaseRequest(skull, out, photos=two, methods=("posest-sfo",), joint=True)
+    assert CaseRequest(skull, out, photos=two, joint=True).joint  # files are read later

@@ -14,7 +14,7 @@ from lilium.casework.lineup import check_candidates
 from lilium.experiments.store import ResultStore
 from lilium.identification.calibration import Calibration
 from lilium.io.calibration import read_calibration, shipped_path
-from lilium.io.case import check_distinct_photos
+from lilium.io.case import check_distinct_files
 from standin_case import terms_database
 
 # -- calibration files -------------------------------------------------------------------------
@@ -110,7 +110,7 @@ def test_a_copied_photo_is_the_same_photo(case, tmp_path):
     _, photo_dir = case
     copy = shutil.copytree(photo_dir, tmp_path / "copy")
     with pytest.raises(ValueError, match=r"--photo .*copy: the same image \(byte for byte\)"):
-        check_distinct_photos([photo_dir, copy])
+        check_distinct_files([photo_dir, copy])
     with pytest.raises(ValueError, match="--candidate B: .* is the same photo as"):
         check_candidates([("A", [photo_dir]), ("B", [photo_dir])])
     with pytest.raises(ValueError, match="--candidate A: .*copy is the same image"):

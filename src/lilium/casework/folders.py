@@ -2,7 +2,7 @@
 lineup`` resume (each stored result's input fingerprint, :func:`sfo_fingerprint`; the test that
 a stored result is this SFO's, :func:`stored_result`), the joint SFO's files and the lock that
 keeps a second run off an output folder (:func:`output_lock`); a photo given twice is refused
-by :func:`lilium.io.case.check_distinct_photos`.
+by :func:`lilium.io.case.check_distinct_files`.
 """
 
 import hashlib

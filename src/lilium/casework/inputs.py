@@ -19,6 +19,7 @@ from ..inputs import CaseWarning
 from ..io.case import (
     IMAGE_NAMES,
     check_axes_file,
+    check_distinct_files,
     first_file,
     parse_skull_files,
     read_mask,
@@ -231,7 +232,16 @@ def load_photos(
         :class:`~lilium.casework.prepared.LandmarkOrigin` of a ``lilium photo`` folder's
         landmarks (None for landmarks placed by hand). Each photo carries its priors' sources
         (``prior_sources``), its ``landmarks_file`` and its input warnings (:func:`with_priors`).
+
+    Raises
+    ------
+    ValueError
+        A photo given twice, by path or as a copy of its image
+        (:func:`~lilium.io.case.check_distinct_files`, before any is read) or of its landmarks
+        (:func:`~lilium.methods.photo_checks.check_distinct_photos`); a photo that cannot be
+        read, naming the file and the fix.
     """
+    check_distinct_files([source.path for source in sources])
     focal_cli, scd_cli = priors.focal_px, priors.scd_mm  # checked intervals
     use_exif, sensor_width_mm = priors.use_exif, priors.sensor_width_mm
     records = []

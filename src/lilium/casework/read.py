@@ -12,11 +12,11 @@ from pathlib import Path
 
 from ..inputs import CaseWarning
 from ..io.calibration import Calibrations
-from ..io.case import check_distinct_photos, parse_depth_table
+from ..io.case import parse_depth_table
 from ..io.results import read_camera
 from ..methods.checks import check_inputs
 from ..methods.options import SfoOptions
-from ..methods.registry import check_joint_methods, check_method, check_runnable
+from ..methods.registry import check_runnable
 from ..softtissue.depths import check_depth_table, depth_table_warning
 from .inputs import load_photos, load_skull
 
@@ -80,22 +80,17 @@ def read_case(request, log=None, out=None, plan=False):
     Raises
     ------
     ValueError
-        An invalid input, naming the file or option, checked in this order: the request (a
-        photo given twice, by path or by the image's bytes; an unknown method or variant;
-        ``--joint`` with fewer than two photos or no joint method), the depth table and the
-        calibration files, then a skull or a photo that cannot be read, mirrored
-        left/right labels (:func:`~lilium.methods.checks.check_inputs`); with ``plan``,
-        landmarks that do not pair.
+        An invalid input, naming the file or option, checked in this order: a skull that
+        cannot be read, a photo given twice (by path or by the image's bytes) or that cannot
+        be read, the depth table and the calibration files, mirrored left/right labels
+        (:func:`~lilium.methods.checks.check_inputs`); with ``plan``, landmarks that do not
+        pair. The request's own faults (an unknown method or variant, ``--joint`` with fewer
+        than two photos or no joint method) are refused when it is made
+        (:class:`~lilium.casework.request.CaseRequest`), before any file is read.
     """
-    # The request itself, and its small files, before the skull and the photos: the photos
-    # given once each, the methods known, the depth table and the calibration models parsed.
-    check_distinct_photos([source.path for source in request.photos])
-    table = None if request.depth_table is None else parse_depth_table(request.depth_table)
-    calibrations = Calibrations(request.calibration)
-    for method in request.methods:
-        check_method(method, request.options.variant)
-    if request.joint:
-        check_joint_methods(request.methods, len(request.photos))
+    # The request's methods were checked when it was made (CaseRequest); its files are read
+    # in one pass: the skull, the photos (each given once), then the small files (the depth
+    # table, the calibration models), and the whole checked together.
     skull, skull_inputs = load_skull(request.skull, log=log, out=out or request.out)
 
     def photos_of(sources, **kwargs):
@@ -108,6 +103,8 @@ def read_case(request, log=None, out=None, plan=False):
         for r, s in zip(records, request.photos, strict=True)
     ]
     candidates = tuple((c.name, tuple(photos_of(c.photos))) for c in request.candidates)
+    table = None if request.depth_table is None else parse_depth_table(request.depth_table)
+    calibrations = Calibrations(request.calibration)
     for record in [*records, *(r for _, rs in candidates for r in rs)]:
         check_inputs(skull, record.photo)
     terms_off = {}

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from ..methods.options import SfoOptions
+from ..methods.registry import check_joint_methods, check_method
 from ..validation import check_prior
 
 
@@ -148,6 +149,12 @@ class CaseRequest:
         Show a progress bar (lineup).
     command : str or None
         The command line as typed, for the provenance only.
+
+    Raises
+    ------
+    ValueError
+        When made, before any file is read: an unknown method or variant, ``joint`` with
+        fewer than two photos or no method with a joint SFO.
     """
 
     skull: SkullSource
@@ -166,6 +173,12 @@ class CaseRequest:
     title: str | None = None
     progress: bool = True
     command: str | None = None
+
+    def __post_init__(self):
+        for method in self.methods:
+            check_method(method, self.options.variant)
+        if self.joint:
+            check_joint_methods(self.methods, len(self.photos))
 
     def to_dict(self):
         """The request as plain JSON values (paths as strings; the SFO options as the

@@ -3,7 +3,7 @@
 Each function here reads one file (or finds one in a folder) into plain arrays and dicts; the
 typed :class:`~lilium.inputs.Skull` and :class:`~lilium.inputs.Photo` are built and checked
 across files by :mod:`lilium.casework.build`. A request's photos are compared as files here too
-(:func:`check_distinct_photos`: the same path, or the same image byte for byte). Every problem
+(:func:`check_distinct_files`: the same path, or the same image byte for byte). Every problem
 found is a ``ValueError`` whose message names the file, the field and the fix.
 """
 
@@ -30,7 +30,7 @@ from .prepared import (
 __all__ = [
     "IMAGE_NAMES",
     "check_axes_file",
-    "check_distinct_photos",
+    "check_distinct_files",
     "check_folder",
     "find_photo_image",
     "first_file",
@@ -386,7 +386,7 @@ def repeated_photo(paths):
     return None
 
 
-def check_distinct_photos(paths):
+def check_distinct_files(paths):
     """Refuse a photo given twice to a case or a joint SFO, by path or as a copy of its image
     (a joint SFO would count its landmarks twice, and the identification of several photos
     would count it as a second view and lift the single-photo cap).

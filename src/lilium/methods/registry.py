@@ -154,7 +154,7 @@ def check_joint_method(method, variant=None):
 
 def check_joint_methods(methods, n_photos):
     """Refuse a joint case (``lilium case --joint``) that cannot run, before the skull and the
-    photos are read (:func:`lilium.casework.read.read_case`).
+    photos are read (when its :class:`~lilium.casework.request.CaseRequest` is made).
 
     Parameters
     ----------
