@@ -6,16 +6,19 @@ import numpy as np
 import pytest
 
 from lilium.skull import locate_skull_landmarks
+from lilium.skull.rules import CRANIOMETRIC
+from lilium.softtissue.landmarks import base_name
 from lilium.synthetic.subjects import MANDIBLE_LANDMARKS, make_skull
 
-#: Located landmarks of a generated skull: median distance to the truth (mm); the
-#: rules are the generator's, so these hold well below the issue's 2 / 4 mm.
+#: Located landmarks of a generated skull: median distance to the truth (mm) of those whose
+#: rules are the generator's (all but :data:`~lilium.skull.rules.CRANIOMETRIC`).
 LOCATED_MEDIAN_MM = 2.0
 #: Landmarks whose rule is the generator's own and must land within this (mm). (alare: 2.5-2.6
 #: mm on this skull when it was the single most lateral row within 4 mm of the template's
-#: aperture centre; the middle of the widest rows finds the generator's height.)
-EXACT = ("nasion", "glabella", "ectoconchion_l", "ectoconchion_r", "orbitale_l", "orbitale_r",
-         "alare_l", "alare_r")  # fmt: skip
+#: aperture centre; the middle of the widest rows finds the generator's height.) Ectoconchion
+#: and dacryon follow the craniometric definitions instead
+#: (:func:`test_orbit_points_by_their_craniometric_definitions`).
+EXACT = ("nasion", "glabella", "orbitale_l", "orbitale_r", "alare_l", "alare_r")
 EXACT_MM = 2.0
 
 
@@ -35,8 +38,9 @@ def test_placement_on_a_generated_skull(skull):
     assert result.mandible
     assert set(result.landmarks) == set(truth)
     errors = {n: np.linalg.norm(result.landmarks[n] - truth[n]) for n in truth}
-    located = [errors[n] for n in truth if result.quality[n] == "located"]
-    assert len(located) >= 15
+    located = [errors[n] for n in truth if result.quality[n] == "located"
+               and base_name(n) not in CRANIOMETRIC]  # fmt: skip
+    assert len(located) >= 11
     assert np.median(located) <= LOCATED_MEDIAN_MM
     assert max(errors[n] for n in EXACT) <= EXACT_MM, {n: errors[n] for n in EXACT}
     assert set(result.quality.values()) <= {"located", "template"}
@@ -45,17 +49,43 @@ def test_placement_on_a_generated_skull(skull):
         assert np.isclose(np.linalg.norm(axis), 1.0)
 
 
+def test_orbit_points_by_their_craniometric_definitions(skull):
+    """Ectoconchion: the most anterior point of the lateral orbital border on the orbit's
+    transverse axis, found here from the mesh's vertices (those within 1 mm of its height
+    about the lateral border), not from the frontal height map the rule scans: on a flat
+    crest the rule takes the crest's orbital side, as deep as the most anterior vertex to
+    0.6 mm and within 2.5 mm of it. It lies in front of and lateral to the generator's
+    ectoconchion (its rim edge, inside the orbit). Dacryon: a vertex of the medial wall behind
+    the generator's point on the margin, by 2-8 mm, and below it (the generator scans 4 mm
+    above the orbit's centre, the rule on the transverse axis)."""
+    v, _, truth, result = skull
+    for name, sx in (("ectoconchion_l", 1.0), ("ectoconchion_r", -1.0)):
+        p, t = result.landmarks[name], truth[name]
+        assert result.quality[name] == "located"
+        band = v[(np.abs(v[:, 1] - p[1]) < 1.0) & (np.abs(v[:, 0] - t[0]) < 12.0)]
+        front = band[np.argmax(band[:, 2])]
+        assert front[2] - 0.6 <= p[2] <= front[2] + 1e-9, (name, p, front)
+        assert np.linalg.norm(p - front) < 2.5, (name, p, front)
+        assert p[2] > t[2] + 1.0 and sx * (p[0] - t[0]) > 0.5, (name, p, t)
+    for name in ("dacryon_l", "dacryon_r"):
+        p, t = result.landmarks[name], truth[name]
+        assert result.quality[name] == "located"
+        assert np.min(np.linalg.norm(v - p, axis=1)) < 1e-6  # a vertex of the mesh
+        assert 2.0 < t[2] - p[2] < 8.0 and 2.0 < t[1] - p[1] < 6.0, (name, p, t)
+
+
 def test_eye_corner_axes_lie_medial_of_the_bone_normal(skull):
     """``lilium skull``'s axes in its fitted frame: the lateral eye corners' medial of the front
-    (the generator's own frame here: x left, z front), where the bone normal points away from
-    the midline (:func:`lilium.softtissue.normals.fitted_axes`)."""
+    (the generator's own frame here: x left, z front) and medial of the bone normal, which on
+    the lateral border's crest points to the front or away from the midline
+    (:func:`lilium.softtissue.normals.fitted_axes`)."""
     from lilium.softtissue.normals import landmark_normals
 
     v, f, _, result = skull
     normals = landmark_normals(v, f, result.landmarks)
     for name, sx in (("ectoconchion_l", 1.0), ("ectoconchion_r", -1.0)):
         assert sx * result.axes[name][0] < -0.3 and result.axes[name][2] > 0.8, name
-        assert sx * normals[name][0] > 0, name
+        assert sx * (result.axes[name][0] - normals[name][0]) < -0.3, name
     np.testing.assert_allclose(result.axes["nasion"], normals["nasion"])
 
 
@@ -75,7 +105,8 @@ def test_invariant_to_a_rigid_motion(skull):
     for name, p in result.landmarks.items():
         assert np.linalg.norm(back[name] - p) < 1e-6, name
     errors = {n: np.linalg.norm(back[n] - truth[n]) for n in truth}
-    located = [errors[n] for n in truth if moved.quality[n] == "located"]
+    located = [errors[n] for n in truth if moved.quality[n] == "located"
+               and base_name(n) not in CRANIOMETRIC]  # fmt: skip
     assert np.median(located) <= LOCATED_MEDIAN_MM
     assert max(errors[n] for n in EXACT) <= EXACT_MM, {n: errors[n] for n in EXACT}
 

@@ -2,8 +2,11 @@
 
 The rules are the generator's placement rules (:mod:`lilium.synthetic.anatomy.landmarks`) with
 the search centres taken from the fitted template (``estimates``, ``anchors``) instead of the
-generator's design points; a landmark whose rule finds nothing keeps its template estimate.
-Written down (docs/method/skull.md lists them too):
+generator's design points, except ectoconchion and dacryon, which follow the craniometric
+definitions an examiner places them by (the generator puts both on the rim's edge, 2-4 mm
+inside the orbit from the first and 4 mm in front of the second, where a rounded real rim
+moves them 5-6 mm from an examiner's points); a landmark whose rule finds nothing keeps its
+template estimate. Written down (docs/method/skull.md lists them too):
 
 - midline profile: the most anterior point of the mesh's cut by ``x = 0`` per
   :data:`PROFILE_STEP_MM` of height (cranium and mandible apart);
@@ -21,9 +24,14 @@ Written down (docs/method/skull.md lists them too):
   chord from the window's top to menton; ``gnathion``: the mandible profile point furthest
   along ``(0, -1, 1)`` within ``CHIN_MM``;
 - orbits (frontal height map, :class:`~lilium.skull.surface.FrontalMap`): the centre is the
-  template's, re-centred once between the rim edges of scans up/down and in/out;
-  ``ectoconchion``: the rim edge of the scan from the centre laterally (32 mm); ``orbitale``:
-  down (30 mm); ``dacryon``: from 4 mm above the centre to 2 mm off the midline;
+  template's, re-centred once between the rim edges of scans up/down and in/out (the
+  transverse axis: the row through that centre); ``orbitale``: the rim edge of the scan
+  down (30 mm); ``ectoconchion``: the most anterior point of the lateral border on the
+  transverse axis, the crest of the scan from the centre laterally (32 mm), the innermost
+  point within :data:`PLATEAU_MM` of its highest (:func:`crest`); ``dacryon``, where frontal,
+  lacrimal and maxilla meet on the medial wall: the mesh vertex nearest to
+  :data:`DACRYON_BEHIND_MM` behind the medial margin, the rim edge of the scan on the
+  transverse axis to 2 mm off the midline;
 - ``alare``: the rim edge (0.9) of the scan from the aperture's centre laterally (25 mm) on
   each row within ``ALARE_ROWS_MM`` of the centre's height; of the rows whose edge lies within
   :data:`PLATEAU_MM` of the most lateral one, the middle one (the generator's scan runs at its
@@ -88,7 +96,13 @@ PLATEAU_MM = 0.5
 #: :data:`PLATEAU_MM` the generated 0.9 (3.0), but headsq's 1.5 mm further from its hand
 #: placement (its 3.2 mm CT's concavity is shallow).
 WALL_MM = 0.1
-ORBIT_SCANS_MM = {"ectoconchion": 32.0, "orbitale": 30.0, "dacryon_dy": 4.0, "dacryon_x": 2.0}
+#: Landmarks whose rule is the craniometric definition, not the generator's (module notes).
+CRANIOMETRIC = ("ectoconchion", "dacryon")
+ORBIT_SCANS_MM = {"ectoconchion": 32.0, "orbitale": 30.0, "dacryon_x": 2.0}
+#: Dacryon lies in the lacrimal fossa behind the medial margin (the anterior lacrimal crest):
+#: the vertex nearest to this far (mm) behind the margin's point; on a CT whose thin lacrimal
+#: bone is below the bone level, the posterior edge of the maxilla's frontal process.
+DACRYON_BEHIND_MM = 4.0
 ALARE_SCAN_MM = 25.0
 ALARE_FRACTION = 0.9
 ALARE_ROWS_MM = 8.0
@@ -198,7 +212,7 @@ def _behind_chord(arc, a, b, posterior):
     return arc[np.argmin(h) if posterior else np.argmax(h)].copy()
 
 
-def _orbit(fm, centre, sx):
+def _orbit(fm, vertices, centre, sx):
     """Ectoconchion, orbitale, dacryon of one side (``sx`` 1 left, -1 right)."""
     s = ORBIT_SCANS_MM
     c = np.asarray(centre, float)[:2]
@@ -210,14 +224,29 @@ def _orbit(fm, centre, sx):
         c[1] = 0.5 * (up[1] + down[1])
     if lateral is not None and medial is not None:
         c[0] = 0.5 * (lateral[0] + medial[0])
+    margin = rim_edge(fm.scan(c, (sx * s["dacryon_x"], c[1])))
     out = {
-        "ectoconchion": rim_edge(fm.scan(c, c + (sx * s["ectoconchion"], 0))),
+        "ectoconchion": crest(fm.scan(c, c + (sx * s["ectoconchion"], 0))),
         "orbitale": rim_edge(fm.scan(c, c - (0, s["orbitale"]))),
-        "dacryon": rim_edge(
-            fm.scan(c + (0, s["dacryon_dy"]), (sx * s["dacryon_x"], c[1] + s["dacryon_dy"]))
+        "dacryon": None if margin is None else _nearest(
+            vertices, margin - (0.0, 0.0, DACRYON_BEHIND_MM)
         ),
     }
     return {k: v for k, v in out.items() if v is not None and np.all(np.isfinite(v))}
+
+
+def crest(points):
+    """The crest of a scan from inside an opening outwards (``(N, 3)``, :meth:`FrontalMap.scan`):
+    of its points within :data:`PLATEAU_MM` of the highest z, the innermost (the rim's orbital
+    side of a flat crest); None when the scan has no surface."""
+    z = np.where(np.isfinite(points[:, 2]), points[:, 2], -np.inf)
+    if not np.isfinite(z).any():
+        return None
+    return points[int(np.argmax(z >= z.max() - PLATEAU_MM))].copy()
+
+
+def _nearest(vertices, point):
+    return vertices[np.argmin(np.sum((vertices - point) ** 2, axis=1))].copy()
 
 
 def _alare(fm, centre, sx):
@@ -317,7 +346,7 @@ def apply_rules(vertices, faces, on_mandible, estimates, anchors, scale=1.0):
     fm = frontal_map(vertices, faces)
     cranium = ~on_mandible
     for sx, sfx in ((1, "_l"), (-1, "_r")):
-        orbit = _orbit(fm, anchors["orbit" + sfx], sx)
+        orbit = _orbit(fm, vertices, anchors["orbit" + sfx], sx)
         out.update({k + sfx: v for k, v in orbit.items() if k + sfx in est})
         if "alare" + sfx in est:
             p = _alare(fm, anchors["aperture"], sx)
