@@ -170,9 +170,8 @@ def table(rows, title, file=sys.stdout):
     """Per-landmark and overall median / p90 / worst (mm) and located share."""
     names = sorted({n for r in rows for n in r["errors"]})
     print(f"\n{title}", file=file)
-    print(f"{'landmark':18s} {'n':>3s} {'median':>7s} {'p90':>7s} {'worst':>7s} {'located':>8s}"
+    print(f"{'landmark':28s} {'n':>3s} {'median':>7s} {'p90':>7s} {'worst':>7s} {'located':>8s}"
           " missing", file=file)  # fmt: skip
-    all_e = []
     for name in names + ["ALL", "ALL BUT " + "/".join(CRANIOMETRIC)]:
         if name == "ALL":
             pairs = [x for r in rows for x in r["errors"].values()]
@@ -184,11 +183,9 @@ def table(rows, title, file=sys.stdout):
         e = np.array([x for x, _ in pairs])
         ok = e[np.isfinite(e)]
         loc = np.mean([q == "located" for _, q in pairs])
-        if not name.startswith("ALL"):
-            all_e.extend(ok)
         stats = (np.median(ok), np.percentile(ok, 90), ok.max()) if len(ok) else (np.nan,) * 3
         print(
-            f"{name:18s} {len(e):3d} {stats[0]:7.2f} {stats[1]:7.2f} {stats[2]:7.2f} "
+            f"{name:28s} {len(e):3d} {stats[0]:7.2f} {stats[1]:7.2f} {stats[2]:7.2f} "
             f"{loc:8.0%} {int(np.isnan(e).sum())}",
             file=file,
         )

@@ -82,11 +82,12 @@ def read_case(request, log=None, out=None, plan=False):
     ValueError
         An invalid input, naming the file or option, checked in this order: a skull that
         cannot be read, a photo given twice (by path or by the image's bytes) or that cannot
-        be read, the depth table and the calibration files, mirrored left/right labels
-        (:func:`~lilium.methods.checks.check_inputs`); with ``plan``, landmarks that do not
-        pair. The request's own faults (an unknown method or variant, ``--joint`` with fewer
-        than two photos or no joint method) are refused when it is made
-        (:class:`~lilium.casework.request.CaseRequest`), before any file is read.
+        be read, a depth table or calibration file that cannot be parsed, mirrored left/right
+        labels (:func:`~lilium.methods.checks.check_inputs`), with ``plan`` landmarks that do
+        not pair, then the depth table's values. The request's own faults (an unknown method
+        or variant, ``--joint`` with fewer than two photos or no joint method) are refused
+        when it is made (:class:`~lilium.casework.request.CaseRequest`), before any file is
+        read.
     """
     # The request's methods were checked when it was made (CaseRequest); its files are read
     # in one pass: the skull, the photos (each given once), then the small files (the depth

@@ -77,9 +77,10 @@ UNDETERMINED_CAPS = ("examiner_camera", "unreviewed_skull_landmarks")
 
 #: The sentence of the ``unreviewed_skull_landmarks`` cap: cranial landmarks placed by ``lilium
 #: skull`` and not reviewed. Measured on the real CT heads (benchmarks/bench_skull_sfo.py):
-#: they lie about 5 mm from the written hand placement (median), and with them the true
-#: person's frontal + lateral decision went from strong support to moderate support for
-#: exclusion on one head: no conclusion either way until a reviewer confirms them.
+#: they lie about 4 mm from the written hand placement (median), and with them the true
+#: person's frontal + lateral decision moves (moderate support to undetermined on one head,
+#: undetermined to limited support on the other): no conclusion either way until a reviewer
+#: confirms them.
 UNREVIEWED_SKULL = (
     "cranial landmarks placed automatically and not reviewed (lilium skull): review them in "
     "the skull's review.html and give the saved file with --landmarks; until then no conclusion"

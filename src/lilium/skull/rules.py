@@ -3,10 +3,11 @@
 The rules are the generator's placement rules (:mod:`lilium.synthetic.anatomy.landmarks`) with
 the search centres taken from the fitted template (``estimates``, ``anchors``) instead of the
 generator's design points, except ectoconchion and dacryon, which follow the craniometric
-definitions an examiner places them by (the generator puts both on the rim's edge, 2-4 mm
-inside the orbit from the first and 4 mm in front of the second, where a rounded real rim
-moves them 5-6 mm from an examiner's points); a landmark whose rule finds nothing keeps its
-template estimate. Written down (docs/method/skull.md lists them too):
+definitions an examiner places them by: the generator puts ectoconchion on the rim's edge
+inside the orbit, about 3.5 mm from the lateral border's crest on its skulls, and dacryon on
+the medial margin, about 4 mm in front of and 4 mm above the craniometric point; on the real
+heads' rounded rims both lay 5-6 mm from an examiner's points (decision 0028). A landmark whose
+rule finds nothing keeps its template estimate. Written down (docs/method/skull.md lists them too):
 
 - midline profile: the most anterior point of the mesh's cut by ``x = 0`` per
   :data:`PROFILE_STEP_MM` of height (cranium and mandible apart);
@@ -85,7 +86,8 @@ GNATHION_SPAN_MM = 14.0
 #: The face's midline profile: section points in front of this (mm) behind the orbits' centres.
 FRONT_BEHIND_ORBIT_MM = 25.0
 #: Extreme points: the centre of the points within this (mm) of the extreme (a flat crest's
-#: middle, not its first vertex).
+#: middle, not its first vertex); the orbit's lateral border (:func:`crest`) takes the
+#: innermost of them instead, the crest's orbital side.
 PLATEAU_MM = 0.5
 #: Subspinale: profile points within this (mm) of the deepest are equally deep (a flat wall,
 #: as below the generator's spine), and the lowest of them is taken, as the generator's scan

@@ -1,6 +1,7 @@
 """Placing the landmarks of a synthetic subject on its bone and skin fields.
 
-Cranial landmarks (docs/method/skull.md) are found on the bone field by casting rays: midline ones
+Cranial landmarks (docs/method/skull.md; ectoconchion and dacryon on the rim's edge, not at
+their craniometric points: decision 0028) are found on the bone field by casting rays: midline ones
 from a frontal profile of the face (:func:`front_profile`) or as the most extreme surface point
 in a direction (:func:`support_point`); the edges of the orbits and the nasal aperture by
 :func:`rim_edge`. :func:`locate_cranial_landmarks` places them all; :func:`place_cheilia`
@@ -280,7 +281,8 @@ def _mental_foramen(bone, arch, y_body, sx):
 
 
 def locate_cranial_landmarks(bone, design):
-    """Every cranial landmark of docs/method/skull.md, on the bone surface.
+    """Every cranial landmark of docs/method/skull.md, on the bone surface (ectoconchion and
+    dacryon on the rim's edge: decision 0028).
 
     Parameters
     ----------
