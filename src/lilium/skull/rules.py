@@ -247,10 +247,6 @@ def crest(points):
     return points[int(np.argmax(z >= z.max() - PLATEAU_MM))].copy()
 
 
-def _nearest(vertices, point):
-    return vertices[np.argmin(np.sum((vertices - point) ** 2, axis=1))].copy()
-
-
 def _alare(fm, centre, sx):
     c = np.asarray(centre, float)[:2]
     edges = []
@@ -273,8 +269,12 @@ def plateau_point(points, direction):
     wanders by centimetres with a fraction of a degree of pose; the plateau's centre does not.
     The benchmarks' hand placements take their extreme points the same way."""
     h = points @ direction
-    top = points[h >= h.max() - PLATEAU_MM]
-    return points[np.argmin(np.linalg.norm(points - top.mean(axis=0), axis=1))].copy()
+    return _nearest(points, points[h >= h.max() - PLATEAU_MM].mean(axis=0))
+
+
+def _nearest(points, point):
+    """The point of ``points`` (N, 3) nearest to ``point`` (a copy)."""
+    return points[np.argmin(np.linalg.norm(points - point, axis=1))].copy()
 
 
 def _support(vertices, mask, centre, radius, direction):
