@@ -106,9 +106,11 @@ def main():
                 print(f"  {label:9s} {deg:+4.1f}: median {np.median(v):5.2f} p90 "
                       f"{np.percentile(v, 90):5.2f} max {v.max():6.1f}  {far}")  # fmt: skip
         moved = np.array(moved)
-        print(f"  {head}, all turns placed ({len(TURNS_DEG) * len(AXES) - len(failed)} of "
-              f"{len(TURNS_DEG) * len(AXES)}), every landmark: median {np.median(moved):.2f}, "
-              f"p90 {np.percentile(moved, 90):.2f}, share > 4 mm {np.mean(moved > 4):.0%}")
+        print(
+            f"  {head}, turns placed ({len(TURNS_DEG) * len(AXES) - len(failed)} of "
+            f"{len(TURNS_DEG) * len(AXES)}), every landmark: median {np.median(moved):.2f}, "
+            f"p90 {np.percentile(moved, 90):.2f}, share > 4 mm {np.mean(moved > 4):.0%}"
+        )
 
 
 if __name__ == "__main__":
