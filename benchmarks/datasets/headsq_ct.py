@@ -167,6 +167,16 @@ def _domed(skin):
 _CACHE = {}
 
 
+def mandible_vertices(skull, cranium):
+    """Which vertices of the complete ``skull`` (V, 3) are the mandible's, ``(V,)`` bool: those
+    with no vertex of the mandible-less ``cranium`` (V', 3) within 2 mm, in the skull's lower
+    60 %."""
+    from scipy.spatial import cKDTree
+
+    mask = cKDTree(cranium).query(skull)[0] > 2.0
+    return mask & (skull[:, 1] < np.percentile(skull[:, 1], 60))
+
+
 def headsq_subjects(path=None, work_dir=None):
     """The two headsq subjects (``lilium.synthetic.subjects.SyntheticSubject``), keyed by id.
 
@@ -192,9 +202,7 @@ def headsq_subjects(path=None, work_dir=None):
 
     skull, skin, nm = frame(skull), frame(skin), frame(nm)
     skin = _domed(skin)  # the head goes on above the cut (module notes, 4)
-    # mandible vertices: complete-skull vertices with no cranium vertex within 2 mm
-    mandible_mask = cKDTree(nm).query(skull)[0] > 2.0
-    mandible_mask &= skull[:, 1] < np.percentile(skull[:, 1], 60)
+    mandible_mask = mandible_vertices(skull, nm)
     cranial, facial, x_mid = place_landmarks(skull, skull_f, skin, skin_f, mandible_mask)
     shift = np.array([x_mid, 0.0, 0.0])  # x = 0 on the midline (between the orbits)
     skull, skin, nm = skull - shift, skin - shift, nm - shift

@@ -35,8 +35,6 @@ NAMED_MM = 3.0
 def headsq_placer():
     """``place(R) -> cranial landmarks`` of headsq (with its mandible) on the head turned by
     ``R`` (3, 3), turned back; None without the CT."""
-    from scipy.spatial import cKDTree
-
     import headsq_ct
     from headsq_landmarks import place_landmarks
 
@@ -45,9 +43,7 @@ def headsq_placer():
     subjects = headsq_ct.headsq_subjects()
     hq, nm = subjects["hq"], subjects["hq_nm"]
     skull, skin = hq.skull_vertices_mm, hq.skin_vertices_mm
-    # the mandible's vertices, as headsq_ct takes them
-    mandible = cKDTree(nm.skull_vertices_mm).query(skull)[0] > 2.0
-    mandible &= skull[:, 1] < np.percentile(skull[:, 1], 60)
+    mandible = headsq_ct.mandible_vertices(skull, nm.skull_vertices_mm)
 
     def place(R):
         cranial = place_landmarks(skull @ R.T, hq.skull_faces, skin @ R.T, hq.skin_faces,
